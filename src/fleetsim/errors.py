@@ -1,0 +1,80 @@
+"""The `FleetsimError` family.
+
+Every error says what was wrong, where (file, line, field, parameter, topic, frame) and, when it
+can, what would fix it. The CLI prints ``str(error)`` on one line without a traceback.
+"""
+
+from __future__ import annotations
+
+import difflib
+from collections.abc import Iterable
+
+
+class FleetsimError(Exception):
+    """Base of every error fleetsim raises on purpose."""
+
+
+class InvalidName(FleetsimError):
+    """An invalid graph resource name, remap or frame name."""
+
+
+class ParameterError(FleetsimError):
+    """A parameter with the wrong type, out of range, or a parameter file that does not parse."""
+
+
+class GraphError(FleetsimError):
+    """Misuse of the graph: a topic with two types, an unknown service, a duplicate node."""
+
+
+class ServiceError(FleetsimError):
+    """A service call that failed: no server, or the server raised."""
+
+
+class ActionError(FleetsimError):
+    """Misuse of an action server or client."""
+
+
+class MessageError(FleetsimError):
+    """An unknown message type, a field that does not exist, or bytes that do not decode."""
+
+
+class TransformError(FleetsimError):
+    """Base of tf lookup failures."""
+
+
+class FrameNotFound(TransformError):
+    """A frame that is not in the tree (tf2's LookupException)."""
+
+
+class ConnectivityError(TransformError):
+    """Two frames in disconnected trees."""
+
+
+class ExtrapolationError(TransformError):
+    """A lookup at a time outside the buffered window."""
+
+
+class DescriptionError(FleetsimError):
+    """A robot description (xacro, URDF, SRDF) that is invalid."""
+
+
+class SimulationError(FleetsimError):
+    """A world or simulator setup that cannot be built."""
+
+
+class LaunchError(FleetsimError):
+    """A launch file that cannot be read or run."""
+
+
+class TransportError(FleetsimError):
+    """Cross-process transport problems: no simulation running, a peer that does not answer."""
+
+
+class RecordingError(FleetsimError):
+    """An MCAP file that cannot be written or read."""
+
+
+def did_you_mean(word: str, choices: Iterable[str]) -> str:
+    """Return ``" (did you mean 'x'?)"`` for the closest choice, or ``""`` when none is close."""
+    close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
+    return f" (did you mean '{close[0]}'?)" if close else ""

@@ -1,0 +1,242 @@
+"""The in-process graph: typed topics with publishers and subscriptions, and services.
+
+Delivery is deferred and ordered: `Publisher.publish` puts the message in each subscription's
+queue (bounded by its ``queue_size``; the oldest message is dropped when full, as ROS does) and
+records the subscription in the runtime's FIFO of pending deliveries. The runtime drains that
+FIFO after every callback, so which callback runs next depends only on the order of events,
+never on the wall clock. A message is shared by reference with every subscriber.
+
+Latched publishers keep their last message and hand it to subscriptions made later, the way
+``map`` and ``/tf_static`` behave in ROS 1.
+
+Topics and services may also have remote ends (the Zenoh bridge): `Graph.listeners` are told of
+every new publisher, subscription and service, and a bridge registers itself as an ordinary
+subscription or service.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+from fleetsim.errors import GraphError, ServiceError, did_you_mean
+
+if TYPE_CHECKING:
+    from fleetsim.runtime.node import Node
+
+
+def _type_name(tp: Any) -> str:
+    return getattr(tp, "__msgtype__", None) or getattr(tp, "name", None) or repr(tp)
+
+
+class Topic:
+    __slots__ = ("name", "publishers", "subscriptions", "type")
+
+    def __init__(self, name: str, msg_type: Any) -> None:
+        self.name = name
+        self.type = msg_type
+        self.publishers: list[Publisher] = []
+        self.subscriptions: list[Subscription] = []
+
+
+class Subscription:
+    """A callback on a topic with its own bounded queue."""
+
+    __slots__ = ("_pending", "callback", "graph", "msg_type", "node", "queue", "queue_size", "topic")
+
+    def __init__(self, graph: Graph, topic: Topic, callback: Callable, queue_size: int, node):
+        self.graph = graph
+        self.topic = topic
+        self.msg_type = topic.type
+        self.callback = callback
+        self.queue_size = queue_size
+        self.queue: deque = deque(maxlen=queue_size if queue_size > 0 else None)
+        self.node = node
+        self._pending = graph._pending
+
+    def destroy(self) -> None:
+        if self in self.topic.subscriptions:
+            self.topic.subscriptions.remove(self)
+            self.queue.clear()
+            self.graph._changed("unsubscribe", self.topic.name, self)
+
+
+class Publisher:
+    """Publishes messages of one type on one topic."""
+
+    __slots__ = ("graph", "latch", "last", "msg_type", "node", "topic")
+
+    def __init__(self, graph: Graph, topic: Topic, latch: bool, node) -> None:
+        self.graph = graph
+        self.topic = topic
+        self.msg_type = topic.type
+        self.latch = latch
+        self.last: Any = None
+        self.node = node
+
+    @property
+    def name(self) -> str:
+        return self.topic.name
+
+    def publish(self, msg: Any) -> None:
+        if type(msg) is not self.msg_type:
+            raise GraphError(
+                f"topic {self.topic.name} carries {_type_name(self.msg_type)}, "
+                f"cannot publish {_type_name(type(msg))}"
+            )
+        if self.latch:
+            self.last = msg
+        pending = self.graph._pending
+        for sub in self.topic.subscriptions:
+            sub.queue.append(msg)
+            pending.append(sub)
+
+    def get_num_connections(self) -> int:
+        return len(self.topic.subscriptions)
+
+    def destroy(self) -> None:
+        if self in self.topic.publishers:
+            self.topic.publishers.remove(self)
+            self.graph._changed("unadvertise", self.topic.name, self)
+
+
+class Service:
+    __slots__ = ("callback", "name", "node", "srv_type")
+
+    def __init__(self, name: str, srv_type: Any, callback: Callable, node) -> None:
+        self.name = name
+        self.srv_type = srv_type
+        self.callback = callback
+        self.node = node
+
+
+class ServiceClient:
+    """Calls a service; in process the call runs the server's callback at once."""
+
+    __slots__ = ("graph", "name", "node", "srv_type")
+
+    def __init__(self, graph: Graph, name: str, srv_type: Any, node) -> None:
+        self.graph = graph
+        self.name = name
+        self.srv_type = srv_type
+        self.node = node
+
+    def wait_for_service(self, timeout: float | None = None) -> bool:
+        """True when a server exists (in process there is nothing to wait for)."""
+        return self.name in self.graph.services
+
+    def service_is_ready(self) -> bool:
+        return self.name in self.graph.services
+
+    def call(self, request: Any = None) -> Any:
+        return self.graph.call_service(self.name, self.srv_type, request)
+
+
+class Graph:
+    """Topics and services of one runtime."""
+
+    def __init__(self) -> None:
+        self.topics: dict[str, Topic] = {}
+        self.services: dict[str, Service] = {}
+        self.nodes: dict[str, Node] = {}
+        self._pending: deque[Subscription] = deque()
+        self.listeners: list[Callable[[str, str, Any], None]] = []
+
+    # -- topics ---------------------------------------------------------------------------
+    def _topic(self, name: str, msg_type: Any, who: str) -> Topic:
+        topic = self.topics.get(name)
+        if topic is None:
+            topic = self.topics[name] = Topic(name, msg_type)
+        elif topic.type is not msg_type:
+            raise GraphError(
+                f"topic {name} already carries {_type_name(topic.type)}; {who} asked for "
+                f"{_type_name(msg_type)}"
+            )
+        return topic
+
+    def advertise(self, name: str, msg_type: Any, latch: bool = False, node=None) -> Publisher:
+        who = f"publisher in {node.full_name}" if node is not None else "a publisher"
+        topic = self._topic(name, msg_type, who)
+        pub = Publisher(self, topic, latch, node)
+        topic.publishers.append(pub)
+        self._changed("advertise", name, pub)
+        return pub
+
+    def subscribe(
+        self, name: str, msg_type: Any, callback: Callable, queue_size: int = 10, node=None
+    ) -> Subscription:
+        if queue_size < 0:
+            raise GraphError(f"subscription to {name}: queue_size must be >= 0, got {queue_size}")
+        who = f"subscription in {node.full_name}" if node is not None else "a subscription"
+        topic = self._topic(name, msg_type, who)
+        sub = Subscription(self, topic, callback, queue_size, node)
+        topic.subscriptions.append(sub)
+        for pub in topic.publishers:
+            if pub.latch and pub.last is not None:
+                sub.queue.append(pub.last)
+                self._pending.append(sub)
+        self._changed("subscribe", name, sub)
+        return sub
+
+    def drain(self) -> int:
+        """Deliver every pending message in FIFO order; returns how many were delivered."""
+        pending = self._pending
+        n = 0
+        while pending:
+            sub = pending.popleft()
+            queue = sub.queue
+            if queue:
+                sub.callback(queue.popleft())
+                n += 1
+        return n
+
+    # -- services ---------------------------------------------------------------------------
+    def advertise_service(self, name: str, srv_type: Any, callback: Callable, node=None) -> Service:
+        if name in self.services:
+            owner = self.services[name].node
+            owner_name = owner.full_name if owner is not None else "another provider"
+            raise GraphError(f"service {name} is already provided by {owner_name}")
+        srv = self.services[name] = Service(name, srv_type, callback, node)
+        self._changed("advertise_service", name, srv)
+        return srv
+
+    def unadvertise_service(self, srv: Service) -> None:
+        if self.services.get(srv.name) is srv:
+            del self.services[srv.name]
+            self._changed("unadvertise_service", srv.name, srv)
+
+    def call_service(self, name: str, srv_type: Any, request: Any = None) -> Any:
+        srv = self.services.get(name)
+        if srv is None:
+            raise ServiceError(
+                f"service {name} is not available{did_you_mean(name, self.services)}"
+            )
+        if srv_type is not None and srv.srv_type is not srv_type:
+            raise ServiceError(
+                f"service {name} is {_type_name(srv.srv_type)}, called as {_type_name(srv_type)}"
+            )
+        if request is None:
+            request = srv.srv_type.Request()
+        elif type(request) is not srv.srv_type.Request:
+            raise ServiceError(
+                f"service {name} takes {_type_name(srv.srv_type.Request)}, "
+                f"got {_type_name(type(request))}"
+            )
+        try:
+            response = srv.callback(request)
+        except ServiceError:
+            raise
+        except Exception as e:
+            raise ServiceError(f"service {name} failed: {type(e).__name__}: {e}") from e
+        if response is None:
+            response = srv.srv_type.Response()
+        return response
+
+    # -- introspection ----------------------------------------------------------------------
+    def topic_types(self) -> dict[str, str]:
+        return {name: _type_name(t.type) for name, t in sorted(self.topics.items())}
+
+    def _changed(self, event: str, name: str, obj: Any) -> None:
+        for listener in self.listeners:
+            listener(event, name, obj)

@@ -1,0 +1,370 @@
+"""Parameters: declared once per node, validated on load, held in a rosparam-style tree.
+
+A node declares its parameters in a frozen dataclass whose fields are made with `param`::
+
+    @dataclass(frozen=True)
+    class AmclParams:
+        min_particles: int = param(100, range=(0, None), help="minimum allowed particles")
+        max_vel_theta: float = param(1.0, unit="rad/s", aliases=("max_rotational_vel",))
+
+`load_params` builds an instance from a mapping (usually the node's private namespace), converting
+where ROS would (an int where a float is declared), rejecting wrong types and out-of-range values
+with a `ParameterError` that names the parameter and where it came from, accepting old ROS names
+with a warning, and warning about unknown keys with a "did you mean" suggestion.
+
+`ParamTree` is the parameter server: a nested dict addressed by global names, with rosparam's
+semantics (loading a YAML mapping into a namespace merges leaf by leaf; setting a dict replaces).
+"""
+
+from __future__ import annotations
+
+import copy
+import dataclasses
+import logging
+import math
+import types
+import typing
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from fleetsim.errors import ParameterError, did_you_mean
+from fleetsim.runtime import names
+
+_log = logging.getLogger("fleetsim.params")
+
+_MISSING = dataclasses.MISSING
+
+
+def param(
+    default: Any,
+    *,
+    unit: str = "",
+    range: tuple[float | None, float | None] | None = None,  # noqa: A002 - reads like ROS docs
+    choices: tuple[Any, ...] | None = None,
+    aliases: tuple[str, ...] = (),
+    help: str = "",  # noqa: A002
+) -> Any:
+    """Declare one parameter: its ROS default, unit, valid range or choices, old names, meaning.
+
+    Mutable defaults (lists, dicts) are copied for each instance.
+    """
+    meta = {"unit": unit, "range": range, "choices": choices, "aliases": aliases, "help": help}
+    if isinstance(default, list | dict | set):
+        return dataclasses.field(default_factory=lambda d=default: copy.deepcopy(d), metadata=meta)
+    return dataclasses.field(default=default, metadata=meta)
+
+
+@dataclasses.dataclass(frozen=True)
+class ParamInfo:
+    """One declared parameter, as documentation and validation see it."""
+
+    name: str
+    type: Any
+    default: Any
+    unit: str
+    range: tuple[float | None, float | None] | None
+    choices: tuple[Any, ...] | None
+    aliases: tuple[str, ...]
+    help: str
+
+
+def describe_params(cls: type) -> list[ParamInfo]:
+    """The declared parameters of a params dataclass, in declaration order."""
+    hints = typing.get_type_hints(cls)
+    out = []
+    for f in dataclasses.fields(cls):
+        default = f.default if f.default is not _MISSING else f.default_factory()  # type: ignore[misc]
+        m = f.metadata
+        out.append(
+            ParamInfo(
+                name=f.name,
+                type=hints[f.name],
+                default=default,
+                unit=m.get("unit", ""),
+                range=m.get("range"),
+                choices=m.get("choices"),
+                aliases=tuple(m.get("aliases", ())),
+                help=m.get("help", ""),
+            )
+        )
+    return out
+
+
+def _type_label(tp: Any) -> str:
+    origin = typing.get_origin(tp)
+    if origin in (typing.Union, types.UnionType):
+        return " or ".join(_type_label(a) for a in typing.get_args(tp))
+    if origin is not None:
+        return getattr(origin, "__name__", str(origin))
+    return "None" if tp is type(None) else getattr(tp, "__name__", str(tp))
+
+
+def _convert(value: Any, tp: Any) -> Any:
+    """Convert ``value`` to the declared type ``tp`` as ROS would, or raise TypeError."""
+    if tp is Any:
+        return value
+    origin = typing.get_origin(tp)
+    if origin in (typing.Union, types.UnionType):
+        errors = []
+        for arg in typing.get_args(tp):
+            try:
+                return _convert(value, arg)
+            except TypeError as e:
+                errors.append(e)
+        raise TypeError(_type_label(tp))
+    if tp is type(None):
+        if value is None:
+            return None
+        raise TypeError("None")
+    if tp is bool:
+        if isinstance(value, bool):
+            return value
+        raise TypeError("bool")
+    if tp is int:
+        if isinstance(value, int) and not isinstance(value, bool):
+            return value
+        if isinstance(value, float) and value.is_integer():
+            return int(value)
+        raise TypeError("int")
+    if tp is float:
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            return float(value)
+        raise TypeError("float")
+    if tp is str:
+        if isinstance(value, str):
+            return value
+        raise TypeError("str")
+    if origin in (list, tuple) or tp in (list, tuple):
+        if not isinstance(value, list | tuple):
+            raise TypeError(_type_label(tp))
+        args = typing.get_args(tp)
+        if origin is tuple and args and args[-1] is not Ellipsis:
+            if len(args) != len(value):
+                raise TypeError(f"{len(args)}-element list")
+            return tuple(_convert(v, a) for v, a in zip(value, args))
+        item_tp = args[0] if args else Any
+        items = [_convert(v, item_tp) for v in value]
+        return tuple(items) if (origin is tuple or tp is tuple) else items
+    if origin is dict or tp is dict:
+        if not isinstance(value, Mapping):
+            raise TypeError("dict")
+        return dict(value)
+    if isinstance(tp, type) and isinstance(value, tp):
+        return value
+    raise TypeError(_type_label(tp))
+
+
+def _describe_value(value: Any) -> str:
+    return f"{type(value).__name__} {value!r}"
+
+
+def load_params(
+    cls: type,
+    values: Mapping[str, Any] | None,
+    where: str = "",
+    *,
+    ignore: tuple[str, ...] | frozenset[str] = (),
+    logger: logging.Logger | None = None,
+) -> Any:
+    """Build a ``cls`` instance from ``values``, validating every field.
+
+    Parameters
+    ----------
+    cls : a frozen dataclass whose fields were declared with `param`.
+    values : the raw parameters (for a node, its private namespace as a dict).
+    where : where the values came from, for messages (``"/lizi1/amcl"`` or ``"amcl.yaml"``).
+    ignore : keys that belong to someone else (sub-namespaces read by plugins); not warned about.
+    logger : where warnings go (renamed and unknown parameters).
+    """
+    log = logger or _log
+    values = dict(values or {})
+    infos = {i.name: i for i in describe_params(cls)}
+    alias_of = {a: i.name for i in infos.values() for a in i.aliases}
+    prefix = f"{where}: " if where else ""
+    kwargs: dict[str, Any] = {}
+    for key, raw in values.items():
+        name = key
+        if key in alias_of:
+            name = alias_of[key]
+            if name in values:
+                log.warning(
+                    "%sparameter '%s' is the old name of '%s'; both are set, using '%s'",
+                    prefix,
+                    key,
+                    name,
+                    name,
+                )
+                continue
+            log.warning("%sparameter '%s' is deprecated, use '%s'", prefix, key, name)
+        elif key not in infos:
+            if key not in ignore:
+                known = list(infos) + list(alias_of)
+                log.warning("%sunknown parameter '%s'%s", prefix, key, did_you_mean(key, known))
+            continue
+        info = infos[name]
+        try:
+            value = _convert(raw, info.type)
+        except TypeError:
+            raise ParameterError(
+                f"{prefix}parameter '{key}' must be {_type_label(info.type)}, "
+                f"got {_describe_value(raw)}"
+            ) from None
+        _check_range(info, key, value, prefix)
+        kwargs[name] = value
+    return cls(**kwargs)
+
+
+def _check_range(info: ParamInfo, key: str, value: Any, prefix: str) -> None:
+    if info.choices is not None and value not in info.choices:
+        options = ", ".join(repr(c) for c in info.choices)
+        raise ParameterError(
+            f"{prefix}parameter '{key}' must be one of {options}, got {value!r}"
+            f"{did_you_mean(str(value), [str(c) for c in info.choices])}"
+        )
+    if info.range is None or value is None:
+        return
+    lo, hi = info.range
+    if isinstance(value, float) and math.isnan(value):
+        raise ParameterError(f"{prefix}parameter '{key}' is NaN")
+    if (lo is not None and value < lo) or (hi is not None and value > hi):
+        lo_s = "-inf" if lo is None else f"{lo:g}"
+        hi_s = "inf" if hi is None else f"{hi:g}"
+        unit = f" {info.unit}" if info.unit else ""
+        raise ParameterError(
+            f"{prefix}parameter '{key}' = {value!r} is out of range [{lo_s}, {hi_s}]{unit}"
+        )
+
+
+# --------------------------------------------------------------------------------------------
+# The parameter server
+
+
+def load_yaml_file(path: str | Path) -> Any:
+    """Read a YAML parameter file; errors name the file and line."""
+    path = Path(path)
+    try:
+        text = path.read_text()
+    except OSError as e:
+        raise ParameterError(f"cannot read parameter file {path}: {e.strerror}") from None
+    return load_yaml_text(text, str(path))
+
+
+def load_yaml_text(text: str, source: str = "<string>") -> Any:
+    try:
+        return yaml.safe_load(text)
+    except yaml.YAMLError as e:
+        mark = getattr(e, "problem_mark", None)
+        at = f":{mark.line + 1}:{mark.column + 1}" if mark is not None else ""
+        problem = getattr(e, "problem", None) or str(e).splitlines()[0]
+        raise ParameterError(f"{source}{at}: YAML does not parse: {problem}") from None
+
+
+class ParamTree:
+    """The rosparam-style parameter server: a nested dict addressed by global names."""
+
+    def __init__(self) -> None:
+        self._root: dict[str, Any] = {}
+
+    @staticmethod
+    def _keys(name: str) -> list[str]:
+        names.validate_name(name)
+        if not name.startswith("/"):
+            raise ParameterError(f"parameter name '{name}' must be resolved (global) here")
+        return [k for k in name.split("/") if k]
+
+    def has(self, name: str) -> bool:
+        node: Any = self._root
+        for k in self._keys(name):
+            if not isinstance(node, dict) or k not in node:
+                return False
+            node = node[k]
+        return True
+
+    def get(self, name: str, default: Any = _MISSING) -> Any:
+        """The value at a global name (a deep copy for namespaces)."""
+        node: Any = self._root
+        for k in self._keys(name):
+            if not isinstance(node, dict) or k not in node:
+                if default is _MISSING:
+                    raise ParameterError(f"parameter '{name}' is not set")
+                return default
+            node = node[k]
+        return copy.deepcopy(node) if isinstance(node, dict | list) else node
+
+    def set(self, name: str, value: Any) -> None:
+        """Set a value; a dict replaces the whole namespace (rosparam ``set``)."""
+        keys = self._keys(name)
+        if not keys:
+            if not isinstance(value, dict):
+                raise ParameterError("the root namespace '/' can only be set to a dict")
+            self._root = copy.deepcopy(value)
+            return
+        node = self._root
+        for k in keys[:-1]:
+            nxt = node.get(k)
+            if not isinstance(nxt, dict):
+                nxt = node[k] = {}
+            node = nxt
+        node[keys[-1]] = copy.deepcopy(value)
+
+    def update(self, namespace: str, values: Mapping[str, Any]) -> None:
+        """Merge a mapping into a namespace leaf by leaf (rosparam ``load``)."""
+        ns = names.validate_namespace(namespace)
+        for key, value in values.items():
+            key = str(key)
+            full = names.join(ns, key.lstrip("/")) if not key.startswith("/") else key
+            if isinstance(value, Mapping) and value:
+                self.update(full, value)
+            else:
+                self.set(full, value)
+
+    def delete(self, name: str) -> None:
+        keys = self._keys(name)
+        node: Any = self._root
+        for k in keys[:-1]:
+            node = node.get(k) if isinstance(node, dict) else None
+            if node is None:
+                raise ParameterError(f"cannot delete parameter '{name}': not set")
+        if not isinstance(node, dict) or keys[-1] not in node:
+            raise ParameterError(f"cannot delete parameter '{name}': not set")
+        del node[keys[-1]]
+
+    def search(self, key: str, namespace: str) -> str | None:
+        """ROS ``searchParam``: the closest ``key`` found walking up from ``namespace``."""
+        ns = names.validate_namespace(namespace)
+        while True:
+            candidate = names.join(ns, key)
+            if self.has(candidate):
+                return candidate
+            if ns == "/":
+                return None
+            ns = names.namespace_of(ns)
+
+    def names(self) -> list[str]:
+        """Every leaf parameter's global name, sorted."""
+        out: list[str] = []
+
+        def walk(prefix: str, node: Any) -> None:
+            if isinstance(node, dict) and node:
+                for k, v in node.items():
+                    walk(f"{prefix}/{k}", v)
+            else:
+                out.append(prefix or "/")
+
+        walk("", self._root)
+        return sorted(out)
+
+    def load_file(self, path: str | Path, namespace: str = "/") -> None:
+        """``rosparam load FILE NS``: merge a YAML file's mapping into ``namespace``."""
+        data = load_yaml_file(path)
+        if data is None:
+            return
+        if not isinstance(data, Mapping):
+            raise ParameterError(
+                f"{path}: a parameter file must hold a mapping at the top level, "
+                f"got {type(data).__name__}"
+            )
+        self.update(namespace, data)

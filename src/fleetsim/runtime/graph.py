@@ -43,7 +43,16 @@ class Topic:
 class Subscription:
     """A callback on a topic with its own bounded queue."""
 
-    __slots__ = ("_pending", "callback", "graph", "msg_type", "node", "queue", "queue_size", "topic")
+    __slots__ = (
+        "_pending",
+        "callback",
+        "graph",
+        "msg_type",
+        "node",
+        "queue",
+        "queue_size",
+        "topic",
+    )
 
     def __init__(self, graph: Graph, topic: Topic, callback: Callable, queue_size: int, node):
         self.graph = graph
@@ -65,7 +74,7 @@ class Subscription:
 class Publisher:
     """Publishes messages of one type on one topic."""
 
-    __slots__ = ("graph", "latch", "last", "msg_type", "node", "topic")
+    __slots__ = ("graph", "last", "latch", "msg_type", "node", "topic")
 
     def __init__(self, graph: Graph, topic: Topic, latch: bool, node) -> None:
         self.graph = graph

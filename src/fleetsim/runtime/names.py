@@ -140,7 +140,9 @@ def parse_remap(text: str, where: str = "") -> tuple[str, str]:
     """Split ``from:=to`` into its two names, validating both."""
     m = _REMAP.match(text.strip())
     if not m or not m.group(2):
-        raise InvalidName(f"invalid remap '{text}'{where}: expected 'from:=to', e.g. 'scan:=base_scan'")
+        raise InvalidName(
+            f"invalid remap '{text}'{where}: expected 'from:=to', e.g. 'scan:=base_scan'"
+        )
     src, dst = m.group(1), m.group(2)
     validate_name(src, where)
     validate_name(dst, where)

@@ -166,9 +166,7 @@ class Node:
         self._subscriptions.append(sub)
         return sub
 
-    def create_service(
-        self, srv_type: Any, name: str, callback: Callable[[Any], Any]
-    ) -> Service:
+    def create_service(self, srv_type: Any, name: str, callback: Callable[[Any], Any]) -> Service:
         srv = self.runtime.graph.advertise_service(
             self.resolve_name(name), srv_type, callback, self
         )
@@ -178,9 +176,7 @@ class Node:
     def create_client(self, srv_type: Any, name: str) -> ServiceClient:
         return ServiceClient(self.runtime.graph, self.resolve_name(name), srv_type, self)
 
-    def create_timer(
-        self, period: float, callback: Callable[[], None], priority: int = 0
-    ) -> Timer:
+    def create_timer(self, period: float, callback: Callable[[], None], priority: int = 0) -> Timer:
         timer = self.runtime.create_timer(period, callback, priority)
         self._timers.append(timer)
         return timer

@@ -42,10 +42,10 @@ def param(
     default: Any,
     *,
     unit: str = "",
-    range: tuple[float | None, float | None] | None = None,  # noqa: A002 - reads like ROS docs
+    range: tuple[float | None, float | None] | None = None,
     choices: tuple[Any, ...] | None = None,
     aliases: tuple[str, ...] = (),
-    help: str = "",  # noqa: A002
+    help: str = "",
 ) -> Any:
     """Declare one parameter: its ROS default, unit, valid range or choices, old names, meaning.
 

@@ -128,6 +128,6 @@ class Scheduler:
                 heapq.heappush(heap, (timer.next_ns, timer.priority, timer.seq, timer))
             timer.callback()
             drain()
-        if until_ns is not None and not self._stop and self.time_ns < until_ns:
-            if condition is None or not condition():
-                self.time_ns = until_ns
+        reached_end = until_ns is not None and not self._stop and self.time_ns < until_ns
+        if reached_end and (condition is None or not condition()):
+            self.time_ns = until_ns

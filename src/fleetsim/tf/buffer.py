@@ -1,0 +1,356 @@
+"""The tf buffer: time-stamped transforms between frames and lookups across the tree.
+
+:class:`Buffer` behaves like tf2's ``BufferCore``: each child frame keeps a time-sorted cache of
+its transform to its parent over a ``cache_time`` window; static transforms hold at all times; a
+lookup walks from both frames to their common ancestor, interpolating each edge between the two
+stamps that bracket the requested time (linear translation, slerp rotation). Time ``0`` (or
+``None``) asks for the latest time at which every edge of the chain has data.
+
+Differences from tf2, on purpose: re-publishing a stamp that is already cached replaces the
+entry (as ROS 2's tf2 does); a frame that gets a new parent (or switches between static and
+dynamic) drops its history, since the earlier stamps describe a different edge; a transform that
+would close a loop is rejected when it is set, not when it is looked up.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from typing import Any
+
+from fleetsim.errors import (
+    ConnectivityError,
+    FrameNotFound,
+    ParameterError,
+    TransformError,
+    did_you_mean,
+)
+from fleetsim.tf import _msgs
+from fleetsim.tf.cache import FrameCache, checked_value, ns_from_time
+from fleetsim.tf.fastmath import IDENTITY, Transform7, compose, invert
+from fleetsim.tf.frame_info import FrameInfo, frame_info_of, frames_as_string, frames_as_yaml
+from fleetsim.tf.names import normalize_frame
+
+__all__ = ["Buffer", "FrameInfo"]
+
+_log = logging.getLogger("fleetsim.tf")
+
+#: How many known frames an error message lists before it says "... and N more".
+_MAX_LISTED_FRAMES = 12
+
+
+class Buffer:
+    """Transforms between coordinate frames over time (tf2's ``BufferCore``).
+
+    Parameters
+    ----------
+    cache_time : float
+        Seconds of history kept per frame, counted back from that frame's newest stamp.
+    """
+
+    def __init__(self, cache_time: float = 10.0) -> None:
+        if not (
+            isinstance(cache_time, int | float) and cache_time > 0 and math.isfinite(cache_time)
+        ):
+            raise ParameterError(
+                f"tf Buffer cache_time must be a positive number of seconds, got {cache_time!r}"
+            )
+        self.cache_time = float(cache_time)
+        self._cache_ns = round(self.cache_time * 1e9)
+        self._frames: dict[str, FrameCache] = {}
+        self._version = 0  # bumped whenever an edge of the tree appears, moves or disappears
+        self._paths: dict[tuple[str, str], tuple[int, list[FrameCache], list[FrameCache]]] = {}
+
+    # ------------------------------------------------------------------ writing
+    def set_transform(self, transform: Any, authority: str = "", is_static: bool = False) -> bool:
+        """Add one ``geometry_msgs/TransformStamped`` to the buffer.
+
+        ``header.frame_id`` is the parent, ``child_frame_id`` the child; the transform maps points
+        in the child frame into the parent frame. Returns ``False`` (and logs a warning, as tf2
+        does) for data older than the cache window of that frame; ``True`` otherwise.
+
+        Raises
+        ------
+        TransformError
+            For a self transform, a non-finite value, a quaternion far from unit norm, or a
+            transform that would close a loop in the tree.
+        InvalidName
+            For an empty frame id.
+        """
+        tr = transform.transform.translation
+        q = transform.transform.rotation
+        return self.set_transform_values(
+            transform.header.frame_id,
+            transform.child_frame_id,
+            transform.header.stamp,
+            (tr.x, tr.y, tr.z),
+            (q.x, q.y, q.z, q.w),
+            authority=authority,
+            is_static=is_static,
+        )
+
+    def set_transform_values(
+        self,
+        parent_frame: str,
+        child_frame: str,
+        stamp: Any,
+        translation: tuple[float, float, float],
+        rotation: tuple[float, float, float, float],
+        authority: str = "",
+        is_static: bool = False,
+    ) -> bool:
+        """Like :meth:`set_transform`, from plain values.
+
+        ``stamp`` is float seconds or a ``builtin_interfaces/Time``; ``translation`` is
+        ``(x, y, z)`` metres and ``rotation`` a quaternion ``(x, y, z, w)``, child in parent.
+        """
+        parent = normalize_frame(parent_frame)
+        child = normalize_frame(child_frame)
+        if parent == child:
+            raise TransformError(
+                f"transform from {authority or 'default_authority'!r} has child_frame_id equal to "
+                f"frame_id {child!r}; a frame cannot be its own parent"
+            )
+        value = checked_value(parent, child, translation, rotation)
+        stamp_ns = ns_from_time(stamp)
+        frames = self._frames
+        f = frames.get(child)
+        if f is None:
+            f = frames[child] = FrameCache(child)
+        if f.parent != parent or f.is_static != is_static:
+            self._check_no_loop(parent, child)
+            if parent not in frames:
+                frames[parent] = FrameCache(parent)
+            f.reset(parent, is_static)
+            self._version += 1
+        f.authority = authority
+        if f.insert(stamp_ns, value, self._cache_ns):
+            return True
+        _log.warning(
+            "tf: ignoring %s -> %s at %.9f s from %s: older than the cache window "
+            "(newest %.9f s, cache_time %g s)",
+            parent, child, stamp_ns * 1e-9, authority or "default_authority",
+            f.stamps[-1] * 1e-9, self.cache_time,
+        )  # fmt: skip
+        return False
+
+    def clear(self) -> None:
+        """Forget all dynamic transforms (as after a jump back in time); static ones stay."""
+        for f in self._frames.values():
+            if f.parent is not None and not f.is_static:
+                f.reset(None, False)
+        self._version += 1
+
+    def _check_no_loop(self, parent: str, child: str) -> None:
+        chain = [parent]
+        node = self._frames.get(parent)
+        while node is not None and node.parent is not None:
+            chain.append(node.parent)
+            if node.parent == child:
+                path = " -> ".join(reversed([child, *chain]))
+                raise TransformError(
+                    f"setting {child!r} as a child of {parent!r} would close a loop in the tf "
+                    f"tree (parent -> child: {path}); each frame has one parent, so find the "
+                    f"node that publishes {child!r} with parent {parent!r}"
+                )
+            node = self._frames.get(node.parent)
+
+    # ------------------------------------------------------------------ lookups
+    def lookup_transform(self, target_frame: str, source_frame: str, time: Any = 0.0) -> Any:
+        """Return the transform that maps points in ``source_frame`` into ``target_frame``.
+
+        Parameters
+        ----------
+        target_frame, source_frame : str
+            Frame ids; one leading ``/`` is ignored.
+        time : float, builtin_interfaces/Time or None
+            Sim time in seconds; ``0`` or ``None`` for the latest time common to the chain.
+
+        Returns
+        -------
+        geometry_msgs/TransformStamped
+            ``header.frame_id = target_frame``, ``child_frame_id = source_frame``,
+            ``header.stamp`` the time used.
+
+        Raises
+        ------
+        FrameNotFound, ConnectivityError, ExtrapolationError
+        """
+        stamp_ns, value, target, source = self._lookup(target_frame, source_frame, time)
+        return _msgs.transform_stamped(target, source, stamp_ns, value)
+
+    def lookup_transform_full(
+        self,
+        target_frame: str,
+        target_time: Any,
+        source_frame: str,
+        source_time: Any,
+        fixed_frame: str,
+    ) -> Any:
+        """Time-travelling lookup through a frame assumed fixed over time (tf2's advanced API).
+
+        Returns the transform mapping points in ``source_frame`` at ``source_time`` into
+        ``target_frame`` at ``target_time``, via ``fixed_frame``. The returned stamp is the
+        later of the two resolved times.
+        """
+        t1, v1, target, _ = self._lookup(target_frame, fixed_frame, target_time)
+        t2, v2, _, source = self._lookup(fixed_frame, source_frame, source_time)
+        return _msgs.transform_stamped(target, source, max(t1, t2), compose(v1, v2))
+
+    def can_transform(self, target_frame: str, source_frame: str, time: Any = 0.0) -> bool:
+        """Return whether :meth:`lookup_transform` with these arguments would succeed."""
+        try:
+            self._lookup(target_frame, source_frame, time)
+        except TransformError:
+            return False
+        return True
+
+    def lookup_arrays(self, target_frame: str, source_frame: str, time: Any = 0.0) -> tuple:
+        """Fast path: ``(translation (3,), quaternion (4,))`` NumPy arrays, target <- source."""
+        import numpy as np
+
+        v = self._lookup(target_frame, source_frame, time)[1]
+        return np.array(v[:3]), np.array(v[3:])
+
+    def lookup_matrix(self, target_frame: str, source_frame: str, time: Any = 0.0) -> Any:
+        """Fast path: the homogeneous 4x4 matrix mapping source points into the target frame."""
+        from fleetsim.tf.transforms import matrix_from_transform
+
+        v = self._lookup(target_frame, source_frame, time)[1]
+        return matrix_from_transform(v[:3], v[3:])
+
+    def lookup_tuple(self, target_frame: str, source_frame: str, time: Any = 0.0) -> Transform7:
+        """Fastest path: ``(tx, ty, tz, qx, qy, qz, qw)`` as plain floats, target <- source."""
+        return self._lookup(target_frame, source_frame, time)[1]
+
+    def lookup_pose2d(
+        self, target_frame: str, source_frame: str, time: Any = 0.0
+    ) -> tuple[float, float, float]:
+        """Planar pose ``(x, y, yaw)`` of ``source_frame`` in ``target_frame`` (metres, radians)."""
+        x, y, _, qx, qy, qz, qw = self._lookup(target_frame, source_frame, time)[1]
+        return x, y, math.atan2(2.0 * (qw * qz + qx * qy), qw * qw + qx * qx - qy * qy - qz * qz)
+
+    def latest_common_time(self, target_frame: str, source_frame: str) -> float:
+        """Newest time (seconds) at which every edge between the two frames has data.
+
+        ``0.0`` when the chain holds only static transforms (or the frames are the same).
+        """
+        down, up = self._chain(target_frame, source_frame)
+        return self._latest_ns(down, up) * 1e-9
+
+    def _lookup(
+        self, target_frame: str, source_frame: str, time: Any
+    ) -> tuple[int, Transform7, str, str]:
+        entry = self._paths.get((target_frame, source_frame))
+        if entry is not None and entry[0] == self._version:
+            down = entry[1]
+            up = entry[2]
+        else:
+            down, up = self._chain(target_frame, source_frame)
+        t_ns = 0 if time is None else ns_from_time(time)
+        if t_ns == 0:
+            t_ns = self._latest_ns(down, up)
+        acc_s = IDENTITY
+        for i, f in enumerate(up):
+            v = f.value_at(t_ns, target_frame, source_frame)
+            acc_s = v if i == 0 else compose(v, acc_s)
+        if down:
+            acc_t = IDENTITY
+            for i, f in enumerate(down):
+                v = f.value_at(t_ns, target_frame, source_frame)
+                acc_t = v if i == 0 else compose(v, acc_t)
+            acc_s = compose(invert(acc_t), acc_s)
+        target = target_frame[1:] if target_frame[:1] == "/" else target_frame
+        source = source_frame[1:] if source_frame[:1] == "/" else source_frame
+        return t_ns, acc_s, target, source
+
+    @staticmethod
+    def _latest_ns(down: list[FrameCache], up: list[FrameCache]) -> int:
+        latest = 0
+        for f in up:
+            if not f.is_static and (latest == 0 or f.stamps[-1] < latest):
+                latest = f.stamps[-1]
+        for f in down:
+            if not f.is_static and (latest == 0 or f.stamps[-1] < latest):
+                latest = f.stamps[-1]
+        return latest
+
+    def _chain(
+        self, target_frame: str, source_frame: str
+    ) -> tuple[list[FrameCache], list[FrameCache]]:
+        """Frames from target and from source up to (excluding) their common ancestor."""
+        target = normalize_frame(target_frame)
+        source = normalize_frame(source_frame)
+        frames = self._frames
+        for name, role in ((target, "target_frame"), (source, "source_frame")):
+            if name not in frames:
+                raise self._not_found(name, role)
+        chain_t = self._ancestors(target)
+        chain_s = self._ancestors(source)
+        index_s = {name: i for i, name in enumerate(chain_s)}
+        for j, name in enumerate(chain_t):
+            i = index_s.get(name)
+            if i is not None:
+                down = [frames[n] for n in chain_t[:j]]
+                up = [frames[n] for n in chain_s[:i]]
+                self._paths[(target_frame, source_frame)] = (self._version, down, up)
+                return down, up
+        raise ConnectivityError(
+            f"cannot transform {source!r} into {target!r}: they are in disconnected tf trees "
+            f"({target!r} is under root {chain_t[-1]!r}, {source!r} under root {chain_s[-1]!r}); "
+            f"a transform linking {chain_t[-1]!r} and {chain_s[-1]!r} (e.g. from a localization "
+            "node or a static_transform_publisher) would connect them"
+        )
+
+    def _ancestors(self, name: str) -> list[str]:
+        chain = [name]
+        f = self._frames[name]
+        while f.parent is not None:
+            chain.append(f.parent)
+            f = self._frames[f.parent]
+        return chain
+
+    def _not_found(self, name: str, role: str) -> FrameNotFound:
+        known = sorted(self._frames)
+        listed = ", ".join(known[:_MAX_LISTED_FRAMES]) or "none"
+        if len(known) > _MAX_LISTED_FRAMES:
+            listed += f" ... and {len(known) - _MAX_LISTED_FRAMES} more"
+        return FrameNotFound(
+            f"{role} {name!r} does not exist in the tf tree{did_you_mean(name, known)}; "
+            f"known frames: {listed}"
+        )
+
+    # ------------------------------------------------------------------ introspection
+    def all_frames(self) -> list[str]:
+        """Every frame id in the tree (children and roots), sorted."""
+        return sorted(self._frames)
+
+    def parents(self) -> dict[str, str]:
+        """Map each child frame to its parent (the edges of ``tf tree`` / view_frames)."""
+        return {n: f.parent for n, f in sorted(self._frames.items()) if f.parent is not None}
+
+    def frame_info(self, frame: str) -> FrameInfo:
+        """Parent, authority, average rate and time window of one child frame's transform."""
+        name = normalize_frame(frame)
+        f = self._frames.get(name)
+        if f is None:
+            raise self._not_found(name, "frame")
+        if f.parent is None:
+            raise FrameNotFound(f"frame {name!r} is a root of the tf tree and has no parent edge")
+        return frame_info_of(f, self.cache_time)
+
+    def frames_info(self) -> dict[str, FrameInfo]:
+        """:meth:`frame_info` for every child frame, by frame id."""
+        return {
+            n: frame_info_of(f, self.cache_time)
+            for n, f in sorted(self._frames.items())
+            if f.parent is not None
+        }
+
+    def all_frames_as_yaml(self) -> str:
+        """tf2's ``allFramesAsYAML``: one block per child frame, as view_frames reads it."""
+        return frames_as_yaml(self.frames_info())
+
+    def all_frames_as_string(self) -> str:
+        """tf2's ``allFramesAsString``: ``Frame X exists with parent Y.`` lines."""
+        return frames_as_string(self.parents())

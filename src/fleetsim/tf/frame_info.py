@@ -1,0 +1,86 @@
+"""Per-frame statistics of a tf buffer, as ``view_frames`` and ``tf_monitor`` report them."""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import yaml
+
+__all__ = ["FrameInfo", "frame_info_of", "frames_as_string", "frames_as_yaml"]
+
+#: Authority reported for transforms set without one (tf2's name for it).
+DEFAULT_AUTHORITY = "default_authority"
+
+
+@dataclass(frozen=True, slots=True)
+class FrameInfo:
+    """What the buffer knows about one child frame's edge to its parent.
+
+    Attributes
+    ----------
+    frame, parent : str
+        The child frame and its parent.
+    authority : str
+        Who sent the latest transform (the broadcasting node's name), or ``default_authority``.
+    is_static : bool
+        Whether the edge came from ``/tf_static`` (valid at all times).
+    rate : float or None
+        Average publishing rate over the cached window in Hz; ``None`` for a static edge or a
+        single cached stamp.
+    most_recent, oldest : float
+        Newest and oldest cached stamps, seconds of sim time.
+    buffer_length : float
+        ``most_recent - oldest``, seconds.
+    """
+
+    frame: str
+    parent: str
+    authority: str
+    is_static: bool
+    rate: float | None
+    most_recent: float
+    oldest: float
+    buffer_length: float
+
+
+def frame_info_of(f: Any, cache_time: float) -> FrameInfo:
+    """Summarise one buffer frame record (``name``, ``parent``, ``stamps``...) as `FrameInfo`."""
+    newest = f.stamps[-1] * 1e-9 if f.stamps else 0.0
+    oldest = f.stamps[0] * 1e-9 if f.stamps else 0.0
+    span = newest - oldest
+    rate = (len(f.stamps) - 1) / span if (not f.is_static and span > 0.0) else None
+    return FrameInfo(
+        frame=f.name,
+        parent=f.parent,
+        authority=f.authority or DEFAULT_AUTHORITY,
+        is_static=f.is_static,
+        rate=rate,
+        most_recent=newest,
+        oldest=oldest,
+        buffer_length=span,
+    )
+
+
+def frames_as_yaml(infos: dict[str, FrameInfo]) -> str:
+    """tf2's ``allFramesAsYAML`` layout: ``frame: {parent, broadcaster, rate, ...}`` blocks."""
+    doc = {}
+    for name, info in infos.items():
+        d = asdict(info)
+        doc[name] = {
+            "parent": d["parent"],
+            "broadcaster": d["authority"],
+            "rate": 10000.0 if info.is_static else round(d["rate"] or 0.0, 3),
+            "most_recent_transform": d["most_recent"],
+            "oldest_transform": d["oldest"],
+            "buffer_length": d["buffer_length"],
+            "is_static": d["is_static"],
+        }
+    return yaml.safe_dump(doc, sort_keys=False) if doc else ""
+
+
+def frames_as_string(parents: dict[str, str]) -> str:
+    """tf2's ``allFramesAsString``: one ``Frame X exists with parent Y.`` line per child."""
+    return "".join(
+        f"Frame {child} exists with parent {parent}.\n" for child, parent in parents.items()
+    )

@@ -20,7 +20,10 @@ from fleetsim.msgs.fields import Prim, SeqSpec
 from fleetsim.msgs.registry import ROS1_FIELD_RENAMES, get_type, is_message, type_name
 
 _TIME_TYPES = ("builtin_interfaces/msg/Time", "builtin_interfaces/msg/Duration")
-_FLOAT_WORDS = {"inf": math.inf, "+inf": math.inf, "-inf": -math.inf, "nan": math.nan}
+_FLOAT_WORDS = {  # strings accepted for float fields (YAML spells them .inf, .nan)
+    "inf": math.inf, "+inf": math.inf, "-inf": -math.inf, "nan": math.nan,
+    ".inf": math.inf, "+.inf": math.inf, "-.inf": -math.inf, ".nan": math.nan,
+}  # fmt: skip
 
 
 def to_dict(msg: Any) -> dict[str, Any]:
@@ -116,6 +119,8 @@ def _value(spec: Any, val: Any, where: str, path: str) -> Any:
 
             if isinstance(val, str | bytes | Mapping) or np.ndim(val) == 0:
                 _wrong(spec_label(spec), val, where, path)
+            if spec.elem.py is float and isinstance(val, list | tuple):
+                val = [_float_word(v) for v in val]
             return coerce_array(val, spec, f"{where}: {_label(path)}")
         if not isinstance(val, list | tuple):
             _wrong(spec_label(spec), val, where, path)
@@ -140,10 +145,13 @@ def _wrong(expected: str, val: Any, where: str, path: str) -> None:
     )
 
 
+def _float_word(v: Any) -> Any:
+    return _FLOAT_WORDS.get(v.strip().lower(), v) if isinstance(v, str) else v
+
+
 def _prim(spec: Prim, val: Any, where: str, path: str) -> Any:
     if spec.py is float:
-        if isinstance(val, str) and val.strip().lower() in _FLOAT_WORDS:
-            return _FLOAT_WORDS[val.strip().lower()]
+        val = _float_word(val)
         if isinstance(val, bool | np.bool_) or not isinstance(
             val, int | float | np.integer | np.floating
         ):

@@ -8,7 +8,7 @@ STAMP := $(VENV)/.installed
 
 # System packages: graphviz (urdf graph, tf tree), Mesa EGL (headless MuJoCo rendering),
 # ffmpeg comes inside imageio-ffmpeg. Installed only when missing.
-SYSPKGS := graphviz libegl1 libegl-mesa0 libgl1-mesa-dri libgles2 libosmesa6
+SYSPKGS := graphviz libegl1 libegl-mesa0 libgl1-mesa-dri libgles2
 
 sysdeps:
 	@missing=""; for p in $(SYSPKGS); do \

@@ -43,3 +43,16 @@ def populated():
         return populate(cls, np.random.default_rng(seed))
 
     return make
+
+
+def own_definition(typename: str) -> list[str]:
+    """The lines of a type's own ros2msg definition (without its dependencies)."""
+    from fleetsim.msgs import msgdef
+
+    return msgdef(typename).split("=" * 80)[0].strip().splitlines()
+
+
+@pytest.fixture
+def own_def():
+    """``own_def(typename)`` -> the lines of the type's own ros2msg definition."""
+    return own_definition

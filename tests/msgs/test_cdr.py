@@ -105,3 +105,24 @@ def test_msgdef_format_for_mcap():
     assert "=" * 80 + "\nMSG: builtin_interfaces/Time\nint32 sec\nuint32 nanosec\n" in text
     status = msgdef("actionlib_msgs/msg/GoalStatus")
     assert "uint8 PENDING=0" in status and "uint8 LOST=9" in status
+
+
+def test_user_types_and_redefinition():
+    def define():
+        from fleetsim.msgs import message
+        from fleetsim.msgs.fields import Seq, float32, string
+
+        @message("fleetsim_test/msg/Beacon")
+        class Beacon:
+            name: string
+            signal: Seq[float32]
+
+        return Beacon
+
+    first = define()
+    b = first(name="dock", signal=np.array([1.5], np.float32))
+    assert type(deserialize(serialize(b), "fleetsim_test/Beacon")) is first
+    second = define()  # e.g. a module reloaded: same name and fields
+    back = deserialize(serialize(second(name="x")), "fleetsim_test/msg/Beacon")
+    assert type(back) is second and back.name == "x"
+    assert msgdef("fleetsim_test/Beacon") == "string name\nfloat32[] signal\n"

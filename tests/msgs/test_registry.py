@@ -127,3 +127,11 @@ def test_bad_definitions_are_reported():
         @message("fleetsim_test/msg/Clash")
         class Clash2:
             y: float64
+
+
+def test_unknown_annotation_name_is_reported():
+    with pytest.raises(MessageError, match=r"Bad3\)\: an annotation names an unknown type"):
+
+        @message("fleetsim_test/msg/Bad3")
+        class Bad3:
+            x: NotAType  # noqa: F821

@@ -3,7 +3,9 @@
 from __future__ import annotations
 
 import math
+from typing import NoReturn
 
+from fleetsim.errors import MessageError
 from fleetsim.msgs.fields import int32, uint32
 from fleetsim.msgs.registry import message
 
@@ -64,7 +66,5 @@ class Duration:
         return self.sec * _NS + self.nanosec
 
 
-def _not_finite(cls: type, t: float):
-    from fleetsim.errors import MessageError
-
+def _not_finite(cls: type, t: float) -> NoReturn:
     raise MessageError(f"{cls.__msgtype__}.from_sec: {t!r} seconds is not a finite number")

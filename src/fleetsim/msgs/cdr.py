@@ -23,7 +23,7 @@ from fleetsim.msgs.fields import Prim, SeqSpec
 from fleetsim.msgs.registry import get_type, is_message, type_name
 
 _STORE = get_typestore(Stores.ROS2_HUMBLE)
-_READY: set[str] = set()
+_READY: dict[str, type] = {}  # type name -> the class the store currently decodes into
 _PLANS: dict[type, list[tuple[str, str, Any]]] = {}
 _MSGDEFS: dict[str, str] = {}
 _DUMMY = ("structure_needs_at_least_one_member", (Nodetype.BASE, ("uint8", 0)))
@@ -62,7 +62,7 @@ def _same(have: tuple, mine: tuple) -> bool:
 
 def _prepare(cls: type) -> None:
     name = cls.__msgtype__
-    if name in _READY:
+    if _READY.get(name) is cls:
         return
     for _, spec in cls.__msgfields__:
         sub = _nested(spec)
@@ -84,7 +84,8 @@ def _prepare(cls: type) -> None:
         _STORE.types[name] = cls
     else:
         _STORE.types[name] = lambda *_dummy, _cls=cls: _cls()
-    _READY.add(name)
+    _STORE.cache.pop(name, None)  # a class registered again (same fields) replaces the old one
+    _READY[name] = cls
 
 
 def _plan(cls: type) -> list[tuple[str, str, Any]]:
@@ -173,7 +174,7 @@ def serialize(msg: Any) -> bytes:
     """Encode a message as CDR (little-endian, with the 4-byte encapsulation header)."""
     name = type_name(msg)
     cls = type(msg)
-    if name not in _READY:
+    if _READY.get(name) is not cls:
         _prepare(cls)
     msg = normalized(msg)
     try:
@@ -192,7 +193,7 @@ def deserialize(data: bytes | bytearray | memoryview, typename: str | type) -> A
     """
     cls = typename if isinstance(typename, type) else get_type(typename)
     name = type_name(cls)
-    if name not in _READY:
+    if _READY.get(name) is not cls:
         _prepare(cls)
     try:
         return _STORE.deserialize_cdr(data, name)

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import inspect
 import math
+import sys
 import typing
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -56,7 +57,11 @@ def message(typename: str) -> Callable[[type[T]], type[T]]:
 
     def wrap(cls: type[T]) -> type[T]:
         where = f"{typename} ({cls.__module__}.{cls.__qualname__})"
-        hints = typing.get_type_hints(cls, include_extras=True)
+        caller = sys._getframe(1).f_locals  # names local to a function defining the class
+        try:
+            hints = typing.get_type_hints(cls, localns=dict(caller), include_extras=True)
+        except NameError as exc:
+            raise MessageError(f"{where}: an annotation names an unknown type: {exc}") from exc
         fields, consts = [], []
         for fname in inspect.get_annotations(cls):
             hint = hints[fname]

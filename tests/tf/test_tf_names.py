@@ -8,7 +8,7 @@ from hypothesis import strategies as st
 from tf_strategies import tf_settings
 
 from fleetsim.errors import InvalidName
-from fleetsim.tf.names import normalize_frame, resolve_frame
+from fleetsim.tf.names import normalize_frame, resolve_frame, resolve_frame_once
 
 segments = st.from_regex(r"[A-Za-z_][A-Za-z0-9_]{0,8}", fullmatch=True)
 names = st.lists(segments, min_size=1, max_size=3).map("/".join)
@@ -78,3 +78,19 @@ def test_normalize_frame_strips_one_leading_slash_and_rejects_empty():
         normalize_frame("/")
     with pytest.raises(InvalidName, match=r"frame id must be a string"):
         normalize_frame(None)
+
+
+@pytest.mark.parametrize(
+    ("prefix", "frame", "expected"),
+    [
+        ("lizi1", "lizi1/base_link", "lizi1/base_link"),
+        ("lizi1", "base_link", "lizi1/base_link"),
+        ("/lizi1/", "lizi1/laser_link", "lizi1/laser_link"),
+        ("lizi1", "lizi2/base_link", "lizi1/lizi2/base_link"),
+        ("lizi1", "lizi10/base_link", "lizi1/lizi10/base_link"),
+        ("lizi1", "/map", "map"),
+        ("", "base_link", "base_link"),
+    ],
+)
+def test_resolve_frame_once_accepts_already_prefixed_frames(prefix, frame, expected):
+    assert resolve_frame_once(prefix, frame) == expected

@@ -6,6 +6,8 @@ and the message classes are built the same way everywhere in tf.
 
 from __future__ import annotations
 
+from typing import Any
+
 from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.msgs.geometry_msgs import (
     Quaternion,
@@ -16,7 +18,13 @@ from fleetsim.msgs.geometry_msgs import (
 from fleetsim.msgs.std_msgs import Header
 from fleetsim.msgs.tf2_msgs import TFMessage
 
-__all__ = ["TFMessage", "TransformStamped", "transform_stamped", "value_of"]
+__all__ = [
+    "TFMessage",
+    "TransformStamped",
+    "make_transform_stamped",
+    "transform_stamped",
+    "value_of",
+]
 
 
 def transform_stamped(
@@ -38,3 +46,29 @@ def value_of(msg: TransformStamped) -> tuple[float, ...]:
     t = msg.transform.translation
     q = msg.transform.rotation
     return (t.x, t.y, t.z, q.x, q.y, q.z, q.w)
+
+
+def make_transform_stamped(
+    parent_frame: str,
+    child_frame: str,
+    stamp: Any,
+    translation: Any = (0.0, 0.0, 0.0),
+    rotation: Any = (0.0, 0.0, 0.0, 1.0),
+) -> TransformStamped:
+    """A ``TransformStamped`` of ``child_frame`` in ``parent_frame`` from plain values.
+
+    Parameters
+    ----------
+    parent_frame, child_frame : str
+        ``header.frame_id`` and ``child_frame_id``, used as given (apply tf_prefix first).
+    stamp : float or builtin_interfaces/Time
+        Sim time in seconds, or a ``Time``.
+    translation : sequence of 3 floats
+        Child origin in the parent frame, metres.
+    rotation : sequence of 4 floats
+        Child orientation in the parent frame, quaternion ``(x, y, z, w)``.
+    """
+    stamp_ns = stamp.to_nsec() if hasattr(stamp, "to_nsec") else round(float(stamp) * 1e9)
+    x, y, z = (float(v) for v in translation)
+    qx, qy, qz, qw = (float(v) for v in rotation)
+    return transform_stamped(parent_frame, child_frame, stamp_ns, (x, y, z, qx, qy, qz, qw))

@@ -11,7 +11,7 @@ import re
 
 from fleetsim.errors import InvalidName
 
-__all__ = ["normalize_frame", "resolve_frame"]
+__all__ = ["normalize_frame", "resolve_frame", "resolve_frame_once"]
 
 _SEGMENT = re.compile(r"[A-Za-z0-9_]+")
 _INVALID_CHAR = re.compile(r"[^A-Za-z0-9_/]")
@@ -88,3 +88,19 @@ def resolve_frame(tf_prefix: str, frame: str) -> str:
         return key
     _check_segments(frame, "frame id", frame)
     return f"{prefix}/{frame}" if prefix else frame
+
+
+def resolve_frame_once(tf_prefix: str, frame: str) -> str:
+    """Like :func:`resolve_frame`, but a frame already under ``tf_prefix`` is left as it is.
+
+    ROS 1 launch files for tf_prefix robots often spell frames out in full
+    (``$(arg robot_name)/base_link``) for nodes that, since ROS Hydro, no longer apply the
+    prefix themselves. Resolving those once more would give ``lizi1/lizi1/base_link``; this
+    function accepts both spellings: ``resolve_frame_once("lizi1", "lizi1/base_link")`` and
+    ``resolve_frame_once("lizi1", "base_link")`` are both ``"lizi1/base_link"``.
+    """
+    resolved = resolve_frame(tf_prefix, frame)
+    prefix = tf_prefix.strip("/")
+    if prefix and not frame.startswith("/") and frame.startswith(prefix + "/"):
+        return frame
+    return resolved

@@ -1,0 +1,203 @@
+"""``MjSpec`` construction: the world, SDF models and URDF robots as MuJoCo bodies.
+
+Every model becomes a top-level body tree whose names carry the prefix ``<model>/`` (bodies
+``<model>/<link>``, joints ``<model>/<joint>``), so many copies of one robot coexist. Collision
+filtering: static geoms have ``contype=2, conaffinity=1`` and movable ones ``contype=1,
+conaffinity=3``, so walls never test against walls. Collision geoms sit in geom group 3 (hidden
+in renders), visual geoms in group 1 (no contacts, no mass). Movable geoms get ``priority=1`` so
+their friction, not the ground's, sets the contact friction (Gazebo/ODE takes the smaller mu;
+MuJoCo would otherwise take the larger).
+"""
+
+from __future__ import annotations
+
+import warnings
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from fleetsim.errors import SimulationError
+from fleetsim.sim.sdf import GAZEBO_COLOURS
+from fleetsim.sim.world import GeomDesc, ModelDesc, Pose, WorldDesc
+
+G = mujoco.mjtGeom
+COLLISION_GROUP = 3
+VISUAL_GROUP = 1
+MIN_MASS = 1e-3
+MIN_INERTIA = 1e-6
+
+
+def quat_from_rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
+    """Unit quaternion ``(w, x, y, z)`` of fixed-axis roll, pitch, yaw (URDF/SDF convention)."""
+    cr, sr = np.cos(roll / 2), np.sin(roll / 2)
+    cp, sp = np.cos(pitch / 2), np.sin(pitch / 2)
+    cy, sy = np.cos(yaw / 2), np.sin(yaw / 2)
+    return np.array(
+        [
+            cr * cp * cy + sr * sp * sy,
+            sr * cp * cy - cr * sp * sy,
+            cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy,
+        ]
+    )
+
+
+def rpy_from_quat(q) -> tuple[float, float, float]:
+    """Roll, pitch, yaw (rad) of a unit quaternion ``(w, x, y, z)``."""
+    w, x, y, z = q
+    roll = np.arctan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    pitch = np.arcsin(np.clip(2 * (w * y - z * x), -1.0, 1.0))
+    yaw = np.arctan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    return float(roll), float(pitch), float(yaw)
+
+
+def new_world_spec(timestep: float = 0.002) -> mujoco.MjSpec:
+    """An empty spec with fleetsim's physics options (implicit-fast integrator, no gravity
+    compensation tricks) and a large offscreen buffer for cameras."""
+    spec = mujoco.MjSpec()
+    spec.option.timestep = timestep
+    spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
+    spec.option.cone = mujoco.mjtCone.mjCONE_PYRAMIDAL
+    spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE
+    spec.visual.global_.offwidth = 1920
+    spec.visual.global_.offheight = 1080
+    spec.visual.map.zfar = 200.0
+    spec.stat.extent = 20.0
+    return spec
+
+
+def _material_for(spec: mujoco.MjSpec, g: GeomDesc, prefix: str) -> str:
+    if not g.texture:
+        return ""
+    path = Path(g.texture)
+    if not path.exists():
+        raise SimulationError(f"texture image '{g.texture}' of '{prefix}{g.name}' not found")
+    name = f"{prefix}tex:{path.name}"
+    if spec.texture(name) is None:
+        spec.add_texture(name=name, type=mujoco.mjtTexture.mjTEXTURE_2D, file=str(path))
+        mat = spec.add_material(name=name)
+        mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = name
+    return name
+
+
+def add_geom(
+    spec, body, g: GeomDesc, static: bool, prefix: str, index: int, shown: bool = False
+) -> None:
+    """Add one ``GeomDesc`` to ``body`` (collision or visual, per ``g.collide``); ``shown``
+    puts a collision geom in the visual group (for links without visuals)."""
+    kw = {"pos": g.pose[:3], "quat": quat_from_rpy(*g.pose[3:])}
+    if g.kind == "box":
+        kw.update(type=G.mjGEOM_BOX, size=[s / 2 for s in g.size])
+    elif g.kind == "cylinder":
+        kw.update(type=G.mjGEOM_CYLINDER, size=[g.size[0], g.size[1] / 2, 0])
+    elif g.kind == "sphere":
+        kw.update(type=G.mjGEOM_SPHERE, size=[g.size[0], 0, 0])
+    elif g.kind == "plane":
+        kw.update(type=G.mjGEOM_PLANE, size=[g.size[0] / 2, g.size[1] / 2, 1.0])
+    elif g.kind == "mesh":
+        mesh_file = Path(g.mesh or "")
+        if mesh_file.suffix.lower() not in (".stl", ".obj", ".msh"):
+            warnings.warn(
+                f"mesh '{g.mesh}' of '{prefix}{g.name}': only STL/OBJ/MSH meshes load; "
+                "the shape is skipped",
+                stacklevel=2,
+            )
+            return
+        mesh_name = f"{prefix}mesh{index}"
+        spec.add_mesh(name=mesh_name, file=str(mesh_file), scale=list(g.size))
+        kw.update(type=G.mjGEOM_MESH, meshname=mesh_name)
+    else:
+        raise SimulationError(f"geometry kind '{g.kind}' of '{prefix}{g.name}' is not supported")
+    geom = body.add_geom(name=f"{prefix}{g.name or 'geom'}#{index}", **kw)
+    if g.collide:
+        geom.group = VISUAL_GROUP if shown else COLLISION_GROUP
+        geom.contype, geom.conaffinity = (2, 1) if static else (1, 3)
+        geom.priority = 0 if static else 1
+        if g.friction is not None:
+            geom.friction = [g.friction[0], 0.005, 0.0001]
+        geom.rgba = list(g.rgba) if (shown and g.rgba) else [0.6, 0.6, 0.62, 1.0]
+        if shown and g.kind == "plane":
+            geom.material = _floor_material(spec)
+    else:
+        geom.group = VISUAL_GROUP
+        geom.contype = geom.conaffinity = 0
+        geom.density = 0
+        geom.rgba = list(g.rgba) if g.rgba is not None else [0.7, 0.7, 0.7, 1.0]
+        geom.material = _material_for(spec, g, prefix)
+        if geom.material:
+            geom.rgba = [1, 1, 1, 1]
+        if g.kind == "plane":
+            geom.material = _floor_material(spec)
+
+
+def _floor_material(spec) -> str:
+    if spec.material("__floor") is None:
+        spec.add_texture(
+            name="__floor",
+            type=mujoco.mjtTexture.mjTEXTURE_2D,
+            builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
+            width=256,
+            height=256,
+            rgb1=[0.82, 0.82, 0.8],
+            rgb2=[0.74, 0.74, 0.72],
+        )
+        mat = spec.add_material(name="__floor", texrepeat=[1, 1], texuniform=True)
+        mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = "__floor"
+    return "__floor"
+
+
+def add_sdf_model(spec: mujoco.MjSpec, m: ModelDesc, pose: Pose | None = None) -> list[str]:
+    """Add an SDF model; returns its top-level body names (one per link, ``<model>/<link>``)."""
+    pose = pose if pose is not None else m.pose
+    mq = quat_from_rpy(*pose[3:])
+    roots = []
+    for link in m.links:
+        # link pose is relative to the model pose
+        lp = np.zeros(3)
+        lq = np.zeros(4)
+        mujoco.mju_rotVecQuat(lp, np.array(link.pose[:3], float), mq)
+        mujoco.mju_mulQuat(lq, mq, quat_from_rpy(*link.pose[3:]))
+        name = f"{m.name}/{link.name}"
+        body = spec.worldbody.add_body(name=name, pos=lp + np.array(pose[:3]), quat=lq)
+        if not m.static:
+            body.add_freejoint(name=f"{name}/free")
+            body.mass = max(link.mass, MIN_MASS)
+            inertia = link.inertia or (link.mass * 0.01,) * 3
+            body.inertia = [max(i, MIN_INERTIA) for i in inertia]
+            body.explicitinertial = True
+        has_visual = any(not g.collide for g in link.geoms)
+        for i, g in enumerate(link.geoms):
+            add_geom(spec, body, g, m.static, f"{m.name}/{link.name}/", i, not has_visual)
+        roots.append(name)
+    return roots
+
+
+def spec_from_world(world: WorldDesc, timestep: float = 0.002) -> tuple[mujoco.MjSpec, dict]:
+    """Build the world's spec; returns it and ``{model name: [top-level body names]}``."""
+    spec = new_world_spec(timestep)
+    spec.option.gravity = list(world.gravity)
+    spec.modelname = world.name
+    for light in world.lights:
+        d = np.array(light.direction, float)
+        spec.worldbody.add_light(
+            name=f"light:{light.name}",
+            pos=light.pose[:3],
+            dir=d / max(np.linalg.norm(d), 1e-9),
+            type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL
+            if light.directional
+            else mujoco.mjtLightType.mjLIGHT_SPOT,
+            diffuse=list(light.diffuse),
+            castshadow=False,
+        )
+    bodies = {}
+    for m in world.models:
+        if m.name in bodies:
+            raise SimulationError(f"{world.source}: duplicate model name '{m.name}'")
+        bodies[m.name] = add_sdf_model(spec, m)
+    return spec, bodies
+
+
+def gazebo_colour(name: str | None) -> tuple | None:
+    """RGBA of a ``Gazebo/<Colour>`` material name, or None."""
+    return GAZEBO_COLOURS.get(name or "")

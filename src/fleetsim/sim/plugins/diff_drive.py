@@ -1,0 +1,212 @@
+"""Differential drive (``libgazebo_ros_diff_drive.so``) and the shared wheeled-drive logic.
+
+The wheels are real MuJoCo hinge joints rolling on friction contacts, each driven by a velocity
+actuator whose force is limited to the plugin's torque, as Gazebo's joint motors are. Encoder
+odometry integrates the wheel angle increments, so it drifts and slips as a real base does;
+``odometrySource world`` reports the model's true world pose instead (Gazebo's default).
+A ``Twist`` with NaN or infinite components is ignored with a warning and the robot stops; a
+robot whose commands stop for ``commandTimeout`` seconds stops (fleetsim addition, 0 disables).
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from fleetsim.runtime.params import param
+from fleetsim.sim.plugins.base import (
+    DrivePlugin,
+    OdometryReading,
+    joint_addresses,
+    register,
+    require_joint,
+)
+
+_log = logging.getLogger("fleetsim.sim.drive")
+KV_PER_TORQUE = 20.0  # velocity-actuator gain per N m of torque limit (N m s/rad)
+
+
+@dataclass(frozen=True)
+class DiffDriveParams:
+    leftJoint: str = param("left_joint", help="left wheel joint")
+    rightJoint: str = param("right_joint", help="right wheel joint")
+    wheelSeparation: float = param(0.34, unit="m", range=(0.0, None), help="wheel track")
+    wheelDiameter: float = param(0.15, unit="m", range=(0.0, None), help="wheel diameter")
+    wheelTorque: float = param(5.0, unit="N m", range=(0.0, None), help="max wheel torque")
+    wheelAcceleration: float = param(
+        0.0, unit="m/s^2", range=(0.0, None), help="wheel speed ramp, 0: unlimited"
+    )
+    commandTopic: str = param("cmd_vel", help="Twist command topic")
+    odometryTopic: str = param("odom", help="Odometry topic")
+    odometryFrame: str = param("odom", help="odometry frame (tf_prefix applied)")
+    robotBaseFrame: str = param("base_footprint", help="child frame of the odometry")
+    odometrySource: str = param(
+        "world",
+        choices=("world", "encoder"),
+        help="world: true pose; encoder: integrated wheel angles",
+    )
+    publishOdomTF: bool = param(True, help="broadcast odom -> base on /tf")
+    publishTf: bool = param(True, help="legacy switch for publishOdomTF")
+    publishWheelTF: bool = param(False, help="unused")
+    publishWheelJointState: bool = param(False, help="unused: use the joint state publisher")
+    legacyMode: bool = param(True, help="unused (wheel sign convention)")
+    updateRate: float = param(100.0, unit="Hz", range=(0.0, None), help="odometry rate")
+    commandTimeout: float = param(
+        0.5,
+        unit="s",
+        range=(0.0, None),
+        help="stop when no command arrives for this long (0: never)",
+    )
+    rosDebugLevel: str = param("na", help="unused")
+
+
+class WheeledDrive(DrivePlugin):
+    """Shared logic of the diff-drive and skid-steer plugins (``left``/``right`` joint lists)."""
+
+    left: list[str]
+    right: list[str]
+    torque: float
+    accel: float
+    encoder: bool
+    publish_tf: bool
+
+    def _setup(self) -> None:
+        p = self.params
+        for j, key in zip(self.left + self.right, self.joint_params):
+            require_joint(self.ctx, j, key, self.name)
+        self.sep = p.wheelSeparation
+        self.radius = p.wheelDiameter / 2
+        self.cmd = (0.0, 0.0)
+        self.last_cmd_t = -math.inf
+        self.speed = np.zeros(2)  # current wheel surface speed targets, m/s (left, right)
+        self.reset()
+
+    def reset(self) -> None:
+        self.cmd = (0.0, 0.0)
+        self.speed = np.zeros(2)
+        self.pose = np.zeros(3)  # encoder odometry x, y, yaw in the odom frame
+        self.prev_angles: np.ndarray | None = None
+        self.prev_t: float | None = None
+        self.twist = np.zeros(2)
+
+    def build(self, spec, engine) -> None:
+        kv = KV_PER_TORQUE * max(self.torque, 1e-3)
+        for j in self.left + self.right:
+            a = spec.add_actuator(
+                name=f"{self.ctx.model}/{self.name}/{j}",
+                target=f"{self.ctx.model}/{j}",
+                trntype=mujoco.mjtTrn.mjTRN_JOINT,
+            )
+            a.set_to_velocity(kv=kv)
+            a.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
+            a.forcerange = [-self.torque, self.torque]
+
+    def bind(self, engine) -> None:
+        m = engine.model
+        self.act = np.array(
+            [
+                mujoco.mj_name2id(
+                    m, mujoco.mjtObj.mjOBJ_ACTUATOR, f"{self.ctx.model}/{self.name}/{j}"
+                )
+                for j in self.left + self.right
+            ],
+            np.int64,
+        )
+        self.qadr, _ = joint_addresses(engine, self.ctx.model, self.left + self.right)
+        self.root = engine.root_body(self.ctx.model)
+        self.nl = len(self.left)
+
+    def command(self, vx: float, wz: float, t: float) -> None:
+        if not (math.isfinite(vx) and math.isfinite(wz)):
+            _log.warning("%s: ignoring non-finite command (%s, %s); stopping", self.where, vx, wz)
+            self.cmd = (0.0, 0.0)
+            self.last_cmd_t = t
+            return
+        self.cmd = (float(vx), float(wz))
+        self.last_cmd_t = t
+
+    def control(self, engine, t: float) -> None:
+        vx, wz = self.cmd
+        timeout = self.params.commandTimeout
+        if timeout > 0 and t - self.last_cmd_t > timeout:
+            vx, wz = 0.0, 0.0
+        target = np.array([vx - wz * self.sep / 2, vx + wz * self.sep / 2])
+        if self.accel > 0:
+            dv = self.accel * engine.model.opt.timestep
+            target = self.speed + np.clip(target - self.speed, -dv, dv)
+        self.speed = target
+        ctrl = engine.data.ctrl
+        ctrl[self.act[: self.nl]] = target[0] / self.radius
+        ctrl[self.act[self.nl :]] = target[1] / self.radius
+
+    @property
+    def update_rate(self) -> float:
+        return self.params.updateRate
+
+    def _encoder_step(self, engine, t: float) -> None:
+        q = engine.data.qpos[self.qadr]
+        left, right = q[: self.nl].mean(), q[self.nl :].mean()
+        if self.prev_angles is None:
+            self.prev_angles = np.array([left, right])
+            self.prev_t = t
+            return
+        dl = (left - self.prev_angles[0]) * self.radius
+        dr = (right - self.prev_angles[1]) * self.radius
+        self.prev_angles = np.array([left, right])
+        ds = (dl + dr) / 2
+        dth = (dr - dl) / self.sep
+        mid = self.pose[2] + dth / 2
+        self.pose += (ds * math.cos(mid), ds * math.sin(mid), dth)
+        dt = t - self.prev_t
+        self.prev_t = t
+        if dt > 0:
+            self.twist = np.array([ds / dt, dth / dt])
+
+    def measure(self, engine, t: float) -> OdometryReading:
+        p = self.params
+        if self.encoder:
+            self._encoder_step(engine, t)
+            x, y, yaw = self.pose
+            pos = np.array([x, y, 0.0])
+            quat = np.array([0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)])
+            lin = np.array([self.twist[0], 0.0, 0.0])
+            ang = np.array([0.0, 0.0, self.twist[1]])
+        else:
+            d = engine.data
+            pos = d.xpos[self.root].copy()
+            w, qx, qy, qz = d.xquat[self.root]
+            quat = np.array([qx, qy, qz, w])
+            vel = np.zeros(6)
+            mujoco.mj_objectVelocity(engine.model, d, mujoco.mjtObj.mjOBJ_BODY, self.root, vel, 1)
+            lin, ang = vel[3:].copy(), vel[:3].copy()
+        return OdometryReading(
+            t,
+            p.odometryTopic,
+            self.ctx.frame(p.odometryFrame),
+            self.ctx.frame(p.robotBaseFrame),
+            pos,
+            quat,
+            lin,
+            ang,
+            publish_tf=self.publish_tf,
+        )
+
+
+@register("libgazebo_ros_diff_drive.so")
+class DiffDrivePlugin(WheeledDrive):
+    Params = DiffDriveParams
+    joint_params = ("leftJoint", "rightJoint")
+
+    def __init__(self, ctx, spec, sensor=None) -> None:
+        super().__init__(ctx, spec, sensor)
+        p = self.params
+        self.left, self.right = [p.leftJoint], [p.rightJoint]
+        self.torque = p.wheelTorque
+        self.accel = p.wheelAcceleration
+        self.encoder = p.odometrySource == "encoder"
+        self.publish_tf = p.publishOdomTF and p.publishTf
+        self._setup()

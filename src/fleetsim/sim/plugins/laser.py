@@ -1,0 +1,119 @@
+"""Planar laser (``libgazebo_ros_laser.so``, ``libgazebo_ros_gpu_laser.so``) in a ray sensor.
+
+Beam geometry comes from the enclosing ``<sensor type="ray">``: ``scan/horizontal`` samples,
+min_angle, max_angle; ``range`` min, max; ``noise`` gaussian mean, stddev; ``update_rate``.
+Rays are cast in the horizontal plane at the sensor's height, along its heading; the casting is
+batched over all lasers by ``fleetsim.sim.lasers.LaserBatch``. No hit within range: ``inf``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from fleetsim.errors import SimulationError
+from fleetsim.runtime.params import param
+from fleetsim.sim.build import quat_from_rpy
+from fleetsim.sim.plugins.base import ScanReading, SensorPlugin, register, require_link
+
+
+@dataclass(frozen=True)
+class LaserParams:
+    topicName: str = param("/world", help="scan topic (relative to the robot namespace)")
+    frameName: str = param("/world", help="frame_id of the scans (tf_prefix applied)")
+    gaussianNoise: float = param(0.0, unit="m", range=(0.0, None), help="unused (sensor noise)")
+    updateRate: float = param(
+        0.0, unit="Hz", range=(0.0, None), help="unused: the sensor's <update_rate> sets the rate"
+    )
+    hokuyoMinIntensity: float = param(101.0, help="unused")
+
+
+def _num(d: dict, path: str, default: float, where: str) -> float:
+    cur = d
+    for k in path.split("/"):
+        if not isinstance(cur, dict) or k not in cur:
+            return default
+        cur = cur[k]
+    try:
+        return float(cur)
+    except (TypeError, ValueError):
+        raise SimulationError(
+            f"{where}: sensor field '{path}' must be a number, got '{cur}'"
+        ) from None
+
+
+@register("libgazebo_ros_laser.so", "libgazebo_ros_gpu_laser.so", "libgazebo_ros_ray_sensor.so")
+class LaserPlugin(SensorPlugin):
+    Params = LaserParams
+    is_laser = True
+
+    def __init__(self, ctx, spec, sensor=None) -> None:
+        super().__init__(ctx, spec, sensor)
+        if sensor is None:
+            raise SimulationError(f"{self.where}: a laser plugin must sit inside a <sensor>")
+        w = f"{self.where} sensor '{sensor.name}'"
+        ray = sensor.ray or {}
+        self.samples = int(_num(ray, "scan/horizontal/samples", 640, w))
+        self.angle_min = _num(ray, "scan/horizontal/min_angle", 0.0, w)
+        self.angle_max = _num(ray, "scan/horizontal/max_angle", 0.0, w)
+        self.range_min = _num(ray, "range/min", 0.0, w)
+        self.range_max = _num(ray, "range/max", 0.0, w)
+        self.noise_mean = _num(ray, "noise/mean", 0.0, w)
+        self.noise_std = _num(ray, "noise/stddev", 0.0, w)
+        if self.samples < 1 or self.range_max <= self.range_min:
+            raise SimulationError(
+                f"{w}: needs samples >= 1 and range max > min; got samples {self.samples}, "
+                f"range [{self.range_min}, {self.range_max}]"
+            )
+        self.link = require_link(ctx, sensor.reference, "the sensor reference", spec.name)
+        self.rate = float(sensor.update_rate)
+        self.pos = np.array(sensor.pose.xyz, float)
+        self.quat = quat_from_rpy(*sensor.pose.rpy)
+        n = self.samples
+        self.beams = (
+            np.linspace(self.angle_min, self.angle_max, n) if n > 1 else np.array([self.angle_min])
+        )
+        self.frame_id = ctx.frame(self.params.frameName)
+
+    @property
+    def update_rate(self) -> float:
+        return self.rate
+
+    def bind(self, engine) -> None:
+        self.body = engine.link_id(self.ctx.model, self.link)
+        self.owner = engine._model_names.index(self.ctx.model)
+
+    def rays(self, engine):
+        """World ray origins (S, 3), world yaws (S,) and the owner model index."""
+        d = engine.data
+        R = d.xmat[self.body].reshape(3, 3)
+        origin = d.xpos[self.body] + R @ self.pos
+        rs = np.zeros(9)
+        q = np.zeros(4)
+        mujoco.mju_mulQuat(q, d.xquat[self.body], self.quat)
+        mujoco.mju_quat2Mat(rs, q)
+        heading = np.arctan2(rs[3], rs[0])
+        return np.tile(origin, (self.samples, 1)), heading + self.beams, self.owner
+
+    def reading(self, ranges: np.ndarray, t: float, rng: np.random.Generator) -> ScanReading:
+        r = ranges.astype(np.float64)
+        if self.noise_std > 0 or self.noise_mean != 0:
+            hit = np.isfinite(r)
+            r[hit] += self.noise_mean + self.noise_std * rng.standard_normal(int(hit.sum()))
+            r[hit] = np.clip(r[hit], self.range_min, self.range_max)
+        inc = (self.angle_max - self.angle_min) / max(self.samples - 1, 1)
+        return ScanReading(
+            t,
+            self.params.topicName,
+            self.frame_id,
+            self.angle_min,
+            self.angle_max,
+            inc,
+            0.0,
+            1.0 / self.rate if self.rate > 0 else 0.0,
+            self.range_min,
+            self.range_max,
+            r.astype(np.float32),
+        )

@@ -126,3 +126,15 @@ def test_user_types_and_redefinition():
     back = deserialize(serialize(second(name="x")), "fleetsim_test/msg/Beacon")
     assert type(back) is second and back.name == "x"
     assert msgdef("fleetsim_test/Beacon") == "string name\nfloat32[] signal\n"
+
+
+def test_wrong_nested_values_name_the_field():
+    with pytest.raises(MessageError, match=r"field 'pose' expected a mapping .* got NoneType"):
+        serialize(nav_msgs.Odometry(pose=None))
+    with pytest.raises(
+        MessageError,
+        match=r"^cannot serialize std_msgs/msg/Header: field 'stamp' expected a mapping .* float",
+    ):
+        serialize(std_msgs.Header(stamp=1.5))
+    with pytest.raises(MessageError, match=r"field 'poses\[0\]' expected a mapping .* got int"):
+        serialize(geometry_msgs.PoseArray(poses=[3]))

@@ -157,10 +157,14 @@ def normalized(msg: Any, where: str = "") -> Any:
                 continue
             new = coerce_array(val, spec, f"{where or type_name(msg)}.{fname}")
         elif kind == "msg":
+            if type(val) is not spec:  # left for the encoder to report
+                continue
             new = normalized(val, f"{where or type_name(msg)}.{fname}")
             if new is val:
                 continue
         else:
+            if not isinstance(val, list | tuple) or not all(type(v) is spec for v in val):
+                continue
             base = f"{where or type_name(msg)}.{fname}"
             new = [normalized(v, f"{base}[{i}]") for i, v in enumerate(val)]
             if all(a is b for a, b in zip(new, val)):
@@ -182,8 +186,8 @@ def serialize(msg: Any) -> bytes:
     except (struct.error, AttributeError, TypeError, ValueError, SerdeError) as exc:
         from fleetsim.msgs.dicts import find_invalid_field
 
-        problem = find_invalid_field(msg) or str(exc)
-        raise MessageError(f"cannot serialize {name}: {problem}") from exc
+        problem = find_invalid_field(msg)  # "<type>: field 'a.b' expected ..."
+        raise MessageError(f"cannot serialize {problem or f'{name}: {exc}'}") from exc
 
 
 def deserialize(data: bytes | bytearray | memoryview, typename: str | type) -> Any:

@@ -55,13 +55,13 @@ def from_dict(typename_or_cls: str | type, data: Any, where: str | None = None) 
         cls = typename_or_cls
     else:
         raise MessageError(f"{typename_or_cls!r} is not a message type name or class")
-    return _build(cls, data, where or type_name(cls), "")
+    return _build(cls, data, where or type_name(cls), "", False)
 
 
 def find_invalid_field(msg: Any) -> str | None:
     """A description of the first field of ``msg`` whose value does not fit its type, or None."""
     try:
-        from_dict(type(msg), to_dict(msg))
+        _build(type(msg), to_dict(msg), type_name(msg), "", True)
     except MessageError as exc:
         return str(exc)
     return None
@@ -75,17 +75,19 @@ def _label(path: str) -> str:
     return f"field '{path}'" if path else "message"
 
 
-def _build(cls: type, data: Any, where: str, path: str) -> Any:
-    if data is None:
-        return cls()
+def _build(cls: type, data: Any, where: str, path: str, strict: bool) -> Any:
+    """A ``cls`` from ``data``; ``strict`` turns off conveniences (None, seconds, bare value)."""
     if type(data) is cls:
         return data
     name = cls.__msgtype__
-    if name in _TIME_TYPES and isinstance(data, int | float) and not isinstance(data, bool):
-        return cls.from_sec(float(data))
+    if not strict:
+        if data is None:
+            return cls()
+        if name in _TIME_TYPES and isinstance(data, int | float) and not isinstance(data, bool):
+            return cls.from_sec(float(data))
     specs = dict(cls.__msgfields__)
     if not isinstance(data, Mapping):
-        if len(specs) == 1:
+        if len(specs) == 1 and not strict:
             data = {next(iter(specs)): data}
         else:
             raise MessageError(
@@ -106,11 +108,11 @@ def _build(cls: type, data: Any, where: str, path: str) -> Any:
                 f"{where}: unknown field '{_join(path, str(key))}' in {name}"
                 f"{did_you_mean(str(key), specs)}; its fields are {', '.join(specs) or 'none'}"
             )
-        kwargs[fname] = _value(spec, val, where, _join(path, fname))
+        kwargs[fname] = _value(spec, val, where, _join(path, fname), strict)
     return cls(**kwargs)
 
 
-def _value(spec: Any, val: Any, where: str, path: str) -> Any:
+def _value(spec: Any, val: Any, where: str, path: str, strict: bool) -> Any:
     if isinstance(spec, Prim):
         return _prim(spec, val, where, path)
     if isinstance(spec, SeqSpec):
@@ -128,8 +130,8 @@ def _value(spec: Any, val: Any, where: str, path: str) -> Any:
             raise MessageError(
                 f"{where}: {_label(path)} expected {spec.length} items, got {len(val)}"
             )
-        return [_value(spec.elem, v, where, f"{path}[{i}]") for i, v in enumerate(val)]
-    return _build(spec, val, where, path)
+        return [_value(spec.elem, v, where, f"{path}[{i}]", strict) for i, v in enumerate(val)]
+    return _build(spec, val, where, path, strict)
 
 
 def spec_label(spec: Any) -> str:

@@ -2,6 +2,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from rosbags.typesys import Stores, get_typestore
 
 from fleetsim.errors import MessageError
@@ -138,3 +140,18 @@ def test_wrong_nested_values_name_the_field():
         serialize(std_msgs.Header(stamp=1.5))
     with pytest.raises(MessageError, match=r"field 'poses\[0\]' expected a mapping .* got int"):
         serialize(geometry_msgs.PoseArray(poses=[3]))
+
+
+@settings(max_examples=50, deadline=None)
+@given(
+    ranges=st.lists(st.floats(width=32, allow_nan=True), max_size=40),
+    frame=st.text(max_size=12),
+    sec=st.integers(-(2**31), 2**31 - 1),
+)
+def test_scan_round_trip_is_bit_exact(ranges, frame, sec):
+    scan = sensor_msgs.LaserScan(ranges=np.array(ranges, np.float32))
+    scan.header.frame_id = frame
+    scan.header.stamp.sec = sec
+    back = deserialize(serialize(scan), "sensor_msgs/LaserScan")
+    assert back.ranges.tobytes() == scan.ranges.tobytes()
+    assert back.header == scan.header

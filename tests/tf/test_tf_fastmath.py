@@ -44,3 +44,9 @@ def test_interpolate_endpoints_and_nearly_equal_rotations():
     mid = fm.interpolate(a, b, 0.5)
     assert mid[0] == 1.0 and np.all(np.isfinite(mid))
     assert close7(fm.interpolate(a, b, 0.0), a) and close7(fm.interpolate(a, b, 1.0), b)
+
+
+@tf_settings
+@given(translations, unit_quaternions())
+def test_matrix_rows_match_numpy(t, q):
+    assert np.allclose(np.array(fm.matrix_rows(as7(t, q))), tm.matrix_from_transform(t, q))

@@ -2,7 +2,7 @@
 
 Import the math from :mod:`fleetsim.tf.transforms`, and these from here::
 
-    from fleetsim.tf import Buffer, resolve_frame
+    from fleetsim.tf import Buffer, make_transform_stamped, resolve_frame
     from fleetsim.tf import TransformBroadcaster, StaticTransformBroadcaster, TransformListener
 
 The node-facing classes (broadcasters, listener, static_transform_publisher) are imported on
@@ -14,9 +14,10 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
+from fleetsim.tf._msgs import make_transform_stamped
 from fleetsim.tf.buffer import Buffer
 from fleetsim.tf.frame_info import FrameInfo
-from fleetsim.tf.names import normalize_frame, resolve_frame
+from fleetsim.tf.names import normalize_frame, resolve_frame, resolve_frame_once
 
 _LAZY = {
     "TransformBroadcaster": "fleetsim.tf.broadcaster",
@@ -25,7 +26,15 @@ _LAZY = {
     "StaticTransformPublisher": "fleetsim.tf.static_transform_publisher",
 }
 
-__all__ = ["Buffer", "FrameInfo", "normalize_frame", "resolve_frame", *_LAZY]
+__all__ = [
+    "Buffer",
+    "FrameInfo",
+    "make_transform_stamped",
+    "normalize_frame",
+    "resolve_frame",
+    "resolve_frame_once",
+    *_LAZY,
+]
 
 
 def __getattr__(name: str) -> Any:

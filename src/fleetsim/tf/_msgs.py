@@ -17,6 +17,7 @@ from fleetsim.msgs.geometry_msgs import (
 )
 from fleetsim.msgs.std_msgs import Header
 from fleetsim.msgs.tf2_msgs import TFMessage
+from fleetsim.tf.cache import checked_value, ns_from_time
 
 __all__ = [
     "TFMessage",
@@ -66,9 +67,13 @@ def make_transform_stamped(
     translation : sequence of 3 floats
         Child origin in the parent frame, metres.
     rotation : sequence of 4 floats
-        Child orientation in the parent frame, quaternion ``(x, y, z, w)``.
+        Child orientation in the parent frame, quaternion ``(x, y, z, w)``; normalised when
+        nearly unit.
+
+    Raises
+    ------
+    TransformError
+        For values that are not numbers, not finite, or a quaternion far from unit length.
     """
-    stamp_ns = stamp.to_nsec() if hasattr(stamp, "to_nsec") else round(float(stamp) * 1e9)
-    x, y, z = (float(v) for v in translation)
-    qx, qy, qz, qw = (float(v) for v in rotation)
-    return transform_stamped(parent_frame, child_frame, stamp_ns, (x, y, z, qx, qy, qz, qw))
+    value = checked_value(parent_frame, child_frame, translation, rotation)
+    return transform_stamped(parent_frame, child_frame, ns_from_time(stamp), value)

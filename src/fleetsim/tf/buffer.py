@@ -18,6 +18,8 @@ import logging
 import math
 from typing import Any
 
+import numpy as np
+
 from fleetsim.errors import (
     ConnectivityError,
     FrameNotFound,
@@ -27,7 +29,7 @@ from fleetsim.errors import (
 )
 from fleetsim.tf import _msgs
 from fleetsim.tf.cache import FrameCache, checked_value, ns_from_time
-from fleetsim.tf.fastmath import IDENTITY, Transform7, compose, invert
+from fleetsim.tf.fastmath import IDENTITY, Transform7, compose, invert, matrix_rows
 from fleetsim.tf.frame_info import FrameInfo, frame_info_of, frames_as_string, frames_as_yaml
 from fleetsim.tf.names import normalize_frame
 
@@ -207,17 +209,12 @@ class Buffer:
 
     def lookup_arrays(self, target_frame: str, source_frame: str, time: Any = 0.0) -> tuple:
         """Fast path: ``(translation (3,), quaternion (4,))`` NumPy arrays, target <- source."""
-        import numpy as np
-
         v = self._lookup(target_frame, source_frame, time)[1]
         return np.array(v[:3]), np.array(v[3:])
 
     def lookup_matrix(self, target_frame: str, source_frame: str, time: Any = 0.0) -> Any:
         """Fast path: the homogeneous 4x4 matrix mapping source points into the target frame."""
-        from fleetsim.tf.transforms import matrix_from_transform
-
-        v = self._lookup(target_frame, source_frame, time)[1]
-        return matrix_from_transform(v[:3], v[3:])
+        return np.array(matrix_rows(self._lookup(target_frame, source_frame, time)[1]))
 
     def lookup_tuple(self, target_frame: str, source_frame: str, time: Any = 0.0) -> Transform7:
         """Fastest path: ``(tx, ty, tz, qx, qy, qz, qw)`` as plain floats, target <- source."""
@@ -250,16 +247,17 @@ class Buffer:
         t_ns = 0 if time is None else ns_from_time(time)
         if t_ns == 0:
             t_ns = self._latest_ns(down, up)
-        acc_s = IDENTITY
-        for i, f in enumerate(up):
-            v = f.value_at(t_ns, target_frame, source_frame)
-            acc_s = v if i == 0 else compose(v, acc_s)
+        if up:
+            acc_s = up[0].value_at(t_ns, target_frame, source_frame)
+            for f in up[1:]:
+                acc_s = compose(f.value_at(t_ns, target_frame, source_frame), acc_s)
+        else:
+            acc_s = IDENTITY
         if down:
-            acc_t = IDENTITY
-            for i, f in enumerate(down):
-                v = f.value_at(t_ns, target_frame, source_frame)
-                acc_t = v if i == 0 else compose(v, acc_t)
-            acc_s = compose(invert(acc_t), acc_s)
+            acc_t = down[0].value_at(t_ns, target_frame, source_frame)
+            for f in down[1:]:
+                acc_t = compose(f.value_at(t_ns, target_frame, source_frame), acc_t)
+            acc_s = compose(invert(acc_t), acc_s) if up else invert(acc_t)
         target = target_frame[1:] if target_frame[:1] == "/" else target_frame
         source = source_frame[1:] if source_frame[:1] == "/" else source_frame
         return t_ns, acc_s, target, source

@@ -13,7 +13,14 @@ from __future__ import annotations
 
 from math import atan2, sin, sqrt
 
-__all__ = ["IDENTITY", "compose", "interpolate", "invert", "slerp_angle_threshold"]
+__all__ = [
+    "IDENTITY",
+    "compose",
+    "interpolate",
+    "invert",
+    "matrix_rows",
+    "slerp_angle_threshold",
+]
 
 Transform7 = tuple[float, float, float, float, float, float, float]
 
@@ -96,4 +103,18 @@ def interpolate(a: Transform7, b: Transform7, fraction: float) -> Transform7:
         qy * n,
         qz * n,
         qw * n,
+    )
+
+
+def matrix_rows(a: Transform7) -> tuple[tuple[float, float, float, float], ...]:
+    """Return the 4x4 homogeneous matrix of ``a`` as four row tuples (``np.array`` them)."""
+    x, y, z, qx, qy, qz, qw = a
+    xx, yy, zz = qx * qx, qy * qy, qz * qz
+    xy, xz, yz = qx * qy, qx * qz, qy * qz
+    wx, wy, wz = qw * qx, qw * qy, qw * qz
+    return (
+        (1.0 - 2.0 * (yy + zz), 2.0 * (xy - wz), 2.0 * (xz + wy), x),
+        (2.0 * (xy + wz), 1.0 - 2.0 * (xx + zz), 2.0 * (yz - wx), y),
+        (2.0 * (xz - wy), 2.0 * (yz + wx), 1.0 - 2.0 * (xx + yy), z),
+        (0.0, 0.0, 0.0, 1.0),
     )

@@ -300,10 +300,13 @@ class Engine:
 
     def model_twist(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """Linear (3,) m/s and angular (3,) rad/s velocity of the model root, world frame."""
-        b = self.root_body(name)
-        vel = np.zeros(6)
-        mujoco.mj_objectVelocity(self.model, self.data, mujoco.mjtObj.mjOBJ_BODY, b, vel, 0)
-        return vel[3:].copy(), vel[:3].copy()
+        j = self._free_joint(name)
+        if j < 0:
+            return np.zeros(3), np.zeros(3)
+        qa, va = self.model.jnt_qposadr[j], self.model.jnt_dofadr[j]
+        ang = np.zeros(3)
+        mujoco.mju_rotVecQuat(ang, self.data.qvel[va + 3 : va + 6], self.data.qpos[qa + 3 : qa + 7])
+        return self.data.qvel[va : va + 3].copy(), ang
 
     def link_pose(self, model: str, link: str) -> tuple[np.ndarray, np.ndarray]:
         b = self.link_id(model, link)
@@ -391,6 +394,7 @@ class Engine:
             if not self.paused:
                 self.step()
             readings += self.due_readings()
+        mujoco.mj_kinematics(self.model, self.data)  # poses of the current state for queries
         return readings
 
     def due_readings(self) -> list[Any]:

@@ -1,0 +1,37 @@
+"""Shared fixtures of the simulator tests: small robots and worlds in fixtures/."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+FIXTURES = Path(__file__).parent / "fixtures"
+BARN = Path("/work/shared/data/barn/world_3.world")
+WILLOW = Path("/work/shared/data/maps/willow-full.yaml")
+
+
+@pytest.fixture(scope="session")
+def diffbot():
+    from fleetsim.description import load_robot
+
+    return load_robot(FIXTURES / "diffbot.urdf")
+
+
+@pytest.fixture(scope="session")
+def skidbot():
+    from fleetsim.description import load_robot
+
+    return load_robot(FIXTURES / "skidbot.urdf")
+
+
+def robot_text(name: str) -> str:
+    return (FIXTURES / name).read_text()
+
+
+def replace_plugin_param(text: str, old: str, new: str) -> str:
+    assert old in text, old
+    return text.replace(old, new)

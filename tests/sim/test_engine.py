@@ -1,0 +1,174 @@
+import warnings
+
+import numpy as np
+import pytest
+
+from fleetsim.description import parse_urdf
+from fleetsim.errors import ParameterError, SimulationError
+from fleetsim.sim import Engine
+from fleetsim.sim.build import quat_from_rpy
+
+from .conftest import robot_text
+
+
+def drive(engine, entry, vx, wz, seconds):
+    drive_plugin = entry.plugins[0]
+    out = []
+    for _ in range(round(seconds / 0.05)):
+        drive_plugin.command(vx, wz, engine.time)
+        out += engine.advance(0.05)
+    return out
+
+
+def test_spawn_and_delete_keep_the_state_of_other_robots(diffbot):
+    e = Engine(None)
+    r1 = e.spawn_robot("r1", diffbot, (0, 0, 0, 0, 0, 0))
+    drive(e, r1, 0.4, 0.2, 1.0)
+    pos, quat = e.model_pose("r1")
+    lin, ang = e.model_twist("r1")
+    t = e.time
+    e.spawn_robot("r2", diffbot, (3, 0, 0, 0, 0, 0))
+    p2, q2 = e.model_pose("r1")
+    np.testing.assert_array_equal(pos, p2)
+    np.testing.assert_array_equal(quat, q2)
+    np.testing.assert_allclose(e.model_twist("r1")[0], lin, atol=1e-12)
+    assert e.time == t
+    drive(e, r1, 0.4, 0.2, 0.5)
+    p3, _ = e.model_pose("r1")
+    e.delete_model("r2")
+    np.testing.assert_array_equal(e.model_pose("r1")[0], p3)
+    assert "r2" not in e.world_properties()["model_names"]
+    with pytest.raises(SimulationError, match="no model named 'r2'"):
+        e.model_pose("r2")
+
+
+def test_same_model_many_times_and_duplicate_names(diffbot):
+    e = Engine(None)
+    for i in range(5):
+        e.spawn_robot(f"bot{i}", diffbot, (i, 0, 0, 0, 0, 0))
+    assert e.model.body("bot3/left_wheel").id > 0
+    with pytest.raises(SimulationError, match="a model named 'bot1' already exists"):
+        e.spawn_robot("bot1", diffbot)
+
+
+def test_deterministic_bit_identical(diffbot):
+    def run():
+        e = Engine(None, rng=np.random.default_rng(7))
+        a = e.spawn_robot("a", diffbot, (0, 0, 0, 0, 0, 0))
+        b = e.spawn_robot("b", diffbot, (0, 1, 0, 0, 0, 0))
+        drive(e, a, 0.3, 0.5, 0.5)
+        drive(e, b, -0.2, 0.1, 0.5)
+        return e.data.qpos.copy(), e.data.qvel.copy()
+
+    (q1, v1), (q2, v2) = run(), run()
+    assert q1.tobytes() == q2.tobytes() and v1.tobytes() == v2.tobytes()
+
+
+def test_contacts_with_walls_are_reported(diffbot):
+    from fleetsim.sim.world import GeomDesc, LinkDesc, ModelDesc, WorldDesc, ground_plane
+
+    wall = ModelDesc(
+        "wall",
+        (1.0, 0, 0.5, 0, 0, 0),
+        True,
+        [LinkDesc("link", geoms=[GeomDesc("box", (0.1, 4, 1))])],
+    )
+    e = Engine(WorldDesc("w", [ground_plane(), wall]))
+    r = e.spawn_robot("r", diffbot, (0, 0, 0, 0, 0, 0))
+    assert e.contacts() == []
+    drive(e, r, 0.5, 0.0, 3.0)
+    hits = e.contacts()
+    assert hits and {(c.model1, c.model2) for c in hits} <= {("r", "wall"), ("wall", "r")}
+    assert all(c.link1 == "base_link" or c.link2 == "base_link" for c in hits)
+
+
+def test_set_model_state_and_resets(diffbot):
+    e = Engine(None)
+    r = e.spawn_robot("r", diffbot, (1, 2, 0, 0, 0, 0.5))
+    drive(e, r, 0.5, 0.0, 0.5)
+    e.set_model_state("r", position=[5, 5, 0.0], orientation=quat_from_rpy(0, 0, 1.0))
+    pos, quat = e.model_pose("r")
+    np.testing.assert_allclose(pos, [5, 5, 0.0])
+    np.testing.assert_allclose(quat, quat_from_rpy(0, 0, 1.0))
+    e.set_model_state("r", linear=[0.0, 0.0, 0.0], angular=[0, 0, 1.0])
+    np.testing.assert_allclose(e.model_twist("r")[1], [0, 0, 1.0], atol=1e-12)
+    t = e.time
+    e.reset_world()
+    np.testing.assert_allclose(e.model_pose("r")[0], [1, 2, 0], atol=1e-12)
+    assert e.time == t
+    e.reset_simulation()
+    assert e.time == 0.0
+    with pytest.raises(SimulationError, match="model 'ground_plane' is static"):
+        e.set_model_state("ground_plane", position=[0, 0, 0])
+
+
+def test_pause_stops_physics_time(diffbot):
+    e = Engine(None)
+    e.spawn_robot("r", diffbot)
+    e.paused = True
+    e.advance(0.1)
+    assert e.time == 0.0
+    e.paused = False
+    e.advance(0.1)
+    assert e.time == pytest.approx(0.1)
+
+
+def test_bad_plugins(diffbot):
+    text = robot_text("diffbot.urdf")
+    e = Engine(None)
+    unknown = text.replace("libgazebo_ros_joint_state_publisher.so", "libmy_fancy_plugin.so")
+    with pytest.warns(UserWarning, match="unknown plugin filename 'libmy_fancy_plugin.so'"):
+        e.spawn_robot("u", parse_urdf(unknown))
+    assert "u" in e.models
+    wrong = text.replace("<wheelTorque>5</wheelTorque>", "<wheelTorque>strong</wheelTorque>")
+    with pytest.raises(
+        ParameterError,
+        match=r"model 'w' plugin 'diff_drive'.*'wheelTorque' "
+        r"must be float, got 'strong'",
+    ):
+        e.spawn_robot("w", parse_urdf(wrong))
+    lacks = text.replace("<leftJoint>left_wheel_joint", "<leftJoint>left_whel_joint")
+    with pytest.raises(
+        SimulationError,
+        match=r"leftJoint names 'left_whel_joint', a joint the "
+        r"model lacks \(did you mean 'left_wheel_joint'",
+    ):
+        e.spawn_robot("j", parse_urdf(lacks))
+    assert set(e.models) == {"ground_plane", "u"}
+    e.spawn_robot("ok", diffbot)  # the failed spawns left nothing behind in the spec
+
+
+def test_nan_commands_are_ignored_and_stop(diffbot, caplog):
+    e = Engine(None)
+    r = e.spawn_robot("r", diffbot)
+    drive(e, r, 0.5, 0.0, 1.0)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        drive(e, r, float("nan"), 0.0, 1.0)
+    assert "ignoring non-finite command" in caplog.text
+    assert np.linalg.norm(e.model_twist("r")[0]) < 0.02
+    drive(e, r, 0.5, float("inf"), 0.2)
+    assert np.linalg.norm(e.model_twist("r")[0]) < 0.2
+
+
+def test_command_timeout_stops_the_robot(diffbot):
+    e = Engine(None)
+    r = e.spawn_robot("r", diffbot)
+    drive(e, r, 0.5, 0.0, 1.0)
+    assert e.model_twist("r")[0][0] > 0.4
+    e.advance(1.5)  # no commands: timeout 0.5 s
+    assert abs(e.model_twist("r")[0][0]) < 0.01
+
+
+def test_spawn_sdf_model_and_world_properties():
+    e = Engine(None)
+    e.spawn_sdf(
+        "box",
+        "<sdf><model name='b'><link name='l'><inertial><mass>1</mass>"
+        "</inertial><collision name='c'><geometry><box><size>.2 .2 .2</size></box>"
+        "</geometry></collision></link></model></sdf>",
+        (0, 0, 1, 0, 0, 0),
+    )
+    e.advance(1.0)
+    assert e.model_pose("box")[0][2] == pytest.approx(0.1, abs=2e-3)
+    assert e.world_properties()["model_names"] == ["ground_plane", "box"]

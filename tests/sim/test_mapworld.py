@@ -1,0 +1,63 @@
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from hypothesis.extra.numpy import arrays
+
+from fleetsim.errors import SimulationError
+from fleetsim.sim.mapworld import load_map, rectangles_from_occupancy, wall_boxes
+
+from .conftest import WILLOW
+
+
+@settings(max_examples=60, deadline=None)
+@given(arrays(np.bool_, st.tuples(st.integers(1, 25), st.integers(1, 25))))
+def test_rectangles_cover_exactly_the_occupied_cells(occ):
+    rects = rectangles_from_occupancy(occ)
+    cover = np.zeros(occ.shape, np.int64)
+    for r0, c0, r1, c1 in rects:
+        assert r1 > r0 and c1 > c0
+        cover[r0:r1, c0:c1] += 1
+    np.testing.assert_array_equal(cover, occ.astype(np.int64))  # disjoint and exact
+
+
+def write_map(tmp_path, pixels, origin=(0.0, 0.0, 0.0), res=0.5):
+    from PIL import Image
+
+    Image.fromarray(pixels.astype(np.uint8)).save(tmp_path / "m.pgm")
+    (tmp_path / "m.yaml").write_text(
+        f"image: m.pgm\nresolution: {res}\norigin: [{origin[0]}, {origin[1]}, {origin[2]}]\n"
+        "negate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n"
+    )
+    return tmp_path / "m.yaml"
+
+
+def test_walls_sit_where_map_server_puts_the_cells(tmp_path):
+    px = np.full((4, 6), 254)
+    px[0, 5] = 0  # top row, last column -> highest y, highest x
+    grid = load_map(write_map(tmp_path, px, origin=(-1.0, 2.0, 0.0)))
+    assert grid.occupied.shape == (4, 6) and grid.occupied[3, 5]
+    (box,) = wall_boxes(grid, height=2.0)
+    np.testing.assert_allclose(
+        box, [-1.0 + 5.5 * 0.5, 2.0 + 3 * 0.5 + 0.25, 1.0, 0.25, 0.25, 1.0, 0]
+    )
+
+
+def test_willow_map_merges_into_few_boxes():
+    grid = load_map(WILLOW)
+    boxes = wall_boxes(grid)
+    assert grid.occupied.sum() > 2 * len(boxes)
+    cells = np.sum(4 * boxes[:, 3] * boxes[:, 4]) / grid.resolution**2
+    assert round(cells) == grid.occupied.sum()
+
+
+def test_bad_map_files_are_named(tmp_path):
+    (tmp_path / "a.yaml").write_text("image: nothere.pgm\nresolution: 0.1\n")
+    with pytest.raises(SimulationError, match=r"a.yaml: map image 'nothere.pgm' not found"):
+        load_map(tmp_path / "a.yaml")
+    (tmp_path / "b.yaml").write_text("resolution: 0.1\n")
+    with pytest.raises(SimulationError, match=r"b.yaml: map YAML lacks the field 'image'"):
+        load_map(tmp_path / "b.yaml")
+    (tmp_path / "c.yaml").write_text("image: x.pgm\nresolution: fast\n")
+    with pytest.raises(SimulationError, match=r"c.yaml: bad number"):
+        load_map(tmp_path / "c.yaml")

@@ -1,0 +1,65 @@
+"""Which class runs a launch file's ``<node pkg= type=>``.
+
+ROS package and executable names map to fleetsim node classes; user nodes are written
+``pkg="module" type="Class"`` or ``type="module:Class"``. An unknown ``pkg/type`` is an error
+that lists what exists.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+from fleetsim.errors import LaunchError, did_you_mean
+
+#: (pkg, type) -> "module:Class"
+NODES: dict[tuple[str, str], str] = {
+    ("tf", "static_transform_publisher"): "fleetsim.tf.static_transform_publisher:StaticTransformPublisher",
+    ("tf2_ros", "static_transform_publisher"): "fleetsim.tf.static_transform_publisher:StaticTransformPublisher",
+    ("robot_state_publisher", "robot_state_publisher"): "fleetsim.description.robot_state_publisher:RobotStatePublisher",
+    ("robot_state_publisher", "state_publisher"): "fleetsim.description.robot_state_publisher:RobotStatePublisher",
+    ("joint_state_publisher", "joint_state_publisher"): "fleetsim.description.joint_state_publisher:JointStatePublisher",
+}  # fmt: skip
+
+
+def register(pkg: str, type_: str, target: str) -> None:
+    """Add a node class: ``register("my_pkg", "my_node", "my_module:MyNode")``."""
+    if ":" not in target:
+        raise LaunchError(f"node target {target!r} must be 'module:Class'")
+    NODES[(pkg, type_)] = target
+
+
+def _import(target: str, what: str) -> Any:
+    module, _, attr = target.partition(":")
+    try:
+        mod = importlib.import_module(module)
+    except ImportError as e:
+        raise LaunchError(f"{what}: cannot import module '{module}': {e}") from None
+    try:
+        return getattr(mod, attr)
+    except AttributeError:
+        raise LaunchError(
+            f"{what}: module '{module}' has no '{attr}'{did_you_mean(attr, dir(mod))}"
+        ) from None
+
+
+def resolve_node(pkg: str, type_: str, where: str = "") -> Any:
+    """The class for ``pkg/type``; ``where`` (file:line) prefixes errors."""
+    what = f"{where + ': ' if where else ''}node {pkg}/{type_}"
+    target = NODES.get((pkg, type_))
+    if target is not None:
+        return _import(target, what)
+    if ":" in type_:
+        return _import(type_, what)
+    if "." in pkg or pkg.startswith("fleetsim"):
+        try:
+            importlib.import_module(pkg)
+        except ImportError:
+            pass
+        else:
+            return _import(f"{pkg}:{type_}", what)
+    known = [f"{p}/{t}" for p, t in sorted(NODES)]
+    raise LaunchError(
+        f"{what} is unknown{did_you_mean(f'{pkg}/{type_}', known)}; known nodes: "
+        f'{", ".join(known)}; user nodes are written type="module:Class"'
+    )

@@ -1,0 +1,36 @@
+"""The node registry: every entry imports; unknown nodes list what exists."""
+
+import pytest
+
+from fleetsim.errors import LaunchError
+from fleetsim.launch.registry import NODES, register, resolve_node
+from fleetsim.runtime import Node
+
+
+@pytest.mark.parametrize(("pkg", "type_"), sorted(NODES))
+def test_every_registered_node_is_a_node_class(pkg, type_):
+    cls = resolve_node(pkg, type_)
+    assert isinstance(cls, type) and issubclass(cls, Node), (pkg, type_, cls)
+
+
+def test_user_nodes_by_module_and_class():
+    assert resolve_node("anything", "fleetsim.runtime.node:Node") is Node
+    assert resolve_node("fleetsim.runtime.node", "Node") is Node
+
+
+def test_unknown_node_lists_known_ones():
+    match = (
+        r"x.launch:3: node tf/static_transform_publisherr is unknown "
+        r"\(did you mean 'tf/static_transform_publisher'\?\); known nodes: .*robot_state_publisher"
+    )
+    with pytest.raises(LaunchError, match=match):
+        resolve_node("tf", "static_transform_publisherr", "x.launch:3")
+    with pytest.raises(LaunchError, match="cannot import module 'no_such_mod'"):
+        resolve_node("p", "no_such_mod:Thing")
+    with pytest.raises(LaunchError, match=r"module 'fleetsim.runtime.node' has no 'Nod' \(did you"):
+        resolve_node("p", "fleetsim.runtime.node:Nod")
+
+
+def test_register_checks_the_target():
+    with pytest.raises(LaunchError, match="must be 'module:Class'"):
+        register("a", "b", "just_a_module")

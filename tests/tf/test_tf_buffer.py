@@ -323,6 +323,8 @@ def test_introspection_lists_frames_parents_authority_and_rates():
     assert laser.is_static and laser.rate is None
     assert "Frame lizi1/odom exists with parent map.\n" in buf.all_frames_as_string()
     assert "broadcaster: /lizi1/fake_localization" in buf.all_frames_as_yaml()
+    dot = buf.all_frames_as_dot(recorded_at=6.0)
+    assert dot.count(" -> ") == 3 and '"map" -> "lizi1/odom"' in dot
     with pytest.raises(FrameNotFound, match=r"'map' is a root of the tf tree"):
         buf.frame_info("map")
     with pytest.raises(FrameNotFound, match=r"frame 'mapp' does not exist.*did you mean 'map'"):

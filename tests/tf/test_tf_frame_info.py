@@ -6,7 +6,7 @@ import pytest
 import yaml
 
 from fleetsim.tf.cache import FrameCache
-from fleetsim.tf.frame_info import frame_info_of, frames_as_string, frames_as_yaml
+from fleetsim.tf.frame_info import frame_info_of, frames_as_dot, frames_as_string, frames_as_yaml
 
 S = 1_000_000_000
 
@@ -46,3 +46,15 @@ def test_yaml_and_string_layouts():
     assert frames_as_string({"odom": "map", "laser": "odom"}) == (
         "Frame odom exists with parent map.\nFrame laser exists with parent odom.\n"
     )
+
+
+def test_dot_graph_has_one_labelled_edge_per_child():
+    infos = {
+        "lizi1/odom": frame_info_of(cache("lizi1/odom", "map", [0, S], authority="/amcl"), 10.0),
+        "lizi1/laser": frame_info_of(cache("lizi1/laser", "lizi1/odom", [0], static=True), 10.0),
+    }
+    dot = frames_as_dot(infos, recorded_at=12.5)
+    assert dot.startswith("digraph G {\n") and dot.endswith("}\n")
+    assert '"map" -> "lizi1/odom" [label="Broadcaster: /amcl\\nAverage rate: 1.000 Hz\\n' in dot
+    assert '"lizi1/odom" -> "lizi1/laser" [label="Broadcaster: default_authority\\n' in dot
+    assert "Average rate: static" in dot and 'label="Recorded at time: 12.500"' in dot

@@ -30,7 +30,14 @@ from fleetsim.errors import (
 from fleetsim.tf import _msgs
 from fleetsim.tf.cache import FrameCache, checked_value, ns_from_time
 from fleetsim.tf.fastmath import IDENTITY, Transform7, compose, invert, matrix_rows
-from fleetsim.tf.frame_info import FrameInfo, frame_info_of, frames_as_string, frames_as_yaml
+from fleetsim.tf.frame_info import (
+    FrameInfo,
+    frame_info_of,
+    frames_as_dot,
+    frames_as_string,
+    frames_as_yaml,
+)
+from fleetsim.tf.geometry import TRANSFORMERS
 from fleetsim.tf.names import normalize_frame
 
 __all__ = ["Buffer", "FrameInfo"]
@@ -199,6 +206,28 @@ class Buffer:
         t2, v2, _, source = self._lookup(fixed_frame, source_frame, source_time)
         return _msgs.transform_stamped(target, source, max(t1, t2), compose(v1, v2))
 
+    def transform(self, obj: Any, target_frame: str, time: Any = None) -> Any:
+        """Return a stamped geometry message expressed in ``target_frame`` (tf2_ros ``transform``).
+
+        Supports ``PointStamped``, ``Vector3Stamped``, ``PoseStamped`` and
+        ``PoseWithCovarianceStamped``. The lookup uses ``obj.header.stamp`` (zero: latest)
+        unless ``time`` is given.
+
+        Raises
+        ------
+        TransformError
+            For an unsupported message type; or the lookup's errors.
+        """
+        kind = getattr(obj, "__msgtype__", type(obj).__name__)
+        fn = TRANSFORMERS.get(kind)
+        if fn is None:
+            raise TransformError(
+                f"Buffer.transform cannot transform a {kind}; supported: "
+                + ", ".join(sorted(TRANSFORMERS))
+            )
+        stamp = obj.header.stamp if time is None else time
+        return fn(obj, self.lookup_transform(target_frame, obj.header.frame_id, stamp))
+
     def can_transform(self, target_frame: str, source_frame: str, time: Any = 0.0) -> bool:
         """Return whether :meth:`lookup_transform` with these arguments would succeed."""
         try:
@@ -348,6 +377,10 @@ class Buffer:
     def all_frames_as_yaml(self) -> str:
         """tf2's ``allFramesAsYAML``: one block per child frame, as view_frames reads it."""
         return frames_as_yaml(self.frames_info())
+
+    def all_frames_as_dot(self, recorded_at: float | None = None) -> str:
+        """The tree as a Graphviz digraph labelled like ``view_frames`` (render with ``dot``)."""
+        return frames_as_dot(self.frames_info(), recorded_at)
 
     def all_frames_as_string(self) -> str:
         """tf2's ``allFramesAsString``: ``Frame X exists with parent Y.`` lines."""

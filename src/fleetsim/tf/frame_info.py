@@ -7,7 +7,13 @@ from typing import Any
 
 import yaml
 
-__all__ = ["FrameInfo", "frame_info_of", "frames_as_string", "frames_as_yaml"]
+__all__ = [
+    "FrameInfo",
+    "frame_info_of",
+    "frames_as_dot",
+    "frames_as_string",
+    "frames_as_yaml",
+]
 
 #: Authority reported for transforms set without one (tf2's name for it).
 DEFAULT_AUTHORITY = "default_authority"
@@ -84,3 +90,33 @@ def frames_as_string(parents: dict[str, str]) -> str:
     return "".join(
         f"Frame {child} exists with parent {parent}.\n" for child, parent in parents.items()
     )
+
+
+def _dot_id(text: str) -> str:
+    """A quoted Graphviz id; ``\\n`` escapes in ``text`` stay line breaks."""
+    return '"' + text.replace('"', '\\"') + '"'
+
+
+def frames_as_dot(infos: dict[str, FrameInfo], recorded_at: float | None = None) -> str:
+    """A Graphviz digraph of the tree, labelled like tf2_tools' ``view_frames``.
+
+    Each edge ``parent -> child`` carries the broadcaster, the average rate, the most recent
+    and oldest stamps and the buffer length; static edges say so instead of a rate.
+    """
+    lines = ["digraph G {"]
+    for name, info in infos.items():
+        rate = (
+            "static"
+            if info.is_static
+            else (f"{info.rate:.3f} Hz" if info.rate is not None else "n/a (one stamp)")
+        )
+        label = (
+            f"Broadcaster: {info.authority}\\nAverage rate: {rate}\\n"
+            f"Most recent transform: {info.most_recent:.3f}\\n"
+            f"Oldest transform: {info.oldest:.3f}\\nBuffer length: {info.buffer_length:.3f} sec"
+        )
+        lines.append(f"{_dot_id(info.parent)} -> {_dot_id(name)} [label={_dot_id(label)}];")
+    if recorded_at is not None:
+        lines.append(f'label="Recorded at time: {recorded_at:.3f}"; labelloc=t;')
+    lines.append("}")
+    return "\n".join(lines) + "\n"

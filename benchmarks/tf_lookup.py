@@ -18,7 +18,7 @@ import time
 
 import numpy as np
 
-from fleetsim.tf import Buffer
+from fleetsim.tf import Buffer, make_transform_stamped
 from fleetsim.tf import fastmath as fm
 from fleetsim.tf import transforms as tm
 
@@ -82,6 +82,15 @@ def main() -> None:
     for label, fn in rows:
         r = rate(fn, n)
         print(f"  {label:38s} {r:>10,.0f} /s   {1e6 / r:6.2f} us")
+
+    msgs = [make_transform_stamped("odom", "base_link", k * 0.01, (k * 0.01, 0.0, 0.0),
+                                   yawq(k * 0.001)) for k in range(20_000)]  # fmt: skip
+    fresh = Buffer()
+    t0 = time.perf_counter()
+    for msg in msgs:
+        fresh.set_transform(msg)
+    r = len(msgs) / (time.perf_counter() - t0)
+    print(f"  {'set_transform (TransformStamped)':38s} {r:>10,.0f} /s   {1e6 / r:6.2f} us")
 
     print("\none transform, plain-float tuples vs NumPy arrays")
     a = (1.0, 2.0, 0.5, *yawq(0.3))

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
@@ -69,6 +70,7 @@ def test_ns_from_time_accepts_seconds_and_time_messages():
     assert ns_from_time(0.1 + 0.2) == 300_000_000
     assert ns_from_time(Time(3, 5)) == 3 * S + 5
     assert ns_from_time(2) == 2 * S
+    assert ns_from_time(np.float32(0.5)) == S // 2 and ns_from_time(np.int64(3)) == 3 * S
     with pytest.raises(TransformError, match=r"tf time nan is not finite"):
         ns_from_time(float("nan"))
 

@@ -27,16 +27,20 @@ def ns_from_time(time: Any) -> int:
     """
     if time is None:
         return 0
-    if isinstance(time, float | int):
-        if not math.isfinite(time):
-            raise TransformError(f"tf time {time!r} is not finite; give seconds of sim time")
-        return round(time * 1e9)
-    try:
+    if time.__class__ is float or time.__class__ is int:
+        seconds = time
+    elif hasattr(time, "sec") and hasattr(time, "nanosec"):
         return int(time.sec) * 1_000_000_000 + int(time.nanosec)
-    except AttributeError:
-        raise TransformError(
-            f"tf time {time!r} is neither seconds nor a builtin_interfaces/Time (sec, nanosec)"
-        ) from None
+    else:
+        try:
+            seconds = float(time)  # NumPy scalars and other real numbers
+        except (TypeError, ValueError):
+            raise TransformError(
+                f"tf time {time!r} is neither seconds nor a builtin_interfaces/Time (sec, nanosec)"
+            ) from None
+    if not math.isfinite(seconds):
+        raise TransformError(f"tf time {time!r} is not finite; give seconds of sim time")
+    return round(seconds * 1e9)
 
 
 def checked_value(parent: str, child: str, translation: Any, rotation: Any) -> Transform7:

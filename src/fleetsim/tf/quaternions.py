@@ -81,8 +81,10 @@ def quaternion_multiply(q1: ArrayLike, q0: ArrayLike) -> FloatArray:
     -------
     ndarray, shape (..., 4)
     """
-    x1, y1, z1, w1 = np.moveaxis(_f(q1), -1, 0)
-    x0, y0, z0, w0 = np.moveaxis(_f(q0), -1, 0)
+    q1 = _f(q1)
+    q0 = _f(q0)
+    x1, y1, z1, w1 = q1[..., 0], q1[..., 1], q1[..., 2], q1[..., 3]
+    x0, y0, z0, w0 = q0[..., 0], q0[..., 1], q0[..., 2], q0[..., 3]
     return np.stack(
         [
             w1 * x0 + x1 * w0 + y1 * z0 - z1 * y0,
@@ -280,10 +282,20 @@ def rotate_vector(q: ArrayLike, v: ArrayLike) -> FloatArray:
     """
     q = _f(q)
     v = _f(v)
-    u = q[..., :3]
-    w = q[..., 3:]
-    t = 2.0 * np.cross(u, v)
-    return v + w * t + np.cross(u, t)
+    qx, qy, qz, qw = q[..., 0], q[..., 1], q[..., 2], q[..., 3]
+    vx, vy, vz = v[..., 0], v[..., 1], v[..., 2]
+    # v + 2w (u x v) + 2 u x (u x v), written out (np.cross is slow for small inputs)
+    tx = 2.0 * (qy * vz - qz * vy)
+    ty = 2.0 * (qz * vx - qx * vz)
+    tz = 2.0 * (qx * vy - qy * vx)
+    return np.stack(
+        [
+            vx + qw * tx + qy * tz - qz * ty,
+            vy + qw * ty + qz * tx - qx * tz,
+            vz + qw * tz + qx * ty - qy * tx,
+        ],
+        axis=-1,
+    )
 
 
 def slerp(q0: ArrayLike, q1: ArrayLike, fraction: ArrayLike) -> FloatArray:

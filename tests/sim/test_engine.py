@@ -120,7 +120,7 @@ def test_bad_plugins(diffbot):
     with pytest.warns(UserWarning, match="unknown plugin filename 'libmy_fancy_plugin.so'"):
         e.spawn_robot("u", parse_urdf(unknown))
     assert "u" in e.models
-    wrong = text.replace("<wheelTorque>5</wheelTorque>", "<wheelTorque>strong</wheelTorque>")
+    wrong = text.replace("<wheelTorque>1</wheelTorque>", "<wheelTorque>strong</wheelTorque>")
     with pytest.raises(
         ParameterError,
         match=r"model 'w' plugin 'diff_drive'.*'wheelTorque' "

@@ -18,7 +18,7 @@ from fleetsim.errors import SimulationError
 from fleetsim.sim.build import MIN_INERTIA, MIN_MASS, add_geom, gazebo_colour, quat_from_rpy
 from fleetsim.sim.world import GeomDesc, Pose
 
-JOINT_ARMATURE = 0.01  # kg m^2, rotor inertia added to every actuated joint for stability
+JOINT_ARMATURE = 1e-4  # kg m^2, small rotor inertia on every joint (numerical stability)
 
 
 def _geom_desc(geometry: Any, origin: Any, name: str, collide: bool) -> GeomDesc:

@@ -212,7 +212,12 @@ class ParticleFilter:
         return UpdateResult(True, resampled, resampled or first)
 
     def _sensor_update(self, grid: AmclMap, beams: ScanBeams) -> None:
-        """Weight particles by the scan (amcl's ``pf_update_sensor``)."""
+        """Weight particles by the scan (amcl's ``pf_update_sensor``).
+
+        The running averages track the mean scan likelihood ``sum_i w_i p(z | x_i)`` (weights
+        normalised), as Probabilistic Robotics' Augmented MCL does; amcl divides this by the
+        particle count once more, which ties ``w_fast / w_slow`` to KLD's changes of N.
+        """
         n = self.particle_count
         if len(beams.ranges) == 0:
             return  # nothing to weigh with (all readings invalid or max range)
@@ -228,11 +233,11 @@ class ParticleFilter:
                 return
             w = np.exp(logw - top)
             total = float(w.sum())
-            w_avg = float(np.exp(np.log(total) + top)) / n
+            w_avg = float(np.exp(np.log(total) + top))
         else:
             w = self.weights * vals
             total = float(w.sum())
-            w_avg = total / n
+            w_avg = total
         if not (total > 0.0 and np.isfinite(total)):
             self.weights = np.full(n, 1.0 / n)
             return
@@ -243,7 +248,13 @@ class ParticleFilter:
         self.n_effective = effective_sample_size(self.weights)
 
     def resample(self) -> None:
-        """KLD-adaptive low-variance resampling with random-particle recovery."""
+        """KLD-adaptive low-variance resampling with random-particle recovery.
+
+        A draw is replaced by a random free-space pose with probability
+        ``max(0, 1 - w_fast / w_slow)`` (Augmented MCL). Unlike amcl, the averages are not reset
+        to zero after an injection: amcl's reset re-anchors ``w_slow`` at the likelihood of the
+        lost filter, after which recovery stops before the robot is found again.
+        """
         p = self.params
         if p.selective_resampling and self.n_effective > 0.5 * self.particle_count:
             return
@@ -262,8 +273,6 @@ class ParticleFilter:
             w_diff=w_diff if sampler is not None else 0.0,
             random_poses=sampler,
         )
-        if w_diff > 0.0:
-            self.w_slow = self.w_fast = 0.0
         self.particles = new
         self.weights = np.full(len(new), 1.0 / len(new))
         self.converged = self.is_converged()

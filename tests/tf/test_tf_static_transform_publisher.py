@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from fleetsim.errors import ParameterError
+from fleetsim.errors import ConnectivityError, ParameterError
 from fleetsim.runtime import Runtime
 from fleetsim.tf import StaticTransformPublisher
 from fleetsim.tf.static_transform_publisher import static_transform_from_args
@@ -96,3 +96,35 @@ def test_tf2_form_latches_on_tf_static():
     rt.spin_once()
     assert buf.frame_info("odom").is_static
     assert buf.lookup_tuple("map", "odom", 99.0)[:2] == (1.0, 2.0)
+
+
+def test_three_prefixed_robots_get_separate_trees_joined_by_map():
+    """The seeds' multi-robot launch: one laser publisher per robot group, shared /tf."""
+    rt = Runtime()
+    buf = rt.tf_buffer
+    for name in ("lizi1", "lizi2", "lizi3"):
+        rt.params.set(f"/{name}/tf_prefix", name)
+        StaticTransformPublisher(
+            rt,
+            "laser_link_broadcaster",
+            f"/{name}",
+            args=f"0 0 1 0 0 0 {name}/base_link {name}/laser_link 100".split(),
+        )
+        StaticTransformPublisher(rt, "odom_bc", f"/{name}", args="0 0 0 0 0 0 odom base_link 100")
+    rt.run(duration=0.35)
+    assert buf.parents() == {
+        f"{n}/{child}": f"{n}/{parent}"
+        for n in ("lizi1", "lizi2", "lizi3")
+        for parent, child in (("odom", "base_link"), ("base_link", "laser_link"))
+    }
+    with pytest.raises(
+        ConnectivityError, match=r"under root 'lizi1/odom'.*under root 'lizi2/odom'"
+    ):
+        buf.lookup_transform("lizi1/laser_link", "lizi2/laser_link")
+    for i, name in enumerate(("lizi1", "lizi2", "lizi3")):  # localization joins them under map
+        StaticTransformPublisher(
+            rt, "map_bc", f"/{name}", args=f"{20 + 2 * i} 15 0 0 0 0 /map odom".split()
+        )
+    rt.run(duration=0.1)
+    x, y, _ = buf.lookup_pose2d("lizi1/laser_link", "lizi3/laser_link")
+    assert (x, y) == pytest.approx((4.0, 0.0))

@@ -18,6 +18,7 @@ Frame ids get the node's ``tf_prefix``, unless already under it (see `resolve_fr
 from __future__ import annotations
 
 import math
+import shlex
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
@@ -196,12 +197,15 @@ class StaticTransformPublisher(Node):
     Parameters
     ----------
     runtime, name, namespace, **kw
-        As for `fleetsim.runtime.Node`; the transform comes from ``args=`` (see module doc).
+        As for `fleetsim.runtime.Node`; the transform comes from ``args=`` (see module doc),
+        a list of strings or one string.
     """
 
     def __init__(
         self, runtime: Any, name: str = "static_transform_publisher", namespace: str = "/", **kw
     ) -> None:
+        if isinstance(kw.get("args"), str):  # one command-line string, as in a launch file
+            kw["args"] = shlex.split(kw["args"])
         super().__init__(runtime, name, namespace, **kw)
         spec = static_transform_from_args(self.args)
         prefix = self.tf_prefix

@@ -1,0 +1,202 @@
+"""`SimulationClient`: what the command-line tools use to reach a running simulation.
+
+It is a zenoh *client* session connected to the simulation's endpoint, with no runtime of its
+own: it reads graph snapshots, subscribes and publishes CDR on topic keys, calls services and
+talks to the parameter server. Opening it fails fast (bounded by ``timeout``) with the one-line
+"no simulation running at ..." error when nothing fleetsim answers there.
+"""
+
+from __future__ import annotations
+
+import json
+import time as _wall
+from collections.abc import Callable
+from typing import Any
+
+from fleetsim.errors import GraphError, MessageError, TransportError
+from fleetsim.transport.graphinfo import merge_snapshots
+from fleetsim.transport.keys import (
+    Keys,
+    attachment,
+    cdr_encoding,
+    default_endpoint,
+    no_simulation,
+    open_session,
+    parse_attachment,
+    type_of_encoding,
+)
+from fleetsim.transport.paramserver import request_param
+from fleetsim.transport.services import call_remote_service
+
+
+class Received:
+    """One message a tool received: the decoded message and where it came from."""
+
+    __slots__ = ("msg", "node", "topic", "type", "wall", "zid")
+
+    def __init__(self, topic: str, type_: str, msg: Any, zid: str, node: str) -> None:
+        self.topic, self.type, self.msg, self.zid, self.node = topic, type_, msg, zid, node
+        self.wall = _wall.monotonic()
+
+
+class ToolPublisher:
+    """Publishes one type on one topic from a tool."""
+
+    def __init__(self, client: SimulationClient, name: str, msg_type: type) -> None:
+        import zenoh
+
+        self.name = name
+        self.type = msg_type
+        self._att = attachment(client.zid, "/fleetsim_cli")
+        self._pub = client.session.declare_publisher(
+            client.keys.topic(name),
+            encoding=zenoh.Encoding(cdr_encoding(msg_type.__msgtype__)),
+            reliability=zenoh.Reliability.RELIABLE,
+        )
+
+    def wait_for_subscribers(self, timeout: float) -> bool:
+        """True once some process subscribes this topic (waits at most ``timeout`` s)."""
+        deadline = _wall.monotonic() + timeout
+        while not self._pub.matching_status.matching:
+            if _wall.monotonic() > deadline:
+                return False
+            _wall.sleep(0.01)
+        return True
+
+    def publish(self, msg: Any) -> None:
+        from fleetsim.msgs import serialize
+
+        if type(msg) is not self.type:
+            raise GraphError(f"{self.name} carries {self.type.__msgtype__}, not {type(msg)}")
+        self._pub.put(serialize(msg), attachment=self._att)
+
+    def close(self) -> None:
+        self._pub.undeclare()
+
+
+class SimulationClient:
+    """A connection from a tool to a running simulation.
+
+    Parameters
+    ----------
+    connect : the simulation's endpoint; default ``$FLEETSIM_ZENOH`` or ``tcp/127.0.0.1:7447``.
+    domain : key domain (default ``$FLEETSIM_DOMAIN`` or ``0``).
+    timeout : seconds to wait for any answer (connection, graph, services, parameters).
+    """
+
+    def __init__(
+        self, connect: str | None = None, domain: str | int | None = None, timeout: float = 2.0
+    ) -> None:
+        self.endpoint = connect or default_endpoint()
+        self.keys = Keys(domain)
+        self.timeout = timeout
+        self._subs: list = []
+        self.session = open_session("client", connect=[self.endpoint])
+        self.zid = str(self.session.zid())
+        alive = [
+            r for r in self.session.liveliness().get(self.keys.alive("*"), timeout=timeout) if r.ok
+        ]
+        if not alive:
+            self.session.close()
+            raise TransportError(no_simulation(self.endpoint))
+
+    # -- graph ------------------------------------------------------------------------------
+    def snapshots(self) -> list[dict]:
+        """Each process's graph snapshot (the simulation first)."""
+        out = []
+        for reply in self.session.get(self.keys.graph("*"), timeout=self.timeout):
+            if reply.ok is not None:
+                try:
+                    out.append(json.loads(reply.ok.payload.to_bytes().decode()))
+                except ValueError:
+                    continue
+        if not out:
+            raise TransportError(no_simulation(self.endpoint))
+        return sorted(out, key=lambda s: (s.get("role") != "simulation", s.get("zid", "")))
+
+    def graph(self) -> dict:
+        """Nodes, topics (types, publishers, subscribers) and services of every process."""
+        return merge_snapshots(self.snapshots())
+
+    def sim_time(self) -> float:
+        """The simulation's current sim time, seconds."""
+        snaps = self.snapshots()
+        return float(snaps[0].get("time", 0.0))
+
+    def topic_type(self, name: str) -> str | None:
+        info = self.graph()["topics"].get(name)
+        return info["type"] if info is not None else None
+
+    def check_type(self, name: str, msg_type: type) -> None:
+        """Raise `GraphError` when ``name`` already carries a different type."""
+        have = self.topic_type(name)
+        if have is not None and msg_type.__msgtype__ not in have.split(" | "):
+            raise GraphError(
+                f"topic {name} carries {have}, not {msg_type.__msgtype__}; publish that type "
+                "or use another topic"
+            )
+
+    # -- topics -----------------------------------------------------------------------------
+    def subscribe(
+        self, name: str, callback: Callable[[Received], None], latched: bool = True
+    ) -> None:
+        """Call ``callback`` (on a zenoh thread) with every message on ``name``.
+
+        With ``latched``, a latched topic's last message is fetched first. Messages whose type is
+        unknown here are skipped with one `MessageError` passed to ``callback`` as ``msg``.
+        """
+        from fleetsim.msgs import deserialize, get_type
+
+        def decode(payload: bytes, encoding: object, att: object) -> None:
+            tname = type_of_encoding(encoding)
+            zid, node = parse_attachment(att)
+            try:
+                msg: Any = deserialize(payload, get_type(tname))
+            except MessageError as e:
+                msg = e
+            callback(Received(name, tname, msg, zid, node))
+
+        self._subs.append(
+            self.session.declare_subscriber(
+                self.keys.topic(name),
+                lambda s: decode(s.payload.to_bytes(), s.encoding, s.attachment),
+            )
+        )
+        if latched:
+            for reply in self.session.get(self.keys.latched_any(name), timeout=self.timeout):
+                if reply.ok is not None:
+                    ok = reply.ok
+                    decode(ok.payload.to_bytes(), ok.encoding, ok.attachment)
+
+    def publisher(self, name: str, msg_type: type) -> ToolPublisher:
+        self.check_type(name, msg_type)
+        return ToolPublisher(self, name, msg_type)
+
+    # -- services and parameters --------------------------------------------------------------
+    def service_type(self, name: str) -> str:
+        services = self.graph()["services"]
+        info = services.get(name)
+        if info is None:
+            from fleetsim.errors import did_you_mean
+
+            raise GraphError(f"service {name} is not available{did_you_mean(name, services)}")
+        return info["type"]
+
+    def call_service(self, name: str, request: Any, srv_type: Any, timeout: float = 10.0) -> Any:
+        return call_remote_service(self.session, self.keys, name, srv_type, request, timeout)
+
+    def param(self, op: str, name: str = "/", value: Any = None) -> Any:
+        """A parameter server request (``get``, ``set``, ``list``, ``dump``, ``delete``)."""
+        return request_param(self.session, self.keys, op, name, value, self.timeout)
+
+    def close(self) -> None:
+        for s in self._subs:
+            s.undeclare()
+        self._subs.clear()
+        self.session.close()
+
+    def __enter__(self) -> SimulationClient:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

@@ -1,0 +1,146 @@
+"""ZenohBridge: topics, latched topics, services and graph info between two runtimes."""
+
+import logging
+import time
+
+import pytest
+
+from fleetsim.errors import ServiceError
+from fleetsim.msgs import std_msgs, std_srvs
+from fleetsim.runtime import Node, Runtime
+from fleetsim.transport import SimulationClient, ZenohBridge
+from fleetsim.transport.client import ToolPublisher
+from transport.helper_nodes import Echo
+
+
+def _follower(endpoint):
+    rt = Runtime(seed=2)
+    return rt, ZenohBridge(rt, mode="client", connect=[endpoint], follow_clock=True)
+
+
+def test_topics_latched_and_services_between_processes(sim):
+    rt, bridge = _follower(sim.endpoint)
+    try:
+        assert rt.now() > 0.0  # starts at the simulation's clock, not at zero
+        echo = Echo(rt)
+        greetings = []
+        Node(rt, "late").create_subscription(std_msgs.String, "/greeting", greetings.append)
+        bridge.run_following(until=rt.now() + 1.0)
+        assert len(echo.heard) >= 7
+        stamps = [float(data[2:]) for _, data in echo.heard]
+        assert stamps == sorted(stamps)  # in order
+        assert all(t_recv >= t_pub - 0.02 for (t_recv, _), t_pub in zip(echo.heard, stamps))
+        assert [g.data for g in greetings] == ["hello"]  # the latched message, once
+        assert len(sim.talker.back) >= 5
+        assert sim.talker.back[0].data.startswith("echo:t=")
+        assert echo.answer is not None and echo.answer.startswith("call ")
+    finally:
+        rt.shutdown()
+
+
+def test_forwarding_starts_only_when_someone_remote_listens(sim):
+    assert sim.talker.pub.get_num_connections() == 0
+    rt, bridge = _follower(sim.endpoint)
+    try:
+        Node(rt, "l").create_subscription(std_msgs.String, "/chatter", lambda m: None)
+        assert bridge.wait_for(lambda: sim.talker.pub.get_num_connections() == 1, 3.0)
+    finally:
+        rt.shutdown()
+    deadline = time.monotonic() + 3.0
+    while sim.talker.pub.get_num_connections() and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert sim.talker.pub.get_num_connections() == 0
+
+
+def test_no_echo_of_own_messages(sim):
+    rt, bridge = _follower(sim.endpoint)
+    try:
+        n = Node(rt, "both")
+        got = []
+        n.create_subscription(std_msgs.String, "/loop", got.append)
+        pub = n.create_publisher(std_msgs.String, "/loop")
+        remote = []
+        Node(sim.runtime, "far").create_subscription(std_msgs.String, "/loop", remote.append)
+        assert bridge.wait_for(lambda: pub.get_num_connections() == 2, 3.0)  # local + remote
+        for i in range(3):
+            pub.publish(std_msgs.String(data=str(i)))
+        bridge.run_following(until=rt.now() + 0.3)
+        assert [m.data for m in got] == ["0", "1", "2"]
+        assert [m.data for m in remote] == ["0", "1", "2"]
+    finally:
+        rt.shutdown()
+
+
+def test_wrong_type_and_garbage_are_dropped_with_a_warning(sim, caplog):
+    caplog.set_level(logging.WARNING, logger="fleetsim.transport")
+    with SimulationClient(sim.endpoint) as client:
+        wrong = ToolPublisher(client, "/back", std_msgs.Int32)
+        assert wrong.wait_for_subscribers(3.0)
+        wrong.publish(std_msgs.Int32(data=5))
+        garbage = client.session.declare_publisher(
+            client.keys.topic("/back"),
+            encoding=__import__("zenoh").Encoding("application/cdr;std_msgs/msg/String"),
+        )
+        garbage.put(b"\x01")
+        good = ToolPublisher(client, "/back", std_msgs.String)
+        good.publish(std_msgs.String(data="fine"))
+        deadline = time.monotonic() + 3.0
+        while not sim.talker.back and time.monotonic() < deadline:
+            time.sleep(0.01)
+    assert [m.data for m in sim.talker.back] == ["fine"]
+    text = caplog.text
+    assert "dropping std_msgs/msg/Int32 messages on /back" in text
+    assert "this graph's topic carries std_msgs/msg/String" in text
+    assert "dropping a message on /back: cannot decode 1 bytes as std_msgs/msg/String" in text
+    assert sim.thread.is_alive()
+
+
+def test_service_errors_cross_the_wire(sim):
+    def boom(req):
+        raise ValueError("disk on fire")
+
+    Node(sim.runtime, "bad").create_service(std_srvs.Empty, "/explode", boom)
+    with SimulationClient(sim.endpoint) as client:
+        deadline = time.monotonic() + 3.0
+        while "/explode" not in client.graph()["services"] and time.monotonic() < deadline:
+            time.sleep(0.02)
+        with pytest.raises(
+            ServiceError, match=r"service /explode failed: ValueError: disk on fire"
+        ):
+            client.call_service("/explode", None, std_srvs.Empty)
+        with pytest.raises(ServiceError, match=r"takes std_srvs/srv/Trigger_Request, called with"):
+            client.call_service("/trigger", None, std_srvs.Empty)
+        with pytest.raises(ServiceError, match=r"service /nothing did not answer within 0.5 s"):
+            client.call_service("/nothing", None, std_srvs.Empty, timeout=0.5)
+        assert client.call_service("/trigger", None, std_srvs.Trigger).message.startswith("call")
+
+
+def test_graph_follows_node_lifecycle(sim):
+    with SimulationClient(sim.endpoint) as client:
+        assert "/talker" in client.graph()["nodes"]
+        node = Node(sim.runtime, "temp")
+        node.create_publisher(std_msgs.String, "/temp_topic")
+        deadline = time.monotonic() + 3.0
+        while "/temp_topic" not in client.graph()["topics"] and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert client.graph()["topics"]["/temp_topic"]["publishers"] == ["/temp"]
+        node.destroy()
+        while "/temp_topic" in client.graph()["topics"] and time.monotonic() < deadline:
+            time.sleep(0.02)
+        assert "/temp_topic" not in client.graph()["topics"]
+
+
+def test_close_is_idempotent_and_local_graph_keeps_working(endpoint):
+    rt = Runtime()
+    bridge = ZenohBridge(rt, listen=[endpoint], publish_clock=False)
+    got = []
+    n = Node(rt, "n")
+    n.create_subscription(std_msgs.String, "/x", got.append)
+    pub = n.create_publisher(std_msgs.String, "/x")
+    bridge.close()
+    bridge.close()
+    pub.publish(std_msgs.String(data="a"))
+    rt.run(0.1)
+    assert [m.data for m in got] == ["a"]
+    assert rt.graph.listeners == []
+    rt.shutdown()

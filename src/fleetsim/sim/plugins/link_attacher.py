@@ -79,7 +79,7 @@ class LinkAttacher:
             name1=f"{m1}/{l1}",
             name2=f"{m2}/{l2}",
         )
-        data = np.zeros(11)
+        data = np.zeros(12)  # anchor (3), relpose pos (3) quat (4), torquescale, unused
         data[3:6] = rel_p
         data[6:10] = rel_q
         data[10] = 1.0

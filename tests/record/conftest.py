@@ -76,3 +76,16 @@ def fake_run():
         return rt, robots
 
     return make
+
+
+@pytest.fixture(scope="module")
+def recording(tmp_path_factory):
+    """A finished 1 s recording of one robot with the map (51 messages)."""
+    from fleetsim.record import Recorder
+
+    rt = Runtime()
+    FakeRobot(rt, "/robot0", with_map=True)
+    path = tmp_path_factory.mktemp("rec") / "run.mcap"
+    with Recorder(rt, path, chunk_size=1024):
+        rt.run(1.0)
+    return path

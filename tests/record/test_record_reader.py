@@ -8,21 +8,7 @@ from hypothesis import strategies as st
 from mcap.writer import Writer
 
 from fleetsim.errors import RecordingError
-from fleetsim.record import BagReader, Recorder, format_info
-
-
-@pytest.fixture(scope="module")
-def recording(tmp_path_factory):
-    from conftest import FakeRobot  # the fixture factory is function-scoped
-
-    from fleetsim.runtime import Runtime
-
-    rt = Runtime()
-    FakeRobot(rt, "/robot0", with_map=True)
-    path = tmp_path_factory.mktemp("rec") / "run.mcap"
-    with Recorder(rt, path, chunk_size=1024):
-        rt.run(1.0)
-    return path
+from fleetsim.record import BagReader, format_info
 
 
 def test_foreign_missing_and_folder(tmp_path):

@@ -1,5 +1,6 @@
 """Tests for fleetsim.localization.amcl.params: ROS names/defaults, -1 as unset, validation."""
 
+import logging
 import math
 
 import pytest
@@ -66,11 +67,14 @@ def test_yaml_numbers_are_coerced():
         ({"min_particles": -10}, r"amcl\.yaml: parameter 'min_particles' = -10 is out of range"),
         ({"max_particles": -1}, r"'max_particles' = -1 is out of range"),
         ({"min_particles": 600, "max_particles": 500}, r"min_particles \(600\) > max_particles"),
-        ({"odom_model_type": "dif"}, r"unknown odom_model_type 'dif' \(did you mean 'diff'\?\)"),
-        ({"laser_model_type": "ray"}, r"unknown laser_model_type 'ray'.*likelihood_field"),
-        ({"min_particles": 1.5}, r"'min_particles' must be an integer"),
-        ({"kld_err": "small"}, r"'kld_err' must be a number"),
-        ({"tf_broadcast": "yes"}, r"'tf_broadcast' must be true or false"),
+        (
+            {"odom_model_type": "dif"},
+            r"'odom_model_type' must be one of .* \(did you mean 'diff'\?\)",
+        ),
+        ({"laser_model_type": "ray"}, r"'laser_model_type' must be one of 'likelihood_field'"),
+        ({"min_particles": 1.5}, r"'min_particles' must be int, got float 1.5"),
+        ({"kld_err": "small"}, r"'kld_err' must be float, got str 'small'"),
+        ({"tf_broadcast": "yes"}, r"'tf_broadcast' must be bool"),
         ({"laser_z_hit": 1.5}, r"'laser_z_hit' = 1.5 is out of range \[0, 1\]"),
         ({"resample_interval": 0}, r"'resample_interval' = 0 is out of range"),
     ],
@@ -85,7 +89,18 @@ def test_direct_construction_validates_too():
         AmclParams(min_particles=-1)
 
 
-def test_unknown_key_warns_with_suggestion():
-    with pytest.warns(UserWarning, match=r"unknown parameter 'min_particle' \(did you mean"):
-        p = params_from_mapping({"min_particle": 3})
+def test_unknown_key_warns_with_suggestion(caplog):
+    with caplog.at_level(logging.WARNING):
+        p = params_from_mapping({"min_particle": 3}, source="/lizi1/amcl")
     assert p.min_particles == 100
+    assert "/lizi1/amcl: unknown parameter 'min_particle' (did you mean 'min_particles'?)" in (
+        caplog.text
+    )
+
+
+def test_direct_construction_checks_choices_and_types():
+    with pytest.raises(ParameterError, match=r"unknown odom_model_type 'dif' \(did you mean"):
+        AmclParams(odom_model_type="dif")
+    with pytest.raises(ParameterError, match=r"'min_particles' must be an integer"):
+        AmclParams(min_particles=2.5)
+    assert AmclParams(laser_max_range=-1).laser_max_range is None

@@ -5,49 +5,31 @@ The names and defaults are those of the ROS 1 ``amcl`` node (wiki.ros.org/amcl),
 "unset" (``laser_min_range``, ``laser_max_range``, ``gui_publish_rate``, ``save_pose_rate``) the
 dataclass holds ``None``; ``-1`` (or any negative value) is still accepted from YAML.
 
-`fleetsim.runtime.param` is not committed yet; `param` below is a local stand-in with the same
-signature (default, unit, range, help, aliases, choices) storing everything in field metadata, and
-`params_from_mapping` is the loader. Both are to be replaced by the runtime's when it lands.
+Fields are declared with `fleetsim.runtime.param`; `params_from_mapping` is
+`fleetsim.runtime.load_params` plus the ``-1`` -> None conversion. Constructing `AmclParams`
+directly validates too (types, ranges, choices, ``min_particles <= max_particles``).
 """
 
 from __future__ import annotations
 
 import dataclasses
+import logging
 import math
-import warnings
 from collections.abc import Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from typing import Any
 
 from fleetsim.errors import ParameterError, did_you_mean
+from fleetsim.runtime.params import load_params, param
 
 ODOM_MODEL_TYPES = ("diff", "omni", "diff-corrected", "omni-corrected")
 LASER_MODEL_TYPES = ("likelihood_field", "beam", "likelihood_field_prob")
 
 
-def param(
-    default: Any,
-    *,
-    unit: str = "",
-    range: tuple[float | None, float | None] | None = None,
-    help: str = "",
-    aliases: tuple[str, ...] = (),
-    choices: tuple[str, ...] | None = None,
-    unset: bool = False,
-) -> Any:
-    """Declare one parameter as a dataclass field carrying its unit, range and meaning.
-
-    ``unset=True`` marks a ROS parameter where a negative value means "not set" (held as None).
-    """
-    meta = {
-        "unit": unit,
-        "range": range,
-        "help": help,
-        "aliases": aliases,
-        "choices": choices,
-        "unset": unset,
-    }
-    return field(default=default, metadata=meta)
+#: parameters where ROS uses a negative value (-1) to mean "unset"; held as None here
+UNSET_WHEN_NEGATIVE = frozenset(
+    {"laser_min_range", "laser_max_range", "gui_publish_rate", "save_pose_rate"}
+)
 
 
 @dataclass(frozen=True)
@@ -100,23 +82,22 @@ class AmclParams:
         (math.pi / 12.0) ** 2, unit="rad^2", range=(0.0, None), help="initial covariance yaw*yaw"
     )
     gui_publish_rate: float | None = param(
-        None, unit="Hz", range=(0.0, None), unset=True, help="particlecloud rate (None: off)"
+        None, unit="Hz", range=(0.0, None), help="particlecloud rate (None: off)"
     )
     save_pose_rate: float | None = param(
         0.5,
         unit="Hz",
         range=(0.0, None),
-        unset=True,
         help="rate of storing the pose in ~initial_pose_* (None: off)",
     )
     use_map_topic: bool = param(False, help="subscribe to map instead of calling static_map")
     first_map_only: bool = param(False, help="use only the first map received")
     # --- laser model ---
     laser_min_range: float | None = param(
-        None, unit="m", range=(0.0, None), unset=True, help="min scan range (None: the scan's)"
+        None, unit="m", range=(0.0, None), help="min scan range (None: the scan's)"
     )
     laser_max_range: float | None = param(
-        None, unit="m", range=(0.0, None), unset=True, help="max scan range (None: the scan's)"
+        None, unit="m", range=(0.0, None), help="max scan range (None: the scan's)"
     )
     laser_max_beams: int = param(30, range=(2, None), help="beams used per scan in the update")
     laser_z_hit: float = param(0.95, range=(0.0, 1.0), help="mixture weight of z_hit")
@@ -182,13 +163,14 @@ def _checked(f: dataclasses.Field, value: Any, source: str) -> Any:
     meta = f.metadata
     name = f.name
     default = f.default
-    if meta.get("unset") and value is not None:
+    unset = name in UNSET_WHEN_NEGATIVE
+    if unset and value is not None:
         if isinstance(value, bool) or not isinstance(value, int | float):
             raise ParameterError(f"{source}: parameter '{name}' must be a number, got {value!r}")
         if value < 0:
             return None
     if value is None:
-        if meta.get("unset"):
+        if unset:
             return None
         raise ParameterError(f"{source}: parameter '{name}' must be set (default {default!r})")
     kind = type(default) if default is not None else float
@@ -228,32 +210,23 @@ def _checked(f: dataclasses.Field, value: Any, source: str) -> Any:
 
 
 def params_from_mapping(
-    mapping: Mapping[str, Any] | None, source: str = "amcl", cls: type = AmclParams
-) -> Any:
-    """Build validated params from a ROS-style parameter mapping (``~`` namespace of the node).
+    mapping: Mapping[str, Any] | None,
+    source: str = "amcl",
+    logger: logging.Logger | None = None,
+) -> AmclParams:
+    """Validated `AmclParams` from a ROS-style mapping (the node's private namespace).
 
-    Unknown keys are warned about with a "did you mean" suggestion; aliases are accepted with a
-    warning; ``source`` (a file or node name) is named in every error.
+    Negative values of `UNSET_WHEN_NEGATIVE` parameters become None; everything else is
+    `fleetsim.runtime.load_params` (unknown keys warned about with a suggestion, old names
+    accepted, ``source`` named in every error).
     """
-    fields = {f.name: f for f in dataclasses.fields(cls)}
-    aliases = {a: f.name for f in fields.values() for a in f.metadata.get("aliases", ())}
-    kwargs: dict[str, Any] = {}
-    for key, value in (mapping or {}).items():
-        name = key
-        if key in aliases:
-            name = aliases[key]
-            warnings.warn(f"{source}: parameter '{key}' is deprecated, use '{name}'", stacklevel=2)
-        if name not in fields:
-            if isinstance(value, Mapping):
-                continue  # a sub-namespace (another node's parameters), not ours
-            warnings.warn(
-                f"{source}: unknown parameter '{key}'{did_you_mean(key, fields)} ignored",
-                stacklevel=2,
-            )
-            continue
-        kwargs[name] = value
+    values = dict(mapping or {})
+    for key in UNSET_WHEN_NEGATIVE:
+        v = values.get(key)
+        if isinstance(v, int | float) and not isinstance(v, bool) and v < 0:
+            values[key] = None
     try:
-        return cls(**kwargs)
+        return load_params(AmclParams, values, where=source, logger=logger)
     except ParameterError as err:
-        msg = str(err).replace(f"{cls.__name__}:", f"{source}:", 1)
+        msg = str(err).replace("AmclParams:", f"{source}:", 1)
         raise ParameterError(msg) from None

@@ -2,6 +2,7 @@
 
 fleetsim bag info run.mcap
 fleetsim bag play run.mcap --rate 2 [--topics /map --topics /tf] [--no-bridge]
+fleetsim bag record -o run.mcap [/map /tf ...] [--duration 60]   (a running simulation)
 
 ``play`` republishes on sim time into a fresh runtime; with the Zenoh bridge (the default when
 ``fleetsim.transport`` is installed) other processes, ``fleetsim topic echo`` and nodes started
@@ -88,3 +89,33 @@ def play(
         raise _fail(exc) from None
     finally:
         runtime.shutdown()
+
+
+OUT = typer.Option(..., "--output", "-o", help="The .mcap file to write.")
+RECORD_TOPICS = typer.Argument(None, help="Topics to record (default: all).", show_default=False)
+DURATION = typer.Option(
+    None, "--duration", "-d", help="Sim seconds to record (default: until Ctrl-C)."
+)
+CONNECT = typer.Option(None, "--connect", help="Simulation endpoint (default tcp/127.0.0.1:7447).")
+COMPRESSION = typer.Option("zstd", "--compression", help="zstd, lz4 or none.")
+
+
+@app.command()
+def record(
+    topics: list[str] = RECORD_TOPICS,
+    output: Path = OUT,
+    duration: float = DURATION,
+    connect: str = CONNECT,
+    compression: str = COMPRESSION,
+) -> None:
+    """Record a running simulation's topics (all, or TOPICS) to an MCAP file."""
+    from fleetsim.record.remote import record_remote
+
+    try:
+        rec = record_remote(output, topics or None, connect, duration, compression)
+    except FleetsimError as exc:
+        raise _fail(exc) from None
+    typer.echo(
+        f"recorded {rec.message_count} messages on {len(rec.recorded_topics)} topics to {output}",
+        err=True,
+    )

@@ -112,26 +112,37 @@ class Recorder:
                 self._latched.add(name)
 
     def _maybe_record(self, name: str, topic: Any) -> None:
-        if name in self._channels or (self.topics is not None and name not in self.topics):
+        if any(p.latch for p in topic.publishers) and self._wanted(name):
+            self._latched.add(name)
+        self.record_topic(name, topic.type)
+
+    def _wanted(self, name: str) -> bool:
+        return self.topics is None or name in self.topics
+
+    def record_topic(self, name: str, msg_type: Any) -> None:
+        """Record ``name`` (a global topic of ``msg_type``) from now on, if it is selected.
+
+        Topics of the runtime's graph are found by themselves; this is for topics that exist
+        elsewhere (another process, through the Zenoh bridge) and have no local end yet.
+        """
+        if name in self._channels or not self._wanted(name) or self.closed:
             return
         from fleetsim.msgs import msgdef, type_name
 
-        typename = type_name(topic.type)
+        typename = type_name(msg_type)
         schema_id = self._schemas.get(typename)
         if schema_id is None:
             schema_id = self._writer.register_schema(
-                name=typename, encoding="ros2msg", data=msgdef(topic.type).encode()
+                name=typename, encoding="ros2msg", data=msgdef(msg_type).encode()
             )
             self._schemas[typename] = schema_id
-        if any(p.latch for p in topic.publishers):
-            self._latched.add(name)
         channel_id = self._writer.register_channel(
             topic=name, message_encoding="cdr", schema_id=schema_id
         )
         self._channels[name] = channel_id
         callback = self._make_callback(channel_id)
         # registered before subscribing: the subscribe event comes back to _on_graph_event
-        self._subs.append(self.runtime.graph.subscribe(name, topic.type, callback, queue_size=0))
+        self._subs.append(self.runtime.graph.subscribe(name, msg_type, callback, queue_size=0))
 
     def _make_callback(self, channel_id: int):
         from fleetsim.msgs import serialize

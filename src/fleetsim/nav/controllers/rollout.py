@@ -1,0 +1,176 @@
+"""Trajectory rollout and scoring for all velocity samples at once (base_local_planner).
+
+`trajectory_costs` is TrajectoryPlanner::generateTrajectory for S samples in one compiled
+call: each sample (vx, vy, vtheta) is simulated from the robot's pose and velocity with the
+acceleration limits for ``sim_time`` in ``num_steps`` steps, each pose checked with the
+footprint and scored from the path / goal distance maps.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+from fleetsim.nav.costmap.footprint import footprint_cost_at
+
+
+@njit(cache=True, inline="always")
+def _new_velocity(vg, vi, a_max, dt):
+    if vg - vi >= 0:
+        return min(vg, vi + a_max * dt)
+    return max(vg, vi - a_max * dt)
+
+
+@njit(cache=True)
+def _line_clear(costs, x0, y0, x1, y1):
+    """True when no cell on the line is LETHAL, INSCRIBED or NO_INFORMATION (lineCost >= 0)."""
+    n = max(abs(x1 - x0), abs(y1 - y0))
+    for k in range(n + 1):
+        t = k / n if n > 0 else 0.0
+        x = round(x0 + (x1 - x0) * t)
+        y = round(y0 + (y1 - y0) * t)
+        if costs[y, x] >= 253:
+            return False
+    return True
+
+
+@njit(cache=True)
+def _heading_diff(costs, ox, oy, res, plan_cells, cx, cy, x, y, heading):
+    """TrajectoryPlanner::headingDiff: angle to the farthest plan cell in line of sight."""
+    for i in range(plan_cells.shape[0] - 1, -1, -1):
+        gx = plan_cells[i, 0]
+        gy = plan_cells[i, 1]
+        if _line_clear(costs, cx, cy, gx, gy):
+            wx = ox + (gx + 0.5) * res
+            wy = oy + (gy + 0.5) * res
+            d = math.atan2(wy - y, wx - x) - heading
+            d = (d + math.pi) % (2.0 * math.pi) - math.pi
+            return abs(d)
+    return 1.0e300
+
+
+@njit(cache=True)
+def num_steps_of(samples, sim_time, sim_granularity, angular_sim_granularity, heading_scoring):
+    """Simulation steps of each sample (at least 1). samples : (S, 3). Returns (S,) int64."""
+    out = np.empty(samples.shape[0], dtype=np.int64)
+    for s in range(samples.shape[0]):
+        if heading_scoring:
+            n = int(sim_time / sim_granularity + 0.5)
+        else:
+            vmag = math.hypot(samples[s, 0], samples[s, 1])
+            n = int(
+                max(vmag * sim_time / sim_granularity, abs(samples[s, 2]) / angular_sim_granularity)
+                + 0.5
+            )
+        out[s] = max(n, 1)
+    return out
+
+
+@njit(cache=True)
+def trajectory_costs(
+    samples,
+    pose,
+    velocity,
+    acc,
+    sim_time,
+    num_steps,
+    costs,
+    origin,
+    resolution,
+    outline,
+    path_dist,
+    goal_dist,
+    scales,
+    heading,
+    plan_cells,
+    simple_attractor,
+    final_goal,
+    poses_out,
+):
+    """Score every sample's rollout as TrajectoryPlanner::generateTrajectory.
+
+    Parameters
+    ----------
+    samples : (S, 3) commanded (vx, vy, vtheta), m/s and rad/s, robot frame.
+    pose : (3,) robot x, y (m), yaw (rad) in the costmap frame.
+    velocity : (3,) current (vx, vy, vtheta).
+    acc : (3,) acceleration limits (x, y, theta), m/s^2 and rad/s^2.
+    sim_time : s. num_steps : (S,) steps per sample (see `num_steps_of`).
+    costs : (H, W) uint8 local costmap; origin : (2,) m; resolution : m.
+    outline : (M, 2) footprint outline points, robot frame, m.
+    path_dist, goal_dist : (H, W) float64 MapGrid distances (cells).
+    scales : (3,) pdist_scale, gdist_scale, occdist_scale.
+    heading : (2,) heading_scoring (0/1), heading_scoring_timestep (s).
+    plan_cells : (K, 2) int64 plan cells in the map, for heading scoring.
+    simple_attractor : score by squared distance to ``final_goal`` (2,) instead of the maps.
+    poses_out : (S, T, 3) float64 written with each rollout's poses (T >= max num_steps).
+
+    Returns
+    -------
+    (S,) float64 costs: >= 0 legal; -1 footprint collision or off the map; -2 a pose with no
+    path to the goal (distance at least the map size).
+    """
+    h, w = costs.shape
+    impossible = float(h * w)
+    out = np.empty(samples.shape[0])
+    for s in range(samples.shape[0]):
+        n = num_steps[s]
+        dt = sim_time / n
+        x, y, th = pose[0], pose[1], pose[2]
+        vx, vy, vth = velocity[0], velocity[1], velocity[2]
+        path_d = 0.0
+        goal_d = 0.0
+        occ = 0.0
+        hdiff = 0.0
+        t = 0.0
+        cost = 0.0
+        for i in range(n):
+            fx = (x - origin[0]) / resolution
+            fy = (y - origin[1]) / resolution
+            if fx < 0.0 or fy < 0.0 or fx >= w or fy >= h:
+                cost = -1.0
+                break
+            cx = int(fx)
+            cy = int(fy)
+            fp = footprint_cost_at(costs, origin[0], origin[1], resolution, outline, x, y, th)
+            if fp < 0.0:
+                cost = -1.0
+                break
+            occ = max(occ, fp, float(costs[cy, cx]))
+            if simple_attractor:
+                goal_d = (x - final_goal[0]) ** 2 + (y - final_goal[1]) ** 2
+            else:
+                update = True
+                if heading[0] > 0.5:
+                    if t >= heading[1] and t < heading[1] + dt:
+                        hdiff = _heading_diff(
+                            costs, origin[0], origin[1], resolution, plan_cells, cx, cy, x, y, th
+                        )
+                    else:
+                        update = False
+                if update:
+                    path_d = path_dist[cy, cx]
+                    goal_d = goal_dist[cy, cx]
+                    if impossible <= goal_d or impossible <= path_d:
+                        cost = -2.0
+                        break
+            poses_out[s, i, 0] = x
+            poses_out[s, i, 1] = y
+            poses_out[s, i, 2] = th
+            vx = _new_velocity(samples[s, 0], vx, acc[0], dt)
+            vy = _new_velocity(samples[s, 1], vy, acc[1], dt)
+            vth = _new_velocity(samples[s, 2], vth, acc[2], dt)
+            x = x + (vx * math.cos(th) + vy * math.cos(math.pi / 2.0 + th)) * dt
+            y = y + (vx * math.sin(th) + vy * math.sin(math.pi / 2.0 + th)) * dt
+            th = th + vth * dt
+            t += dt
+        if cost < 0.0:
+            out[s] = cost
+            continue
+        total = scales[0] * path_d + scales[1] * goal_d + scales[2] * occ
+        if heading[0] > 0.5:
+            total += 0.3 * hdiff
+        out[s] = total
+    return out

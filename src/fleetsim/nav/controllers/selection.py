@@ -1,0 +1,167 @@
+"""TrajectoryPlanner::createTrajectories: the velocity samples and the choice among them.
+
+All samples (forward, strafing, in-place, sideways, escape) are scored in one batch; the
+choice then replays base_local_planner's order and tie rules, including its oscillation
+flags (``stuck_left`` / ``stuck_right`` ...) and escape mode, kept on the planner.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from fleetsim.nav.controllers.trajectory_planner import TrajectoryPlanner
+
+
+def velocity_samples(
+    tp: TrajectoryPlanner, pose, vel
+) -> tuple[np.ndarray, dict[str, slice], float]:
+    """Every sample, grouped: (S, 3) (vx, vy, vtheta), the group slices, and dvtheta."""
+    p = tp.params
+    x, y = pose[0], pose[1]
+    max_vx = p.max_vel_x
+    if tp.plan.shape[0]:
+        gx, gy = tp.plan[-1, 0], tp.plan[-1, 1]
+        max_vx = min(max_vx, math.hypot(gx - x, gy - y) / p.sim_time)
+    window = tp.sim_period if p.dwa else p.sim_time
+    max_vx = max(min(max_vx, vel[0] + p.acc_lim_x * window), p.min_vel_x)
+    min_vx = max(p.min_vel_x, vel[0] - p.acc_lim_x * window)
+    max_vth = min(p.max_vel_theta, vel[2] + p.acc_lim_theta * window)
+    min_vth = max(p.min_vel_theta, vel[2] - p.acc_lim_theta * window)
+    dvx = (max_vx - min_vx) / (p.vx_samples - 1) if p.vx_samples > 1 else 0.0
+    dvth = (max_vth - min_vth) / (p.vtheta_samples - 1) if p.vtheta_samples > 1 else 0.0
+    groups: dict[str, slice] = {}
+    rows: list[tuple[float, float, float]] = []
+
+    def add(name: str, items: list[tuple[float, float, float]]) -> None:
+        groups[name] = slice(len(rows), len(rows) + len(items))
+        rows.extend(items)
+
+    forward = []
+    for i in range(p.vx_samples):
+        vx = min_vx + i * dvx
+        forward.append((vx, 0.0, 0.0))
+        forward.extend((vx, 0.0, min_vth + j * dvth) for j in range(p.vtheta_samples - 1))
+    add("forward", forward)
+    add("strafe", [(0.1, 0.1, 0.0), (0.1, -0.1, 0.0)] if p.holonomic_robot else [])
+    in_place = []
+    for i in range(p.vtheta_samples):
+        v = min_vth + i * dvth
+        lim = max(v, p.min_in_place_vel_theta) if v > 0 else min(v, -p.min_in_place_vel_theta)
+        in_place.append((0.0, 0.0, lim))
+    add("in_place", in_place)
+    add("sideways", [(0.0, float(v), 0.0) for v in p.y_vels] if p.holonomic_robot else [])
+    add("escape", [(p.escape_vel, 0.0, 0.0)])
+    raw_vth = np.array([min_vth + i * dvth for i in range(p.vtheta_samples)])
+    tp._in_place_raw = raw_vth
+    return np.array(rows, dtype=np.float64).reshape(-1, 3), groups, dvth
+
+
+def _ahead_goal_dist(tp: TrajectoryPlanner, index: int) -> float | None:
+    """Goal distance at the end of a rollout pushed ``heading_lookahead`` ahead, or None."""
+    n = int(tp._steps[index])
+    xr, yr, thr = tp._poses[index, n - 1]
+    xr += tp.params.heading_lookahead * math.cos(thr)
+    yr += tp.params.heading_lookahead * math.sin(thr)
+    cell = tp.costmap.world_to_map(xr, yr)
+    return None if cell is None else float(tp.goal_dist[cell[1], cell[0]])
+
+
+def _bookkeep(tp: TrajectoryPlanner, sample, pose) -> None:
+    """Oscillation flags and escape reset after a legal choice."""
+    vx, vy, vth = sample
+    x, y, th = pose
+    if not vx > 0:
+        if vth < 0:
+            if tp.rotating_right:
+                tp.stuck_right = True
+            tp.rotating_right = True
+        elif vth > 0:
+            if tp.rotating_left:
+                tp.stuck_left = True
+            tp.rotating_left = True
+        elif vy > 0:
+            if tp.strafe_right:
+                tp.stuck_right_strafe = True
+            tp.strafe_right = True
+        elif vy < 0:
+            if tp.strafe_left:
+                tp.stuck_left_strafe = True
+            tp.strafe_left = True
+        tp.prev = (x, y)
+    if math.hypot(x - tp.prev[0], y - tp.prev[1]) > tp.params.oscillation_reset_dist:
+        tp._reset_oscillation_flags()
+    ex, ey, eth = tp.escape_pose
+    dth = abs((eth - th + math.pi) % (2 * math.pi) - math.pi)
+    if (
+        math.hypot(x - ex, y - ey) > tp.params.escape_reset_dist
+        or dth > tp.params.escape_reset_theta
+    ):
+        tp.escaping = False
+
+
+def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
+    """The chosen sample, its cost and its batch index (cost < 0: nothing legal)."""
+    samples, g, dvth = velocity_samples(tp, pose, vel)
+    costs = tp._score(samples, pose, vel)
+    best, best_cost = -1, -1.0
+
+    def better(i: int, allow_equal: bool) -> bool:
+        c = costs[i]
+        if c < 0:
+            return False
+        return best_cost < 0 or c < best_cost or (allow_equal and c <= best_cost)
+
+    if not tp.escaping:
+        for i in range(g["forward"].start, g["strafe"].stop):
+            if better(i, False):
+                best, best_cost = i, costs[i]
+    heading_dist = math.inf
+    raw = tp._in_place_raw
+    for k, i in enumerate(range(g["in_place"].start, g["in_place"].stop)):
+        v = raw[k]
+        ok = costs[i] >= 0 and (best_cost < 0 or costs[i] <= best_cost or samples[best, 1] != 0.0)
+        if ok and (v > dvth or v < -dvth):
+            ahead = _ahead_goal_dist(tp, i)
+            free_side = (v < 0 and not tp.stuck_left) or (v > 0 and not tp.stuck_right)
+            if ahead is not None and ahead < heading_dist and free_side:
+                best, best_cost = i, costs[i]
+                heading_dist = ahead
+    if best_cost >= 0:
+        _bookkeep(tp, samples[best], pose)
+        return tuple(samples[best]), float(best_cost), best
+    for i in range(g["sideways"].start, g["sideways"].stop):
+        vy = samples[i, 1]
+        if costs[i] >= 0 and (best_cost < 0 or costs[i] <= best_cost):
+            ahead = _ahead_goal_dist(tp, i)
+            free_side = (vy > 0 and not tp.stuck_left_strafe) or (
+                vy < 0 and not tp.stuck_right_strafe
+            )
+            if ahead is not None and ahead < heading_dist and free_side:
+                best, best_cost = i, costs[i]
+                heading_dist = ahead
+    if best_cost >= 0:
+        _bookkeep(tp, samples[best], pose)
+        return tuple(samples[best]), float(best_cost), best
+    # back up slowly, even if the map says it is blocked
+    i = g["escape"].start
+    cost = float(costs[i])
+    x, y, th = pose
+    if math.hypot(x - tp.prev[0], y - tp.prev[1]) > tp.params.oscillation_reset_dist:
+        tp._reset_oscillation_flags()
+    if not tp.escaping and cost > -2.0:
+        tp.escape_pose = (x, y, th)
+        tp.escaping = True
+    ex, ey, eth = tp.escape_pose
+    dth = abs((eth - th + math.pi) % (2 * math.pi) - math.pi)
+    if (
+        math.hypot(x - ex, y - ey) > tp.params.escape_reset_dist
+        or dth > tp.params.escape_reset_theta
+    ):
+        tp.escaping = False
+    if cost == -1.0:
+        cost = 1.0
+    return tuple(samples[i]), cost, i

@@ -1,0 +1,83 @@
+"""Parameters of base_local_planner's TrajectoryPlannerROS, with ROS's names and defaults."""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from fleetsim.runtime import param
+
+
+@dataclass(frozen=True)
+class TrajectoryPlannerParams:
+    """``TrajectoryPlannerROS/`` parameters (base_local_planner)."""
+
+    # robot configuration
+    acc_lim_x: float = param(2.5, unit="m/s^2", range=(0.0, None), help="x acceleration limit")
+    acc_lim_y: float = param(2.5, unit="m/s^2", range=(0.0, None), help="y acceleration limit")
+    acc_lim_theta: float = param(
+        3.2, unit="rad/s^2", range=(0.0, None), help="rotational acceleration limit"
+    )
+    max_vel_x: float = param(0.5, unit="m/s", help="maximum forward velocity")
+    min_vel_x: float = param(0.1, unit="m/s", help="minimum forward velocity")
+    max_vel_theta: float = param(
+        1.0, unit="rad/s", aliases=("max_rotational_vel",), help="maximum rotational velocity"
+    )
+    min_vel_theta: float = param(-1.0, unit="rad/s", help="minimum rotational velocity")
+    min_in_place_vel_theta: float = param(
+        0.4,
+        unit="rad/s",
+        aliases=("min_in_place_rotational_vel",),
+        help="minimum rotational velocity when rotating in place",
+    )
+    escape_vel: float = param(
+        -0.1, unit="m/s", aliases=("backup_vel",), help="velocity when escaping (negative: back)"
+    )
+    holonomic_robot: bool = param(True, help="also sample strafing (y) velocities")
+    y_vels: list = param([-0.3, -0.1, 0.1, 0.3], unit="m/s", help="strafing velocities tried")
+    # goal tolerance
+    yaw_goal_tolerance: float = param(0.05, unit="rad", range=(0.0, None), help="yaw tolerance")
+    xy_goal_tolerance: float = param(0.10, unit="m", range=(0.0, None), help="xy tolerance")
+    latch_xy_goal_tolerance: bool = param(
+        False, help="once within xy tolerance, only rotate even if pushed out"
+    )
+    # forward simulation
+    sim_time: float = param(1.0, unit="s", range=(1e-6, None), help="forward simulation time")
+    sim_granularity: float = param(
+        0.025, unit="m", range=(1e-6, None), help="step between trajectory points"
+    )
+    angular_sim_granularity: float | None = param(
+        None, unit="rad", range=(1e-6, None), help="angular step (unset: sim_granularity)"
+    )
+    vx_samples: int = param(3, range=(1, None), help="x velocity samples")
+    vtheta_samples: int = param(20, range=(1, None), help="rotational velocity samples")
+    controller_frequency: float = param(
+        20.0, unit="Hz", range=(1e-6, None), help="cycle rate (searched upwards, as move_base's)"
+    )
+    # scoring
+    meter_scoring: bool = param(False, help="distances in metres (else cells)")
+    pdist_scale: float = param(0.6, range=(0.0, None), help="weight of path distance")
+    gdist_scale: float = param(0.8, range=(0.0, None), help="weight of goal distance")
+    occdist_scale: float = param(0.01, range=(0.0, None), help="weight of obstacle cost")
+    heading_lookahead: float = param(
+        0.325, unit="m", help="look-ahead when scoring in-place rotations"
+    )
+    heading_scoring: bool = param(False, help="score by heading to the path, not distance")
+    heading_scoring_timestep: float = param(
+        0.8, unit="s", range=(0.0, None), help="look-ahead time for heading scoring"
+    )
+    dwa: bool = param(False, help="Dynamic Window Approach (velocity window of one cycle)")
+    simple_attractor: bool = param(False, help="follow the goal blindly (testing)")
+    publish_cost_grid_pc: bool = param(False, help="publish the scoring grid as a cloud")
+    global_frame_id: str = param("odom", help="frame for the published cost cloud")
+    # oscillation prevention
+    oscillation_reset_dist: float = param(
+        0.05, unit="m", range=(0.0, None), help="travel that resets oscillation flags"
+    )
+    escape_reset_dist: float = param(
+        0.10, unit="m", range=(0.0, None), help="travel that ends escaping"
+    )
+    escape_reset_theta: float = param(
+        math.pi / 4, unit="rad", range=(0.0, None), help="rotation that ends escaping"
+    )
+    prune_plan: bool = param(True, help="drop plan points more than 1 m behind the robot")

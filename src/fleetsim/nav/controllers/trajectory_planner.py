@@ -1,0 +1,258 @@
+"""base_local_planner's TrajectoryPlannerROS: trajectory rollout and DWA.
+
+Each cycle (``compute_velocity_commands``):
+
+1. the global plan is cut to the local costmap (points from the first within half the map's
+   size of the robot, while they stay within it) and, with ``prune_plan``, points more than
+   1 m behind the robot are dropped;
+2. within ``xy_goal_tolerance`` of the goal the robot stops (within its acceleration limits)
+   and then rotates in place to the goal yaw;
+3. otherwise the path and goal distance maps are computed and every velocity sample is rolled
+   out and scored in one batch (`rollout.trajectory_costs`):
+   ``pdist_scale * path_dist + gdist_scale * goal_dist + occdist_scale * occ_cost``
+   (distances in cells, or metres with ``meter_scoring``);
+4. the best is chosen as TrajectoryPlanner::createTrajectories does: forward samples
+   (``vx_samples`` x ``vtheta_samples``), holonomic strafes, rotations in place towards open
+   space (with oscillation flags), sideways moves, and finally backing up at ``escape_vel``.
+
+Rollout velocities: ``[vx - acc_lim_x * T, vx + acc_lim_x * T]`` within ``[min_vel_x,
+max_vel_x]`` (likewise theta), with T = ``sim_time``, or the control period when ``dwa``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from fleetsim.nav.controllers.base import (
+    EmptyPlan,
+    LocalPlanner,
+    NoValidTrajectory,
+    VelocityCommand,
+)
+from fleetsim.nav.controllers.map_grid import distances_from_targets, plan_cells_in_map
+from fleetsim.nav.controllers.rollout import num_steps_of, trajectory_costs
+from fleetsim.nav.controllers.selection import choose_trajectory
+from fleetsim.nav.controllers.trajectory_params import TrajectoryPlannerParams
+from fleetsim.nav.costmap.costmap_2d import Costmap2D
+from fleetsim.nav.costmap.footprint import footprint_at, outline_points, polygon_cells
+from fleetsim.runtime import load_params
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+def _sign(v: float) -> float:
+    return 1.0 if v > 0 else (-1.0 if v < 0 else 0.0)
+
+
+class TrajectoryPlanner(LocalPlanner):
+    """Trajectory rollout / DWA local planner on a local costmap.
+
+    costmap : the local costmap's master grid (read each cycle, may roll).
+    footprint : (K, 2) padded robot polygon, m (the costmap's ``footprint``).
+    """
+
+    Params = TrajectoryPlannerParams
+
+    def __init__(
+        self,
+        costmap: Costmap2D,
+        footprint: np.ndarray,
+        params: TrajectoryPlannerParams | None = None,
+    ) -> None:
+        self.costmap = costmap
+        self.params = p = params or TrajectoryPlannerParams()
+        self.footprint = np.asarray(footprint, dtype=np.float64)
+        self.outline = outline_points(self.footprint, costmap.resolution)
+        self.sim_period = 1.0 / p.controller_frequency
+        self.angular_sim_granularity = p.angular_sim_granularity or p.sim_granularity
+        scale = costmap.resolution if p.meter_scoring else 1.0
+        self.scales = np.array([p.pdist_scale, p.gdist_scale, p.occdist_scale]) * scale
+        self.plan = np.zeros((0, 3))
+        self.local_plan = np.zeros((0, 3))  # the chosen trajectory's poses
+        self.reached_goal = False
+        self.xy_tolerance_latch = False
+        self.rotating_to_goal = False
+        self._reset_oscillation_flags()
+        self.escaping = False
+        self.prev = (0.0, 0.0)
+        self.escape_pose = (0.0, 0.0, 0.0)
+
+    @classmethod
+    def from_namespace(
+        cls,
+        costmap: Costmap2D,
+        footprint: np.ndarray,
+        ns: dict[str, Any] | None,
+        where: str = "TrajectoryPlannerROS",
+    ) -> TrajectoryPlanner:
+        return cls(costmap, footprint, load_params(TrajectoryPlannerParams, ns, where))
+
+    def _reset_oscillation_flags(self) -> None:
+        self.rotating_left = self.rotating_right = False
+        self.strafe_left = self.strafe_right = False
+        self.stuck_left = self.stuck_right = False
+        self.stuck_left_strafe = self.stuck_right_strafe = False
+
+    # -- the plugin interface ------------------------------------------------------------------
+    def set_plan(self, plan: Any) -> None:
+        poses = np.asarray(getattr(plan, "poses", plan), dtype=np.float64)
+        if poses.ndim != 2 or poses.shape[1] not in (2, 3):
+            raise EmptyPlan(f"set_plan: a plan must be (N, 3) x, y, yaw poses, got {poses.shape}")
+        if poses.shape[1] == 2:
+            poses = np.concatenate([poses, np.zeros((poses.shape[0], 1))], axis=1)
+        self.plan = poses
+        self.reached_goal = False
+        self.xy_tolerance_latch = False
+
+    def is_goal_reached(self) -> bool:
+        return self.reached_goal
+
+    def compute_velocity_commands(self, pose, velocity) -> VelocityCommand:
+        p = self.params
+        x, y, yaw = (float(v) for v in pose)
+        vel = tuple(float(v) for v in velocity)
+        if self.plan.shape[0] == 0:
+            raise EmptyPlan("TrajectoryPlannerROS: no plan; call set_plan first")
+        local = self._plan_in_window(x, y)
+        if p.prune_plan:
+            local = self._pruned(local, x, y)
+        if local.shape[0] == 0:
+            raise EmptyPlan(
+                f"TrajectoryPlannerROS: the plan does not pass within the local costmap around "
+                f"({x:.2f}, {y:.2f})"
+            )
+        gx, gy, gyaw = self.plan[-1]
+        if self.xy_tolerance_latch or math.hypot(gx - x, gy - y) <= p.xy_goal_tolerance:
+            if p.latch_xy_goal_tolerance:
+                self.xy_tolerance_latch = True
+            if abs(_wrap(gyaw - yaw)) <= p.yaw_goal_tolerance:
+                self.rotating_to_goal = False
+                self.xy_tolerance_latch = False
+                self.reached_goal = True
+                return VelocityCommand()
+            self._update_maps(local, (x, y, yaw))
+            stopped = abs(vel[2]) <= 1e-2 and abs(vel[0]) <= 1e-2 and abs(vel[1]) <= 1e-2
+            if not self.rotating_to_goal and not stopped:
+                return self._stop_with_acc_limits((x, y, yaw), vel)
+            self.rotating_to_goal = True
+            return self._rotate_to_goal((x, y, yaw), vel, gyaw)
+        self._update_maps(local, (x, y, yaw))
+        best, cost = self._find_best((x, y, yaw), vel)
+        if cost < 0:
+            self.local_plan = np.zeros((0, 3))
+            raise NoValidTrajectory(
+                f"TrajectoryPlannerROS: no valid trajectory from ({x:.2f}, {y:.2f}, yaw "
+                f"{yaw:.2f}): the footprint collides or leaves the local map on every sample"
+            )
+        return VelocityCommand(*best)
+
+    # -- plan handling --------------------------------------------------------------------------
+    def _plan_in_window(self, x: float, y: float) -> np.ndarray:
+        m = self.costmap
+        thr = max(m.size_x * m.resolution / 2.0, m.size_y * m.resolution / 2.0) ** 2
+        d2 = ((self.plan[:, :2] - [x, y]) ** 2).sum(axis=1)
+        near = d2 <= thr
+        if not near.any():
+            return self.plan[:0]
+        i = int(np.argmax(near))
+        rest = near[i:]
+        j = i + (int(np.argmin(rest)) if not rest.all() else rest.shape[0])
+        return self.plan[i:j]
+
+    def _pruned(self, local: np.ndarray, x: float, y: float) -> np.ndarray:
+        """Drop points until the first within 1 m of the robot (base_local_planner prunePlan)."""
+        d2 = ((local[:, :2] - [x, y]) ** 2).sum(axis=1)
+        close = d2 < 1.0
+        if not close.any():
+            return local
+        k = int(np.argmax(close))
+        d2g = ((self.plan[:, :2] - local[k, :2]) ** 2).sum(axis=1)
+        self.plan = self.plan[int(np.argmin(d2g)) :]
+        return local[k:]
+
+    def _update_maps(self, local: np.ndarray, pose: tuple[float, float, float]) -> None:
+        m = self.costmap
+        passable = np.zeros(m.costs.shape, dtype=bool)
+        rows, cols = polygon_cells(m, footprint_at(self.footprint, *pose))
+        passable[rows, cols] = True
+        targets = plan_cells_in_map(m, local[:, :2])
+        self.plan_cells = targets
+        self.path_dist = distances_from_targets(m.costs, targets, passable)
+        goal = targets[-1:] if targets.shape[0] else targets
+        self.goal_dist = distances_from_targets(m.costs, goal, np.zeros_like(passable))
+        self.final_goal = self.plan[-1, :2].copy()
+
+    # -- scoring ----------------------------------------------------------------------------------
+    def _score(self, samples: np.ndarray, pose, vel) -> np.ndarray:
+        p, m = self.params, self.costmap
+        samples = np.ascontiguousarray(samples, dtype=np.float64)
+        steps = num_steps_of(
+            samples, p.sim_time, p.sim_granularity, self.angular_sim_granularity, p.heading_scoring
+        )
+        self._poses = np.empty((samples.shape[0], int(steps.max()), 3))
+        self._steps = steps
+        return trajectory_costs(
+            samples,
+            np.asarray(pose, dtype=np.float64),
+            np.asarray(vel, dtype=np.float64),
+            np.array([p.acc_lim_x, p.acc_lim_y, p.acc_lim_theta]),
+            p.sim_time,
+            steps,
+            m.costs,
+            np.array(m.origin),
+            m.resolution,
+            self.outline,
+            self.path_dist,
+            self.goal_dist,
+            self.scales,
+            np.array([1.0 if p.heading_scoring else 0.0, p.heading_scoring_timestep]),
+            self.plan_cells,
+            p.simple_attractor,
+            self.final_goal,
+            self._poses,
+        )
+
+    def check_trajectory(self, pose, vel, sample) -> bool:
+        """Whether one command's rollout is legal (TrajectoryPlanner::checkTrajectory)."""
+        return bool(self._score(np.array([sample]), pose, vel)[0] >= 0)
+
+    def _stop_with_acc_limits(self, pose, vel) -> VelocityCommand:
+        p, dt = self.params, self.sim_period
+        cmd = (
+            _sign(vel[0]) * max(0.0, abs(vel[0]) - p.acc_lim_x * dt),
+            _sign(vel[1]) * max(0.0, abs(vel[1]) - p.acc_lim_y * dt),
+            _sign(vel[2]) * max(0.0, abs(vel[2]) - p.acc_lim_theta * dt),
+        )
+        if self.check_trajectory(pose, vel, cmd):
+            return VelocityCommand(*cmd)
+        raise NoValidTrajectory("TrajectoryPlannerROS: cannot stop without a collision")
+
+    def _rotate_to_goal(self, pose, vel, goal_yaw: float) -> VelocityCommand:
+        p = self.params
+        ang = _wrap(goal_yaw - pose[2])
+        lo, hi, mn = p.min_vel_theta, p.max_vel_theta, p.min_in_place_vel_theta
+
+        def clamp(v: float) -> float:
+            return min(hi, max(mn, v)) if v > 0.0 else max(lo, min(-mn, v))
+
+        v = clamp(ang)
+        max_acc = abs(vel[2]) + p.acc_lim_theta * self.sim_period
+        min_acc = abs(vel[2]) - p.acc_lim_theta * self.sim_period
+        v = _sign(v) * min(max(abs(v), min_acc), max_acc)
+        v = _sign(v) * min(math.sqrt(2 * p.acc_lim_theta * abs(ang)), abs(v))
+        v = clamp(v)
+        if self.check_trajectory(pose, vel, (0.0, 0.0, v)):
+            return VelocityCommand(0.0, 0.0, v)
+        raise NoValidTrajectory("TrajectoryPlannerROS: cannot rotate to the goal yaw in place")
+
+    def _find_best(self, pose, vel) -> tuple[tuple[float, float, float], float]:
+        (vx, vy, vth), cost, index = choose_trajectory(self, pose, vel)
+        self.local_plan = self._poses[index, : max(int(self._steps[index]), 0)].copy()
+        if cost < 0:
+            self.local_plan = np.zeros((0, 3))
+        return (vx, vy, vth), cost

@@ -1,0 +1,93 @@
+"""Grid ray casting kernels: costmap_2d's Bresenham raytraceLine, batched over rays.
+
+All kernels work on a (size_y, size_x) uint8 grid indexed ``[my, mx]`` in place.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+
+@njit(cache=True)
+def _trace(grid, x, y, abs_da, abs_db, error_b, ax, ay, bx, by, max_length, value):
+    end = min(max_length, abs_da)
+    for _ in range(end):
+        grid[y, x] = value
+        x += ax
+        y += ay
+        error_b += abs_db
+        if error_b >= abs_da:
+            x += bx
+            y += by
+            error_b -= abs_da
+    grid[y, x] = value
+
+
+@njit(cache=True)
+def trace_rays(grid, x0, y0, ends, max_length, value):
+    """Set every cell on the Bresenham line from (x0, y0) to each end cell to ``value``.
+
+    As costmap_2d's raytraceLine: the line is cut after ``max_length`` cells along its major
+    axis (scaled by the true length), and its last cell is included.
+
+    Parameters
+    ----------
+    grid : (size_y, size_x) uint8, modified in place.
+    x0, y0 : start cell (column, row), inside the grid.
+    ends : (N, 2) int64 end cells (column, row), inside the grid.
+    max_length : ray length limit in cells.
+    value : the cost written.
+    """
+    for i in range(ends.shape[0]):
+        x1 = ends[i, 0]
+        y1 = ends[i, 1]
+        dx = x1 - x0
+        dy = y1 - y0
+        abs_dx = abs(dx)
+        abs_dy = abs(dy)
+        sx = 1 if dx > 0 else (-1 if dx < 0 else 0)
+        sy = 1 if dy > 0 else (-1 if dy < 0 else 0)
+        dist = math.hypot(dx, dy)
+        scale = 1.0 if dist == 0.0 else min(1.0, max_length / dist)
+        if abs_dx >= abs_dy:
+            _trace(
+                grid, x0, y0, abs_dx, abs_dy, abs_dx // 2, sx, 0, 0, sy, int(scale * abs_dx), value
+            )
+        else:
+            _trace(
+                grid, x0, y0, abs_dy, abs_dx, abs_dy // 2, 0, sy, sx, 0, int(scale * abs_dy), value
+            )
+
+
+def ray_ends_clipped(
+    origin: np.ndarray, points: np.ndarray, map_min: np.ndarray, map_max: np.ndarray
+) -> np.ndarray:
+    """Ray end points pulled back along each ray to lie inside the map box.
+
+    As ObstacleLayer::raytraceFreespace: ends below the minimum are moved onto it, ends past
+    the maximum onto it less 1 mm.
+
+    origin : (2,) sensor position, m. points : (N, 2) ray ends, m. map_min, map_max : (2,)
+    corners of the grid, m. Returns (N, 2) m.
+    """
+    o = np.asarray(origin, dtype=np.float64)[:2]
+    w = np.array(points, dtype=np.float64)[:, :2].copy()
+    with np.errstate(divide="ignore", invalid="ignore"):
+        for axis in (0, 1):
+            other = 1 - axis
+            d = w - o
+            low = w[:, axis] < map_min[axis]
+            t = (map_min[axis] - o[axis]) / d[low, axis]
+            w[low, other] = o[other] + d[low, other] * t
+            w[low, axis] = map_min[axis]
+        for axis in (0, 1):
+            other = 1 - axis
+            d = w - o
+            high = w[:, axis] > map_max[axis]
+            t = (map_max[axis] - o[axis]) / d[high, axis]
+            w[high, other] = o[other] + d[high, other] * t
+            w[high, axis] = map_max[axis] - 0.001
+    return w

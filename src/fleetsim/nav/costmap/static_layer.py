@@ -1,0 +1,170 @@
+"""The static map layer (costmap_2d::StaticLayer): costs from an occupancy grid."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from fleetsim.nav.costmap.costmap_2d import (
+    FREE_SPACE,
+    LETHAL_OBSTACLE,
+    NO_INFORMATION,
+    Costmap2D,
+)
+from fleetsim.nav.costmap.layer import Bounds, CostmapLayer, combined_max
+from fleetsim.nav.map_io import OccupancyMap
+from fleetsim.runtime import param
+
+
+@dataclass(frozen=True)
+class StaticLayerParams:
+    """Parameters of ``costmap_2d::StaticLayer`` (in the costmap's ``<layer name>/`` ns)."""
+
+    enabled: bool = param(True, help="whether the layer contributes to the costmap")
+    map_topic: str = param("map", help="topic the map is read from")
+    unknown_cost_value: int = param(
+        -1, range=(-128, 255), help="map value read as unknown (compared as an unsigned byte)"
+    )
+    lethal_cost_threshold: int = param(
+        100, range=(0, 255), help="map values at or above this are lethal"
+    )
+    track_unknown_space: bool = param(
+        True, help="unknown map cells stay NO_INFORMATION (else they become free)"
+    )
+    first_map_only: bool = param(False, help="ignore every map after the first")
+    subscribe_to_updates: bool = param(False, help="also apply map_updates patches")
+    trinary_costmap: bool = param(
+        True, help="map values below the lethal threshold become free (else scaled)"
+    )
+    use_maximum: bool = param(
+        False, help="combine with the master by maximum (else overwrite the master)"
+    )
+
+
+def costs_from_occupancy(
+    data: np.ndarray,
+    *,
+    lethal_cost_threshold: int = 100,
+    unknown_cost_value: int = -1,
+    track_unknown_space: bool = True,
+    trinary_costmap: bool = True,
+) -> np.ndarray:
+    """Costmap costs of occupancy values, as StaticLayer::interpretValue.
+
+    data : (H, W) int8 occupancy (-1 unknown, 0..100). Values are compared as unsigned
+    bytes, so -1 is 255. Returns (H, W) uint8 costs.
+    """
+    v = np.asarray(data).astype(np.int16) & 0xFF
+    unknown = v == (unknown_cost_value & 0xFF)
+    if trinary_costmap:
+        out = np.full(v.shape, FREE_SPACE, dtype=np.uint8)
+    else:
+        scaled = v.astype(np.float64) / max(lethal_cost_threshold, 1) * LETHAL_OBSTACLE
+        out = np.clip(scaled, 0, 255).astype(np.uint8)
+    out[v >= lethal_cost_threshold] = LETHAL_OBSTACLE
+    out[unknown] = NO_INFORMATION if track_unknown_space else FREE_SPACE
+    return out
+
+
+class StaticLayer(CostmapLayer):
+    """Holds the latest map (as costs); static maps size the master unless it rolls."""
+
+    Params = StaticLayerParams
+
+    def __init__(self, name: str = "static_layer", params: StaticLayerParams | None = None):
+        super().__init__(name)
+        self.params = params or StaticLayerParams()
+        self.enabled = self.params.enabled
+        self.map_grid: Costmap2D | None = None  # the map's own grid (its resolution, origin)
+        self._has_updated_data = False
+
+    def set_map(self, occupancy: OccupancyMap) -> bool:
+        """Take a new map (the ``map`` topic callback). Returns False if it was ignored."""
+        if self.map_grid is not None and self.params.first_map_only:
+            return False
+        p = self.params
+        grid = Costmap2D(
+            occupancy.width,
+            occupancy.height,
+            occupancy.resolution,
+            occupancy.origin[0],
+            occupancy.origin[1],
+            NO_INFORMATION,
+        )
+        grid.costs = costs_from_occupancy(
+            occupancy.data,
+            lethal_cost_threshold=p.lethal_cost_threshold,
+            unknown_cost_value=p.unknown_cost_value,
+            track_unknown_space=p.track_unknown_space,
+            trinary_costmap=p.trinary_costmap,
+        )
+        self.map_grid = grid
+        assert self.layered is not None
+        lc = self.layered
+        if not lc.rolling_window:
+            m = lc.costmap
+            if (m.size_x, m.size_y, m.resolution, m.origin) != (
+                grid.size_x,
+                grid.size_y,
+                grid.resolution,
+                grid.origin,
+            ):
+                lc.resize_map(
+                    grid.size_x, grid.size_y, grid.resolution, grid.origin_x, grid.origin_y
+                )
+            self.grid.costs = grid.costs.copy()
+        self._has_updated_data = True
+        return True
+
+    def match_size(self) -> None:
+        super().match_size()
+        g = self.map_grid
+        rolling = self.layered is not None and self.layered.rolling_window
+        if g is not None and not rolling and self.grid.costs.shape == g.costs.shape:
+            self.grid.costs = g.costs.copy()
+
+    def reset(self) -> None:
+        # The static map is not sensor data: a reset re-applies it.
+        self._has_updated_data = True
+
+    def update_bounds(self, robot_x: float, robot_y: float, robot_yaw: float, bounds: Bounds):
+        g = self.map_grid
+        if g is None:
+            return
+        if not self.layered.rolling_window and not self._has_updated_data:  # type: ignore[union-attr]
+            return
+        bounds.include(
+            g.origin_x,
+            g.origin_y,
+            g.origin_x + g.size_x * g.resolution,
+            g.origin_y + g.size_y * g.resolution,
+        )
+        self._has_updated_data = False
+
+    def update_costs(self, master: Costmap2D, x0: int, y0: int, xn: int, yn: int) -> None:
+        if not self.enabled or self.map_grid is None or xn <= x0 or yn <= y0:
+            return
+        if not self.layered.rolling_window:  # type: ignore[union-attr]
+            if self.params.use_maximum:
+                self.update_with_max(master, x0, y0, xn, yn)
+            else:
+                self.update_with_true_overwrite(master, x0, y0, xn, yn)
+            return
+        # Rolling window: look each master cell's centre up in the map.
+        mx, my = np.meshgrid(np.arange(x0, xn), np.arange(y0, yn))
+        centres = np.stack(
+            (
+                master.origin_x + (mx + 0.5) * master.resolution,
+                master.origin_y + (my + 0.5) * master.resolution,
+            ),
+            axis=-1,
+        )
+        cells, inside = self.map_grid.cells_of(centres)
+        window = master.costs[y0:yn, x0:xn]
+        values = np.full(window.shape, NO_INFORMATION, dtype=np.uint8)
+        values[inside] = self.map_grid.costs[cells[inside][:, 1], cells[inside][:, 0]]
+        if self.params.use_maximum:
+            master.costs[y0:yn, x0:xn] = combined_max(window, values)
+        else:
+            master.costs[y0:yn, x0:xn] = np.where(inside, values, window)

@@ -1,0 +1,194 @@
+"""NavFn (navfn/NavfnROS): potential-field global planner on the global costmap.
+
+As NavfnROS::makePlan: the potential is propagated from the robot's cell (potential 0) until
+it reaches the goal cell; with ``default_tolerance`` the reachable point nearest the goal
+within a square of that half-size is used instead; the path is extracted by gradient descent
+from the goal down to the robot and returned robot-first, ending with the goal pose.
+Path points are cell centres (navfn places them at cell corners, half a cell off).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from fleetsim.nav.costmap.costmap_2d import (
+    INSCRIBED_INFLATED_OBSTACLE,
+    LETHAL_OBSTACLE,
+    NO_INFORMATION,
+    Costmap2D,
+)
+from fleetsim.nav.errors import pose_text
+from fleetsim.nav.planners.base import (
+    GlobalPlanner,
+    GoalOccupied,
+    GoalOutsideMap,
+    NoPathFound,
+    Path,
+    PlannerTimeout,
+    StartOccupied,
+    StartOutsideMap,
+)
+from fleetsim.nav.planners.navfn_kernels import POT_HIGH, navfn_costs, navfn_path, navfn_potential
+from fleetsim.runtime import param
+
+
+@dataclass(frozen=True)
+class NavfnParams:
+    """Parameters of ``navfn/NavfnROS`` (in move_base's ``NavfnROS/`` namespace)."""
+
+    allow_unknown: bool = param(True, help="plan through unknown cells (at high cost)")
+    default_tolerance: float = param(
+        0.0, unit="m", range=(0.0, None), help="accept the reachable point nearest the goal"
+    )
+    visualize_potential: bool = param(False, help="publish the potential field")
+    planner_window_x: float = param(
+        0.0, unit="m", range=(0.0, None), help="plan only in a window this wide (0: whole map)"
+    )
+    planner_window_y: float = param(
+        0.0, unit="m", range=(0.0, None), help="plan only in a window this tall (0: whole map)"
+    )
+
+
+def _wrap(a: float) -> float:
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+class NavFn(GlobalPlanner):
+    """navfn's planner. After each plan, ``potential`` holds the (ny, nx) field (float32)."""
+
+    Params = NavfnParams
+
+    def __init__(
+        self, costmap: Costmap2D, params: NavfnParams | None = None, frame_id: str = "map"
+    ) -> None:
+        super().__init__(costmap, frame_id)
+        self.params = params or NavfnParams()
+        self.potential: np.ndarray | None = None
+        self.window: tuple[int, int, int, int] = (0, 0, costmap.size_x, costmap.size_y)
+
+    def _window(self, sx: int, sy: int) -> tuple[int, int, int, int]:
+        m, p = self.costmap, self.params
+        x0, y0, xn, yn = 0, 0, m.size_x, m.size_y
+        if p.planner_window_x > 0:
+            half = m.cell_distance(p.planner_window_x / 2)
+            x0, xn = max(0, sx - half), min(m.size_x, sx + half + 1)
+        if p.planner_window_y > 0:
+            half = m.cell_distance(p.planner_window_y / 2)
+            y0, yn = max(0, sy - half), min(m.size_y, sy + half + 1)
+        return x0, y0, xn, yn
+
+    def create_plan(self, start: tuple[float, ...], goal: tuple[float, ...]) -> Path:
+        m, p = self.costmap, self.params
+        sx_w, sy_w = float(start[0]), float(start[1])
+        gx_w, gy_w = float(goal[0]), float(goal[1])
+        goal_yaw = float(goal[2]) if len(goal) > 2 else 0.0
+        s_cell = m.world_to_map(sx_w, sy_w)
+        if s_cell is None:
+            raise StartOutsideMap(
+                f"navfn: the robot's start {pose_text(sx_w, sy_w)} is off the global costmap "
+                f"({self._extent()}); is the robot localized?"
+            )
+        if m.costs[s_cell[1], s_cell[0]] == LETHAL_OBSTACLE:
+            raise StartOccupied(
+                f"navfn: the robot's start {pose_text(sx_w, sy_w)} is inside an obstacle "
+                "(lethal cell); clear the costmaps or move the robot"
+            )
+        if m.world_to_map(gx_w, gy_w) is None:
+            raise GoalOutsideMap(
+                f"navfn: the goal {pose_text(gx_w, gy_w)} is off the global costmap "
+                f"({self._extent()})"
+            )
+        x0, y0, xn, yn = self.window = self._window(*s_cell)
+        nx = xn - x0
+        costarr = navfn_costs(m.costs[y0:yn, x0:xn], p.allow_unknown)
+        start_idx = (s_cell[1] - y0) * nx + (s_cell[0] - x0)
+        if 0 < s_cell[0] - x0 < nx - 1 and 0 < s_cell[1] - y0 < yn - y0 - 1:
+            costarr[start_idx] = navfn_costs(np.zeros((3, 3), np.uint8), True)[4]  # clearRobotCell
+
+        # the reachable point nearest the goal within the tolerance square (cells, not metres)
+        res = m.resolution
+        tol = p.default_tolerance
+        n_tol = math.floor(tol / res + 1e-9)
+        offsets = np.arange(-n_tol, n_tol + 1) * res
+        cand = np.stack(np.meshgrid(gx_w + offsets, gy_w + offsets), axis=-1).reshape(-1, 2)
+        cells, inside = m.cells_of(cand)
+        inside &= (
+            (cells[:, 0] >= x0) & (cells[:, 0] < xn) & (cells[:, 1] >= y0) & (cells[:, 1] < yn)
+        )
+        if not inside.any():
+            raise GoalOutsideMap(
+                f"navfn: the goal {pose_text(gx_w, gy_w)} is outside the planner window "
+                f"(planner_window_x/y {p.planner_window_x:g} x {p.planner_window_y:g} m)"
+            )
+        cand, cells = cand[inside], cells[inside]
+        order = np.argsort(((cand - [gx_w, gy_w]) ** 2).sum(axis=1), kind="stable")
+        cand, cells = cand[order], cells[order]
+
+        goal_cell = cells[0]
+        goal_idx = (goal_cell[1] - y0) * nx + (goal_cell[0] - x0)
+        cycles = max(costarr.size // 20, nx + (yn - y0))
+        pot, finished = navfn_potential(costarr, nx, start_idx, goal_idx, True, cycles)
+        self.potential = pot.reshape(yn - y0, nx)
+        reached = pot[(cells[:, 1] - y0) * nx + (cells[:, 0] - x0)] < POT_HIGH
+        if not reached.any():
+            if not finished:
+                raise PlannerTimeout(
+                    f"navfn: the potential did not reach the goal {pose_text(gx_w, gy_w)} "
+                    f"within {cycles} propagation cycles"
+                )
+            self._raise_unreachable(cells, gx_w, gy_w, sx_w, sy_w)
+        best = int(np.argmax(reached))
+        bx, by = int(cells[best, 0]) - x0, int(cells[best, 1]) - y0
+        steps = 4 * (nx + (yn - y0))  # NavfnROS uses 4 * size_x, too short for tall maps
+        cells_path = navfn_path(pot, nx, bx, by, s_cell[0] - x0, s_cell[1] - y0, steps, 0.5)
+        if cells_path.shape[0] == 0:
+            raise NoPathFound(
+                f"navfn: no path from {pose_text(sx_w, sy_w)} to {pose_text(gx_w, gy_w)}: the "
+                "gradient descent on the potential failed"
+            )
+        xy = np.empty((cells_path.shape[0] + 1, 2))
+        xy[:-1, 0] = m.origin_x + (cells_path[::-1, 0] + x0 + 0.5) * res
+        xy[:-1, 1] = m.origin_y + (cells_path[::-1, 1] + y0 + 0.5) * res
+        xy[0] = (sx_w, sy_w)
+        xy[-1] = cand[best]
+        if best == 0:
+            xy[-1] = (gx_w, gy_w)
+        poses = np.empty((xy.shape[0], 3))
+        poses[:, :2] = xy
+        d = np.diff(xy, axis=0)
+        poses[:-1, 2] = np.arctan2(d[:, 1], d[:, 0])
+        poses[-1, 2] = _wrap(goal_yaw)
+        return Path(poses, self.frame_id)
+
+    def _raise_unreachable(self, cells: np.ndarray, gx: float, gy: float, sx: float, sy: float):
+        costs = self.costmap.costs[cells[:, 1], cells[:, 0]]
+        blocked = costs >= INSCRIBED_INFLATED_OBSTACLE
+        if not self.params.allow_unknown:
+            blocked |= costs == NO_INFORMATION
+        else:
+            blocked &= costs != NO_INFORMATION
+        tol = self.params.default_tolerance
+        within = f" or within default_tolerance {tol:g} m" if tol > 0 else ""
+        if blocked.all():
+            what = (
+                "unknown space (allow_unknown is false)"
+                if (costs == NO_INFORMATION).all()
+                else "an obstacle (lethal or inscribed cost)"
+            )
+            raise GoalOccupied(
+                f"navfn: the goal {pose_text(gx, gy)} is in {what}, and no free cell{within}"
+            )
+        raise NoPathFound(
+            f"navfn: no path from {pose_text(sx, sy)} to the goal {pose_text(gx, gy)}{within}: "
+            "the goal is not connected to the robot through free space"
+        )
+
+    def _extent(self) -> str:
+        m = self.costmap
+        return (
+            f"x {m.origin_x:g}..{m.origin_x + m.size_x * m.resolution:g}, "
+            f"y {m.origin_y:g}..{m.origin_y + m.size_y * m.resolution:g} m"
+        )

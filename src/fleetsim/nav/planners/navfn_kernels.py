@@ -1,0 +1,283 @@
+"""NavFn's compiled kernels: cost translation, potential propagation, gradient descent.
+
+These follow navfn's NavFn class. Arrays are flat, row-major over an (ny, nx) grid
+(index ``y * nx + x``), as navfn stores them.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+COST_UNKNOWN_ROS = 255  # costmap NO_INFORMATION
+COST_OBS_ROS = 253  # costmap INSCRIBED_INFLATED_OBSTACLE and above are obstacles
+COST_OBS = 254  # navfn's obstacle cost
+COST_NEUTRAL = 50  # cost of a free cell
+COST_FACTOR = 0.8  # weight of costmap costs
+POT_HIGH = np.float32(1.0e10)  # unassigned potential
+PRIORITY_INCREMENT = 2 * COST_NEUTRAL  # navfn's priInc
+INV_SQRT2 = np.float32(0.707106781)
+
+
+@njit(cache=True)
+def navfn_costs(costs, allow_unknown):
+    """navfn's cost array from a costmap (NavFn::setCostmap with isROS, then its border).
+
+    costs : (ny, nx) uint8 costmap. Free cells become ``COST_NEUTRAL + COST_FACTOR * cost``
+    (at most 253); cells at or above INSCRIBED become COST_OBS, unknown cells COST_OBS - 1
+    when ``allow_unknown`` else COST_OBS; the outermost ring is COST_OBS.
+    Returns (ny * nx,) uint8.
+    """
+    ny, nx = costs.shape
+    out = np.empty(ny * nx, dtype=np.uint8)
+    for y in range(ny):
+        for x in range(nx):
+            c = costs[y, x]
+            v = COST_OBS
+            if y == 0 or x == 0 or y == ny - 1 or x == nx - 1:
+                v = COST_OBS
+            elif c < COST_OBS_ROS:
+                v = min(int(COST_NEUTRAL + COST_FACTOR * c), COST_OBS - 1)
+            elif c == COST_UNKNOWN_ROS and allow_unknown:
+                v = COST_OBS - 1
+            out[y * nx + x] = v
+    return out
+
+
+@njit(cache=True, inline="always")
+def _push(buf, n_buf, pending, costarr, n):
+    if 0 <= n < costarr.shape[0] and not pending[n] and costarr[n] < COST_OBS:
+        buf[n_buf] = n
+        pending[n] = True
+        return n_buf + 1
+    return n_buf
+
+
+@njit(cache=True)
+def navfn_potential(costarr, nx, goal, start, at_start, cycles):
+    """Potential from ``goal`` by navfn's Dijkstra-like wavefront (propNavFnDijkstra).
+
+    Each cell's potential comes from its 4-neighbours by navfn's quadratic approximation of the
+    Eikonal update (updateCell); cells are processed in bands of ``PRIORITY_INCREMENT``.
+
+    Parameters
+    ----------
+    costarr : (ns,) uint8 from `navfn_costs`.
+    nx : grid width in cells.
+    goal : flat index where the potential is 0 (navfn's goal: the robot for NavfnROS).
+    start : flat index whose potential ends the search when ``at_start``.
+    cycles : maximum number of band-processing cycles.
+
+    Returns
+    -------
+    potential : (ns,) float32, POT_HIGH where unreached.
+    finished : False when the cycle budget ran out.
+    """
+    ns = costarr.shape[0]
+    pot = np.full(ns, POT_HIGH, dtype=np.float32)
+    pending = np.zeros(ns, dtype=np.bool_)
+    cur = np.empty(ns, dtype=np.int32)
+    nxt = np.empty(ns, dtype=np.int32)
+    over = np.empty(ns, dtype=np.int32)
+    n_cur = 0
+    n_next = 0
+    n_over = 0
+    cur_t = np.float32(COST_OBS)
+    pot[goal] = 0.0
+    for n in (goal + 1, goal - 1, goal - nx, goal + nx):
+        n_cur = _push(cur, n_cur, pending, costarr, n)
+    cycle = 0
+    while cycle < cycles:
+        if n_cur == 0 and n_next == 0:
+            break
+        for i in range(n_cur):
+            pending[cur[i]] = False
+        for i in range(n_cur):
+            n = cur[i]
+            if costarr[n] >= COST_OBS:
+                continue
+            left = pot[n - 1]
+            right = pot[n + 1]
+            up = pot[n - nx]
+            down = pot[n + nx]
+            tc = left if left < right else right
+            ta = up if up < down else down
+            hf = np.float32(costarr[n])
+            dc = tc - ta
+            if dc < 0:
+                dc = -dc
+                ta = tc
+            if dc >= hf:
+                p = ta + hf
+            else:
+                d = dc / hf
+                v = np.float32(-0.2301) * d * d + np.float32(0.5307) * d + np.float32(0.7040)
+                p = ta + hf * v
+            p = np.float32(p)
+            if p < pot[n]:
+                le = INV_SQRT2 * np.float32(costarr[n - 1])
+                re = INV_SQRT2 * np.float32(costarr[n + 1])
+                ue = INV_SQRT2 * np.float32(costarr[n - nx])
+                de = INV_SQRT2 * np.float32(costarr[n + nx])
+                pot[n] = p
+                if p < cur_t:
+                    if left > p + le:
+                        n_next = _push(nxt, n_next, pending, costarr, n - 1)
+                    if right > p + re:
+                        n_next = _push(nxt, n_next, pending, costarr, n + 1)
+                    if up > p + ue:
+                        n_next = _push(nxt, n_next, pending, costarr, n - nx)
+                    if down > p + de:
+                        n_next = _push(nxt, n_next, pending, costarr, n + nx)
+                else:
+                    if left > p + le:
+                        n_over = _push(over, n_over, pending, costarr, n - 1)
+                    if right > p + re:
+                        n_over = _push(over, n_over, pending, costarr, n + 1)
+                    if up > p + ue:
+                        n_over = _push(over, n_over, pending, costarr, n - nx)
+                    if down > p + de:
+                        n_over = _push(over, n_over, pending, costarr, n + nx)
+        # swap current and next bands
+        cur, nxt = nxt, cur
+        n_cur = n_next
+        n_next = 0
+        if n_cur == 0:
+            cur_t += PRIORITY_INCREMENT
+            cur, over = over, cur
+            n_cur = n_over
+            n_over = 0
+        cycle += 1
+        if at_start and pot[start] < POT_HIGH:
+            break
+    return pot, cycle < cycles
+
+
+@njit(cache=True)
+def _grad_cell(pot, gradx, grady, nx, ns, n):
+    if gradx[n] + grady[n] > 0.0:
+        return
+    if n < nx or n > ns - nx:
+        return
+    cv = pot[n]
+    dx = 0.0
+    dy = 0.0
+    if cv >= POT_HIGH:
+        if pot[n - 1] < POT_HIGH:
+            dx = -COST_OBS
+        elif pot[n + 1] < POT_HIGH:
+            dx = COST_OBS
+        if pot[n - nx] < POT_HIGH:
+            dy = -COST_OBS
+        elif pot[n + nx] < POT_HIGH:
+            dy = COST_OBS
+    else:
+        if pot[n - 1] < POT_HIGH:
+            dx += pot[n - 1] - cv
+        if pot[n + 1] < POT_HIGH:
+            dx += cv - pot[n + 1]
+        if pot[n - nx] < POT_HIGH:
+            dy += pot[n - nx] - cv
+        if pot[n + nx] < POT_HIGH:
+            dy += cv - pot[n + nx]
+    norm = math.hypot(dx, dy)
+    if norm > 0:
+        gradx[n] = dx / norm
+        grady[n] = dy / norm
+
+
+@njit(cache=True)
+def navfn_path(pot, nx, start_x, start_y, goal_x, goal_y, max_steps, step):
+    """Descend the potential from (start_x, start_y) to the zero-potential goal (calcPath).
+
+    Follows the bilinearly interpolated normalised gradient in steps of ``step`` cells; near
+    unreached cells or on oscillation it moves to the lowest 8-neighbour instead.
+
+    Returns
+    -------
+    (N, 2) float64 path in cell coordinates (x, y), start first, ending at the goal cell;
+    (0, 2) when the descent fails (no gradient, unreached potential, too many steps).
+    """
+    ns = pot.shape[0]
+    gradx = np.zeros(ns, dtype=np.float32)
+    grady = np.zeros(ns, dtype=np.float32)
+    path = np.empty((max_steps + 1, 2))
+    npath = 0
+    stc = start_y * nx + start_x
+    dx = 0.0
+    dy = 0.0
+    for _ in range(max_steps):
+        near = stc + round(dx) + nx * round(dy)
+        near = max(0, min(ns - 1, near))
+        if pot[near] < 50:  # COST_NEUTRAL: reached the goal's cell
+            path[npath, 0] = goal_x
+            path[npath, 1] = goal_y
+            return path[: npath + 1].copy()
+        if stc < nx or stc > ns - nx:
+            return path[:0].copy()
+        path[npath, 0] = stc % nx + dx
+        path[npath, 1] = stc // nx + dy
+        npath += 1  # noqa: SIM113
+        oscillation = (
+            npath > 2
+            and path[npath - 1, 0] == path[npath - 3, 0]
+            and path[npath - 1, 1] == path[npath - 3, 1]
+        )
+        stcnx = stc + nx
+        stcpx = stc - nx
+        if (
+            pot[stc] >= POT_HIGH
+            or pot[stc + 1] >= POT_HIGH
+            or pot[stc - 1] >= POT_HIGH
+            or pot[stcnx] >= POT_HIGH
+            or pot[stcnx + 1] >= POT_HIGH
+            or pot[stcnx - 1] >= POT_HIGH
+            or pot[stcpx] >= POT_HIGH
+            or pot[stcpx + 1] >= POT_HIGH
+            or pot[stcpx - 1] >= POT_HIGH
+            or oscillation
+        ):
+            minc = stc
+            minp = pot[stc]
+            for cand in (
+                stcpx - 1, stcpx, stcpx + 1, stc - 1, stc + 1, stcnx - 1, stcnx, stcnx + 1
+            ):  # fmt: skip
+                if pot[cand] < minp:
+                    minp = pot[cand]
+                    minc = cand
+            stc = minc
+            dx = 0.0
+            dy = 0.0
+            if pot[stc] >= POT_HIGH:
+                return path[:0].copy()
+        else:
+            _grad_cell(pot, gradx, grady, nx, ns, stc)
+            _grad_cell(pot, gradx, grady, nx, ns, stc + 1)
+            _grad_cell(pot, gradx, grady, nx, ns, stcnx)
+            _grad_cell(pot, gradx, grady, nx, ns, stcnx + 1)
+            x1 = (1.0 - dx) * gradx[stc] + dx * gradx[stc + 1]
+            x2 = (1.0 - dx) * gradx[stcnx] + dx * gradx[stcnx + 1]
+            x = (1.0 - dy) * x1 + dy * x2
+            y1 = (1.0 - dx) * grady[stc] + dx * grady[stc + 1]
+            y2 = (1.0 - dx) * grady[stcnx] + dx * grady[stcnx + 1]
+            y = (1.0 - dy) * y1 + dy * y2
+            if x == 0.0 and y == 0.0:
+                return path[:0].copy()
+            ss = step / math.hypot(x, y)
+            dx += x * ss
+            dy += y * ss
+            if dx > 1.0:
+                stc += 1
+                dx -= 1.0
+            if dx < -1.0:
+                stc -= 1
+                dx += 1.0
+            if dy > 1.0:
+                stc += nx
+                dy -= 1.0
+            if dy < -1.0:
+                stc -= nx
+                dy += 1.0
+    return path[:0].copy()

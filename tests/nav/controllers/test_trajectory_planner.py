@@ -1,0 +1,115 @@
+"""TrajectoryPlannerROS: parameters, scoring, goal handling, driving a corridor."""
+
+import logging
+import math
+
+import numpy as np
+import pytest
+
+from fleetsim.errors import ParameterError
+from fleetsim.nav.controllers import (
+    EmptyPlan,
+    NoValidTrajectory,
+    TrajectoryPlanner,
+    TrajectoryPlannerParams,
+)
+from fleetsim.nav.controllers.map_grid import distances_from_targets
+from fleetsim.nav.costmap import Costmap2D
+from fleetsim.nav.costmap.footprint import footprint_from_radius
+
+
+def corridor():
+    m = Costmap2D(120, 40, 0.05)
+    m.costs[0:8, :] = 254
+    m.costs[32:, :] = 254
+    return m
+
+
+def make(m, **kw):
+    p = TrajectoryPlannerParams(holonomic_robot=False, **kw)
+    return TrajectoryPlanner(m, footprint_from_radius(0.2), p)
+
+
+def test_old_names_accepted_with_warning(caplog):
+    with caplog.at_level(logging.WARNING):
+        tp = TrajectoryPlanner.from_namespace(
+            corridor(),
+            footprint_from_radius(0.2),
+            {"max_rotational_vel": 1.5, "min_in_place_rotational_vel": 1.0, "max_vel_y": 0.0},
+        )
+    assert tp.params.max_vel_theta == 1.5 and tp.params.min_in_place_vel_theta == 1.0
+    assert "'max_rotational_vel' is deprecated, use 'max_vel_theta'" in caplog.text
+    assert "unknown parameter 'max_vel_y'" in caplog.text
+    with pytest.raises(ParameterError, match="'vx_samples' = 0 is out of range"):
+        TrajectoryPlanner.from_namespace(corridor(), footprint_from_radius(0.2), {"vx_samples": 0})
+
+
+def test_bfs_distances():
+    costs = np.zeros((5, 5), np.uint8)
+    costs[:, 2] = 254
+    costs[4, 2] = 0
+    d = distances_from_targets(costs, np.array([[0, 0]]), np.zeros((5, 5), bool))
+    assert d[0, 1] == 1 and d[4, 2] == 6 and d[0, 3] == 11 and d[0, 2] == 25.0
+
+
+@pytest.mark.parametrize("dwa", [False, True])
+def test_drives_down_a_corridor_to_the_goal(dwa):
+    m = corridor()
+    tp = make(
+        m,
+        max_vel_x=0.5,
+        vx_samples=6,
+        vtheta_samples=20,
+        xy_goal_tolerance=0.1,
+        yaw_goal_tolerance=0.1,
+        dwa=dwa,
+    )
+    xs = np.linspace(0.5, 5.0, 50)
+    tp.set_plan(np.stack([xs, np.full(50, 1.0), np.full(50, math.pi / 2)], axis=1))
+    x, y, th, v, dt = 0.5, 1.0, 0.0, (0.0, 0.0, 0.0), 0.05
+    top = 0.0
+    for _ in range(1000):
+        cmd = tp.compute_velocity_commands((x, y, th), v)
+        v = cmd
+        top = max(top, cmd.vx)
+        x += cmd.vx * math.cos(th) * dt
+        y += cmd.vx * math.sin(th) * dt
+        th += cmd.vtheta * dt
+        assert 0.4 + 0.2 < y < 1.6 - 0.2 + 0.2  # never touches the walls
+        if tp.is_goal_reached():
+            break
+    assert tp.is_goal_reached()
+    assert math.hypot(x - 5.0, y - 1.0) <= 0.1
+    assert abs((th - math.pi / 2 + math.pi) % (2 * math.pi) - math.pi) <= 0.1
+    assert top == pytest.approx(0.5, abs=1e-9)
+
+
+def test_speed_limit_changes_commands():
+    m = corridor()
+    xs = np.linspace(0.5, 5.5, 60)
+    plan = np.stack([xs, np.full(60, 1.0), np.zeros(60)], axis=1)
+    tops = []
+    for vmax in (0.3, 0.8):
+        tp = make(m, max_vel_x=vmax, acc_lim_x=10.0)
+        tp.set_plan(plan)
+        tops.append(tp.compute_velocity_commands((0.5, 1.0, 0.0), (vmax, 0, 0)).vx)
+    assert tops[0] == pytest.approx(0.3) and tops[1] == pytest.approx(0.8)
+
+
+def test_blocked_and_empty():
+    m = corridor()
+    tp = make(m)
+    with pytest.raises(EmptyPlan, match="no plan"):
+        tp.compute_velocity_commands((1.0, 1.0, 0.0), (0, 0, 0))
+    m.costs[:, :] = 254
+    m.costs[18:22, 18:22] = 0
+    tp.set_plan(np.array([[1.0, 1.0, 0.0], [4.0, 1.0, 0.0]]))
+    cmd = tp.compute_velocity_commands((1.0, 1.0, 0.0), (0, 0, 0))
+    assert cmd.vx == tp.params.escape_vel  # backs up as base_local_planner does
+    assert tp.escaping
+    m.costs[:, :] = 0
+    m.costs[:, 50] = 254  # a wall between the robot and its whole plan: no path at all
+    tp = make(m)
+    tp.set_plan(np.array([[4.0, 1.0, 0.0], [5.0, 1.0, 0.0]]))
+    with pytest.raises(NoValidTrajectory, match="no valid trajectory"):
+        tp.compute_velocity_commands((1.0, 1.0, 0.0), (0, 0, 0))

@@ -1,0 +1,124 @@
+"""Layered costmap construction (plugins form, pre-Hydro form), static and voxel layers."""
+
+import logging
+
+import numpy as np
+import pytest
+
+from fleetsim.errors import ParameterError
+from fleetsim.nav.costmap import (
+    FREE_SPACE,
+    LETHAL_OBSTACLE,
+    NO_INFORMATION,
+    InflationLayer,
+    LayeredCostmap,
+    ObstacleLayer,
+    StaticLayer,
+    VoxelLayer,
+)
+from fleetsim.nav.costmap.static_layer import costs_from_occupancy
+from fleetsim.nav.errors import CostmapError
+from fleetsim.nav.map_io import OccupancyMap
+
+SEED_COMMON = {  # the tutorial's costmap_common_params.yaml + global_costmap_params.yaml
+    "max_obstacle_height": 0.60,
+    "obstacle_range": 3.0,
+    "raytrace_range": 3.0,
+    "robot_radius": 0.15,
+    "map_type": "voxel",
+    "origin_z": 0.0,
+    "z_resolution": 0.2,
+    "z_voxels": 2,
+    "publish_voxel_map": False,
+    "observation_sources": "scan",
+    "scan": {
+        "data_type": "LaserScan",
+        "topic": "scan",
+        "marking": True,
+        "clearing": True,
+        "min_obstacle_height": 0.05,
+        "max_obstacle_height": 0.6,
+    },
+    "global_frame": "map",
+    "robot_base_frame": "base_link",
+    "update_frequency": 1.0,
+    "publish_frequency": 0.5,
+    "static_map": True,
+    "transform_tolerance": 1.0,
+    "inflation_layer": {"inflation_radius": 1.0, "cost_scaling_factor": 20},
+}
+
+
+def test_pre_hydro_form_builds_static_voxel_inflation():
+    lc = LayeredCostmap.from_params(dict(SEED_COMMON), "global_costmap")
+    kinds = [(la.name, type(la)) for la in lc.layers]
+    assert kinds == [
+        ("static_layer", StaticLayer),
+        ("obstacle_layer", VoxelLayer),
+        ("inflation_layer", InflationLayer),
+    ]
+    ob = lc.layer("obstacle_layer")
+    assert ob.params.z_voxels == 2 and ob.params.max_obstacle_height == 0.6
+    assert ob.buffers["scan"].params.obstacle_range == 3.0
+    assert lc.layer("inflation_layer").params.cost_scaling_factor == 20.0
+
+
+def test_plugins_form_and_unknown_type():
+    ns = {
+        "plugins": [{"name": "obs", "type": "costmap_2d::ObstacleLayer"}],
+        "obs": {"observation_sources": "", "combination_method": 0},
+    }
+    lc = LayeredCostmap.from_params(ns, "c")
+    assert [type(la) for la in lc.layers] == [ObstacleLayer]
+    ns["plugins"] = [{"name": "x", "type": "costmap_2d::InflatonLayer"}]
+    with pytest.raises(CostmapError, match="did you mean 'costmap_2d::InflationLayer'"):
+        LayeredCostmap.from_params(ns, "c")
+
+
+def test_bad_parameter_is_named(caplog):
+    with pytest.raises(ParameterError, match="'width' must be float"):
+        LayeredCostmap.from_params({"width": "wide"}, "local_costmap")
+    with caplog.at_level(logging.WARNING):
+        LayeredCostmap.from_params({"rolling_windw": True, "observation_sources": ""}, "lc")
+    assert "did you mean 'rolling_window'" in caplog.text
+
+
+def test_static_layer_values_and_map_resize():
+    data = np.array([[0, 100, -1], [50, 99, 0]], dtype=np.int8)
+    assert costs_from_occupancy(data).tolist() == [[0, 254, 255], [0, 0, 0]]
+    assert costs_from_occupancy(data, track_unknown_space=False)[0, 2] == FREE_SPACE
+    scaled = costs_from_occupancy(data, trinary_costmap=False)
+    assert scaled[1, 0] == int(50 / 100 * 254)
+    lc = LayeredCostmap.from_params({"observation_sources": "", "track_unknown_space": True}, "g")
+    lc.set_map(OccupancyMap(data, 0.5, (1.0, 2.0, 0.0)))
+    lc.update_map(1.2, 2.2, 0.0)
+    assert (lc.costmap.size_x, lc.costmap.size_y, lc.costmap.origin) == (3, 2, (1.0, 2.0))
+    assert lc.costmap.costs[0, 1] == LETHAL_OBSTACLE
+    assert lc.costmap.costs[0, 2] == NO_INFORMATION
+
+
+def test_voxel_flattening_rule():
+    ns = dict(
+        SEED_COMMON,
+        static_map=False,
+        track_unknown_space=True,
+        width=4.0,
+        height=4.0,
+        rolling_window=True,
+        mark_threshold=1,
+    )
+    lc = LayeredCostmap.from_params(ns, "local_costmap")
+    vox = lc.layer("obstacle_layer")
+    # one marked voxel is not enough with mark_threshold 1; two are (z 0.1 and 0.3)
+    lc.add_observation("scan", [0.0, 0.0, 0.3], [[1.0, 0.0, 0.1], [1.0, 1.0, 0.1]])
+    lc.update_map(0.0, 0.0, 0.0)
+    c = vox.grid.world_to_map(1.0, 1.0)
+    assert vox.grid.costs[c[1], c[0]] != LETHAL_OBSTACLE
+    lc.add_observation("scan", [0.0, 0.0, 0.3], [[1.0, 1.0, 0.1], [1.0, 1.0, 0.3]])
+    lc.update_map(0.0, 0.0, 0.0)
+    assert vox.grid.costs[c[1], c[0]] == LETHAL_OBSTACLE
+    # a laser above the column (z 1.0) is clamped into the top voxel and still clears
+    lc.add_observation("scan", [0.0, 0.0, 1.0], [[2.0, 0.0, 0.5]])
+    lc.update_map(0.0, 0.0, 0.0)
+    mid = vox.grid.world_to_map(1.0, 0.0)
+    assert vox.grid.costs[mid[1], mid[0]] == FREE_SPACE

@@ -1,0 +1,97 @@
+"""NavFn against a brute-force Dijkstra reference, tolerance, and typed failures."""
+
+import heapq
+import math
+
+import numpy as np
+import pytest
+
+from fleetsim.nav.costmap import Costmap2D
+from fleetsim.nav.errors import GoalOccupied, GoalOutsideMap, NoPathFound, StartOutsideMap
+from fleetsim.nav.planners import NavFn, NavfnParams
+from fleetsim.nav.planners.navfn_kernels import POT_HIGH, navfn_costs, navfn_potential
+
+
+def dijkstra4(costarr, nx, src):
+    """Reference: 4-connected Dijkstra where entering a cell costs its navfn cost."""
+    dist = np.full(costarr.size, np.inf)
+    dist[src] = 0.0
+    heap = [(0.0, src)]
+    while heap:
+        d, n = heapq.heappop(heap)
+        if d > dist[n]:
+            continue
+        for m in (n - 1, n + 1, n - nx, n + nx):
+            if 0 <= m < costarr.size and costarr[m] < 254 and d + costarr[m] < dist[m]:
+                dist[m] = d + costarr[m]
+                heapq.heappush(heap, (dist[m], m))
+    return dist
+
+
+def random_grid(rng, ny=24, nx=30):
+    costs = rng.integers(0, 200, (ny, nx)).astype(np.uint8)
+    costs[rng.random((ny, nx)) < 0.2] = 254
+    return costs
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_potential_bounded_by_dijkstra(seed):
+    rng = np.random.default_rng(seed)
+    costs = random_grid(rng)
+    nx = costs.shape[1]
+    costarr = navfn_costs(costs, True)
+    free = np.flatnonzero(costarr < 254)
+    src = int(free[0])
+    pot, finished = navfn_potential(costarr, nx, src, 0, False, 10**6)
+    ref = dijkstra4(costarr, nx, src)
+    assert finished
+    reach = np.isfinite(ref)
+    assert np.array_equal(pot < POT_HIGH, reach)  # same reachable set
+    # the Eikonal potential lies between the L1 (4-connected) cost and that cost / sqrt(2)
+    assert (pot[reach] <= ref[reach] * (1 + 1e-3)).all()  # float32 rounding
+    assert (pot[reach] >= ref[reach] / math.sqrt(2) - 1e-3).all()
+
+
+def open_map(n=60, res=0.1):
+    m = Costmap2D(n, n, res)
+    m.costs[:, 30] = 254
+    m.costs[45:50, 30] = 0  # a door
+    return m
+
+
+def test_plan_goes_through_the_door_and_is_near_optimal():
+    m = open_map()
+    nf = NavFn(m)
+    path = nf.create_plan((1.0, 1.0, 0.0), (5.0, 1.0, 1.0))
+    assert path.poses[0, :2].tolist() == [1.0, 1.0]
+    assert path.poses[-1].tolist() == pytest.approx([5.0, 1.0, 1.0])
+    cells, inside = m.cells_of(path.poses[:, :2])
+    assert inside.all() and (m.costs[cells[:, 1], cells[:, 0]] < 254).all()
+    assert (cells[:, 1] >= 45).any()  # through the door
+    straight = math.hypot(3.0 - 1.0, 4.75 - 1.0) + math.hypot(5.0 - 3.0, 4.75 - 1.0)
+    assert straight * 0.95 < path.length < straight * 1.15
+
+
+def test_typed_failures_and_tolerance():
+    m = open_map()
+    nf = NavFn(m)
+    with pytest.raises(StartOutsideMap, match="start \\(-1.000, 1.000\\) is off the global"):
+        nf.create_plan((-1.0, 1.0, 0.0), (5.0, 1.0, 0.0))
+    with pytest.raises(GoalOutsideMap, match="goal \\(9.000, 1.000\\) is off"):
+        nf.create_plan((1.0, 1.0, 0.0), (9.0, 1.0, 0.0))
+    with pytest.raises(GoalOccupied, match="goal \\(3.050, 1.000\\) is in an obstacle"):
+        nf.create_plan((1.0, 1.0, 0.0), (3.05, 1.0, 0.0))
+    tol = NavFn(m, NavfnParams(default_tolerance=0.2))
+    path = tol.create_plan((1.0, 1.0, 0.0), (3.05, 1.0, 0.0))
+    assert math.hypot(*(path.poses[-1, :2] - [3.05, 1.0])) <= 0.2 + 1e-9
+    m.costs[45:50, 30] = 254  # close the door
+    with pytest.raises(NoPathFound, match="not connected"):
+        nf.create_plan((1.0, 1.0, 0.0), (5.0, 1.0, 0.0))
+
+
+def test_unknown_space_respects_allow_unknown():
+    m = Costmap2D(40, 20, 0.1)
+    m.costs[:, 20] = 255
+    assert len(NavFn(m).create_plan((0.5, 1.0, 0), (3.5, 1.0, 0))) > 2
+    with pytest.raises(NoPathFound):
+        NavFn(m, NavfnParams(allow_unknown=False)).create_plan((0.5, 1.0, 0), (3.5, 1.0, 0))

@@ -6,49 +6,20 @@ from amcl_world import exact_ranges, world_map
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fleetsim.localization.amcl.grid_map import LocalizationError
 from fleetsim.localization.amcl.laser import (
-    ScanBeams,
     beam_model_weights,
-    beams_from_scan,
     endpoint_likelihoods,
     endpoint_table_sums,
     laser_likelihoods,
     likelihood_field_prob_log_weights,
     likelihood_field_table,
     ranges_from_map,
-    scan_beam_indices,
 )
 from fleetsim.localization.amcl.params import AmclParams
+from fleetsim.localization.amcl.scan import ScanBeams, beams_from_scan
 
 GRID = world_map()
 TRUE = np.array([5.0, 5.0, 0.3])
-
-
-def test_beam_subsampling_follows_amcl():
-    # likelihood_field / beam: step (n - 1) // (max_beams - 1)
-    assert list(scan_beam_indices(360, 30, "likelihood_field")[:3]) == [0, 12, 24]
-    assert len(scan_beam_indices(360, 30, "beam")) == 30
-    # likelihood_field_prob: step ceil(n / max_beams)
-    assert list(scan_beam_indices(360, 30, "likelihood_field_prob")[:3]) == [0, 12, 24]
-    assert len(scan_beam_indices(100, 30, "likelihood_field_prob")) == 25
-    # fewer readings than beams: every reading
-    assert list(scan_beam_indices(5, 30, "likelihood_field")) == [0, 1, 2, 3, 4]
-
-
-def test_scan_conditioning_nan_inf_and_short_readings():
-    r = np.array([1.0, np.nan, np.inf, 0.01, 12.0, 2.0, -np.inf])
-    lf = beams_from_scan(r, -1.0, 0.1, 0.05, 10.0, 30, "likelihood_field")
-    assert list(lf.ranges) == [1.0, 2.0]  # NaN dropped; inf, short, >max are max range: ignored
-    np.testing.assert_allclose(lf.bearings, [-1.0, -0.5])
-    beam = beams_from_scan(r, -1.0, 0.1, 0.05, 10.0, 30, "beam")
-    assert list(beam.ranges) == [1.0, 10.0, 10.0, 10.0, 2.0, 10.0]  # NaN dropped only
-    tight = beams_from_scan(
-        r, -1.0, 0.1, 0.05, 10.0, 30, "beam", laser_min_range=1.5, laser_max_range=5.0
-    )
-    assert tight.range_max == 5.0 and list(tight.ranges) == [5.0, 5.0, 5.0, 5.0, 2.0, 5.0]
-    with pytest.raises(LocalizationError, match="range_max nan"):
-        beams_from_scan(r, -1.0, 0.1, 0.05, float("nan"), 30, "beam")
 
 
 def brute_force_sums(particles, laser_pose, ranges, bearings, table, off):

@@ -15,17 +15,11 @@ from .estimate import PoseEstimate, covariance_3x3, covariance_6x6, pose_estimat
 from .filter import ParticleFilter, UpdateResult, gaussian_poses
 from .grid_map import AmclMap, LocalizationError, distances_to_obstacles
 from .histogram import cluster_labels, pose_bin_keys
-from .laser import (
-    ScanBeams,
-    beam_model_weights,
-    beams_from_scan,
-    endpoint_likelihoods,
-    laser_likelihoods,
-    ranges_from_map,
-)
+from .laser import beam_model_weights, endpoint_likelihoods, laser_likelihoods, ranges_from_map
 from .motion import particles_after_odometry
 from .params import AmclParams, params_from_mapping
 from .resample import kld_resample, kld_sample_limits, systematic_resample_indices
+from .scan import ScanBeams, beams_from_scan
 
 __all__ = [
     "AmclMap",

@@ -18,10 +18,11 @@ import numpy as np
 
 from .estimate import covariance_3x3, pose_estimate
 from .grid_map import AmclMap, LocalizationError
-from .laser import ScanBeams, laser_likelihoods
+from .laser import laser_likelihoods
 from .motion import odometry_delta, particles_after_odometry, wrapped_angles
 from .params import AmclParams
 from .resample import effective_sample_size, kld_resample
+from .scan import ScanBeams
 
 CONVERGED_DISTANCE = 0.5  # m, amcl's pf->dist_threshold
 

@@ -30,7 +30,10 @@ app = typer.Typer(
 SUBAPPS = [
     ("fleetsim.cli.urdf", "app", "urdf", "Robot descriptions: check, graph, export."),
     ("fleetsim.cli.sim", "app", "sim", "The simulator: world snapshots."),
+    ("fleetsim.cli.bag", "app", "bag", "MCAP recordings: info, play, record."),
 ]
+# modules with a register(app) function that add single commands
+COMMANDS = ["fleetsim.cli.render"]
 
 err_console = Console(stderr=True)
 
@@ -75,6 +78,8 @@ def _add_subapps() -> None:
                 continue
             raise
         app.add_typer(getattr(mod, attr), name=name, help=help_text)
+    for module in COMMANDS:
+        importlib.import_module(module).register(app)
 
 
 _add_subapps()

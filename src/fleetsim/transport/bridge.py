@@ -21,6 +21,7 @@ from __future__ import annotations
 import json
 import logging
 import queue
+import time as _wall
 from collections.abc import Sequence
 from contextlib import contextmanager
 from typing import Any
@@ -190,6 +191,7 @@ class ZenohBridge(TopicBridging, ServiceBridging, ClockFollowing):
         """Handle everything received since the last call; returns how many items."""
         n = 0
         inbox = self._inbox
+        _wall.sleep(0)  # yield the GIL: zenoh's callback threads queue what has arrived
         while not self._closed:
             try:
                 item = inbox.get_nowait()

@@ -4,6 +4,7 @@
 the node that publishes its readings and serves the ``/gazebo/*`` services.
 """
 
-from fleetsim.sim.engine import Contact, Engine, ModelEntry, load_world
+from fleetsim.sim.engine import Engine, ModelEntry, load_world
+from fleetsim.sim.queries import Contact
 
 __all__ = ["Contact", "Engine", "ModelEntry", "load_world"]

@@ -14,12 +14,13 @@ from typing import Any
 import mujoco
 import numpy as np
 
-from fleetsim.errors import SimulationError, did_you_mean
+from fleetsim.errors import SimulationError
 from fleetsim.sim import sdf
-from fleetsim.sim.build import add_sdf_model, quat_from_rpy, spec_from_world
+from fleetsim.sim.build import add_sdf_model, spec_from_world
 from fleetsim.sim.lasers import LaserBatch
 from fleetsim.sim.plugins import base
 from fleetsim.sim.plugins.link_attacher import LinkAttacher
+from fleetsim.sim.queries import StateQueries
 from fleetsim.sim.robot_build import add_robot
 from fleetsim.sim.world import ModelDesc, Pose, WorldDesc, world_from_map
 
@@ -41,18 +42,6 @@ class ModelEntry:
     actuators: list[str] = field(default_factory=list)
 
 
-@dataclass(frozen=True)
-class Contact:
-    """A contact between a robot and something else (not the floor)."""
-
-    model1: str
-    link1: str
-    model2: str
-    link2: str
-    position: tuple[float, float, float]
-    depth: float  # penetration, m (positive when overlapping)
-
-
 def load_world(source: str | Path | WorldDesc | None, wall_height: float = 1.0) -> WorldDesc:
     """A ``WorldDesc`` from an SDF ``.world`` file, a map ``.yaml`` file, or None (empty)."""
     if source is None:
@@ -69,7 +58,7 @@ def load_world(source: str | Path | WorldDesc | None, wall_height: float = 1.0) 
     return sdf.load_sdf_world(path)
 
 
-class Engine:
+class Engine(StateQueries):
     """MuJoCo world plus models, plugins and sensor scheduling.
 
     Parameters
@@ -82,7 +71,7 @@ class Engine:
     def __init__(
         self,
         world=None,
-        timestep: float = 0.002,
+        timestep: float = 0.004,
         rng: np.random.Generator | None = None,
         wall_height: float = 1.0,
     ) -> None:
@@ -123,6 +112,7 @@ class Engine:
                 p.bind(self)
         self.attacher.bind(self)
         self.lasers.bind(self)
+        self._schedule()
 
     def _index(self) -> None:
         m = self.model
@@ -157,6 +147,28 @@ class Engine:
         Topics go under ``namespace`` (default ``/<name>``) and frames under ``tf_prefix``
         (default: the namespace without its leading slash).
         """
+        return self.spawn_robots([(name, robot, pose, namespace, tf_prefix)])[0]
+
+    def spawn_robots(self, robots: list[tuple]) -> list[ModelEntry]:
+        """Spawn many robots with one recompile: ``[(name, robot, pose[, ns[, tf_prefix]])]``.
+
+        All or nothing: when one fails, none is added.
+        """
+        added: list[tuple[ModelEntry, int]] = []
+        try:
+            for item in robots:
+                added.append(self._add_robot(*item))
+            self._compile()
+        except Exception:
+            for entry, n_act in reversed(added):
+                self.models.pop(entry.name, None)
+                self._remove_from_spec(entry, n_act)
+            if added:
+                self._compile()
+            raise
+        return [entry for entry, _ in added]
+
+    def _add_robot(self, name, robot, pose=(0, 0, 0, 0, 0, 0), namespace=None, tf_prefix=None):
         self._check_new_name(name)
         if isinstance(robot, str | Path):
             from fleetsim.description import load_robot
@@ -164,20 +176,13 @@ class Engine:
             robot = load_robot(robot)
         ns = namespace if namespace is not None else f"/{name}"
         prefix = tf_prefix if tf_prefix is not None else ns.strip("/")
+        pose0 = tuple(float(v) for v in pose)
         entry = ModelEntry(
-            name,
-            "robot",
-            False,
-            [],
-            tuple(float(v) for v in pose),
-            robot=robot,
-            namespace=ns,
-            tf_prefix=prefix,
+            name, "robot", False, [], pose0, robot=robot, namespace=ns, tf_prefix=prefix
         )
         entry.plugins = self._make_plugins(entry)
-        root = add_robot(self.spec, robot, name, entry.pose0)
-        entry.bodies = [root]
         n_act = len(self.spec.actuators)
+        entry.bodies = [add_robot(self.spec, robot, name, pose0)]
         try:
             for p in entry.plugins:
                 p.build(self.spec, self)
@@ -186,14 +191,7 @@ class Engine:
             raise
         entry.actuators = [a.name for a in self.spec.actuators[n_act:]]
         self.models[name] = entry
-        try:
-            self._compile()
-        except SimulationError:
-            del self.models[name]
-            self._remove_from_spec(entry, n_act)
-            self._compile()
-            raise
-        return entry
+        return entry, n_act
 
     def _make_plugins(self, entry: ModelEntry) -> list[base.Plugin]:
         out: list[base.Plugin] = []
@@ -261,193 +259,74 @@ class Engine:
         self._compile()
 
     # -------------------------------------------------------------------- queries
-    def entry(self, name: str) -> ModelEntry:
-        if name not in self.models:
-            raise SimulationError(f"no model named '{name}'{did_you_mean(name, self.models)}")
-        return self.models[name]
-
-    @property
-    def time(self) -> float:
-        return float(self.data.time)
-
-    def joint_id(self, model: str, joint: str) -> int:
-        return mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, f"{model}/{joint}")
-
-    def body_id(self, model: str, link: str) -> int:
-        return mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, f"{model}/{link}")
-
-    def link_id(self, model: str, link: str) -> int:
-        """Body id of ``model``'s link; error naming the model's links when missing."""
-        bid = self.body_id(model, link)
-        if bid < 0:
-            links = [
-                self.model.body(b).name.split("/", 1)[1]
-                for b in range(1, self.model.nbody)
-                if self._model_names[self._body_model[b]] == model
-            ]
-            raise SimulationError(
-                f"model '{model}' has no link '{link}'{did_you_mean(link, links)}"
-            )
-        return bid
-
-    def root_body(self, name: str) -> int:
-        return self.model.body(self.entry(name).bodies[0]).id
-
-    def model_pose(self, name: str) -> tuple[np.ndarray, np.ndarray]:
-        """World position (3,) m and orientation quaternion (w, x, y, z) of the model root."""
-        b = self.root_body(name)
-        return self.data.xpos[b].copy(), self.data.xquat[b].copy()
-
-    def model_twist(self, name: str) -> tuple[np.ndarray, np.ndarray]:
-        """Linear (3,) m/s and angular (3,) rad/s velocity of the model root, world frame."""
-        j = self._free_joint(name)
-        if j < 0:
-            return np.zeros(3), np.zeros(3)
-        qa, va = self.model.jnt_qposadr[j], self.model.jnt_dofadr[j]
-        ang = np.zeros(3)
-        mujoco.mju_rotVecQuat(ang, self.data.qvel[va + 3 : va + 6], self.data.qpos[qa + 3 : qa + 7])
-        return self.data.qvel[va : va + 3].copy(), ang
-
-    def link_pose(self, model: str, link: str) -> tuple[np.ndarray, np.ndarray]:
-        b = self.link_id(model, link)
-        return self.data.xpos[b].copy(), self.data.xquat[b].copy()
-
-    def _free_joint(self, name: str) -> int:
-        b = self.root_body(name)
-        if self.model.body_jntnum[b] == 0:
-            return -1
-        j = int(self.model.body_jntadr[b])
-        return j if self.model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE else -1
-
-    def set_model_state(
-        self, name: str, position=None, orientation=None, linear=None, angular=None
-    ) -> None:
-        """Teleport a movable model: position (3,), quaternion (w, x, y, z), world twist."""
-        j = self._free_joint(name)
-        if j < 0:
-            raise SimulationError(f"model '{name}' is static; its state cannot be set")
-        qa, va = self.model.jnt_qposadr[j], self.model.jnt_dofadr[j]
-        if position is not None:
-            self.data.qpos[qa : qa + 3] = position
-        if orientation is not None:
-            q = np.asarray(orientation, float)
-            self.data.qpos[qa + 3 : qa + 7] = q / np.linalg.norm(q)
-        quat = self.data.qpos[qa + 3 : qa + 7]
-        if linear is not None:
-            self.data.qvel[va : va + 3] = linear
-        if angular is not None:  # free-joint angular velocity is in the body frame
-            w = np.zeros(3)
-            qi = np.zeros(4)
-            mujoco.mju_negQuat(qi, quat)
-            mujoco.mju_rotVecQuat(w, np.asarray(angular, float), qi)
-            self.data.qvel[va + 3 : va + 6] = w
-        mujoco.mj_forward(self.model, self.data)
-
-    def contacts(self) -> list[Contact]:
-        """Current contacts between a robot and anything else except the floor (planes)."""
-        out = []
-        m, d = self.model, self.data
-        names = self._model_names
-        plane = mujoco.mjtGeom.mjGEOM_PLANE
-        for c in d.contact[: d.ncon] if d.ncon else []:
-            g1, g2 = int(c.geom1), int(c.geom2)
-            if m.geom_type[g1] == plane or m.geom_type[g2] == plane:
-                continue
-            i1, i2 = self.geom_model[g1], self.geom_model[g2]
-            if i1 == i2:
-                continue
-            e1 = self.models[names[i1]] if i1 >= 0 else None
-            e2 = self.models[names[i2]] if i2 >= 0 else None
-            if not ((e1 and e1.kind == "robot") or (e2 and e2.kind == "robot")):
-                continue
-            b1, b2 = m.body(int(m.geom_bodyid[g1])).name, m.body(int(m.geom_bodyid[g2])).name
-            out.append(
-                Contact(
-                    names[i1] if i1 >= 0 else "world",
-                    b1.split("/", 1)[-1],
-                    names[i2] if i2 >= 0 else "world",
-                    b2.split("/", 1)[-1],
-                    tuple(float(v) for v in c.pos),
-                    float(-c.dist),
-                )
-            )
-        return out
-
     # -------------------------------------------------------------------- stepping
     def plugins(self) -> list[base.Plugin]:
         return [p for e in self.models.values() for p in e.plugins]
 
+    def _schedule(self) -> None:
+        """Refresh the plugin lists after the set of models changed."""
+        self._plugins = self.plugins()
+        self._controllers = [p for p in self._plugins if type(p).control is not base.Plugin.control]
+        self._min_due = 0.0
+
     def step(self) -> None:
         """One physics step: plugin controls, link attacher, ``mj_step``."""
         t = self.time
-        for e in self.models.values():
-            for p in e.plugins:
-                p.control(self, t)
-        self.attacher.control(self, t)
+        for p in self._controllers:
+            p.control(self, t)
+        if self.attacher.pending:
+            self.attacher.control(self, t)
         mujoco.mj_step(self.model, self.data)
 
     def advance(self, duration: float) -> list[Any]:
-        """Step physics for ``duration`` seconds; returns the readings that fell due."""
+        """Step physics for ``duration`` seconds; returns the readings that fell due.
+
+        While paused, neither time nor sensors advance (as in Gazebo).
+        """
+        if self.paused:
+            return []
         readings: list[Any] = []
         n = round(duration / self.model.opt.timestep)
         for _ in range(n):
-            if not self.paused:
-                self.step()
-            readings += self.due_readings()
+            self.step()
+            if self.time + 1e-9 >= self._min_due:
+                readings += self.due_readings()
         mujoco.mj_kinematics(self.model, self.data)  # poses of the current state for queries
         return readings
 
     def due_readings(self) -> list[Any]:
-        """Readings of every sensor/drive whose update time has come (lasers batched)."""
+        """Readings of every sensor/drive whose update time has come (lasers batched).
+
+        A plugin with rate ``r`` fires at ``t0, t0 + 1/r, ...`` (phase kept, no drift); rate 0
+        fires at every physics step.
+        """
         t = self.time
         out: list[Any] = []
         lasers = []
-        for p in self.plugins():
-            rate = p.update_rate
+        min_due = np.inf
+        for p in self._plugins:
             key = id(p)
             due = self._next_due.get(key, 0.0)
             if t + 1e-9 < due:
+                min_due = min(min_due, due)
                 continue
-            self._next_due[key] = t + (1.0 / rate if rate > 0 else 0.0)
+            rate = p.update_rate
+            period = 1.0 / rate if rate > 0 else 0.0
+            nxt = due + period if due > 0 else t + period
+            if nxt <= t + 1e-9:
+                nxt = t + period
+            self._next_due[key] = nxt
+            min_due = min(min_due, nxt)
             if getattr(p, "is_laser", False):
                 lasers.append(p)
             else:
                 r = p.measure(self, t)
                 if r is not None:
                     out.append(r)
+        self._min_due = min_due
         if lasers:
             out += self.lasers.measure(self, lasers, t)
         return out
-
-    # -------------------------------------------------------------------- resets
-    def reset_world(self) -> None:
-        """Put every model back at its initial pose with zero velocity (time keeps running)."""
-        for name, e in self.models.items():
-            if not e.static and self._free_joint(name) >= 0:
-                self.set_model_state(
-                    name, e.pose0[:3], quat_from_rpy(*e.pose0[3:]), np.zeros(3), np.zeros(3)
-                )
-        self._reset_joints()
-        for p in self.plugins():
-            p.reset()
-        mujoco.mj_forward(self.model, self.data)
-
-    def _reset_joints(self) -> None:
-        m, d = self.model, self.data
-        for j in range(m.njnt):
-            if m.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE:
-                d.qpos[m.jnt_qposadr[j]] = m.qpos0[m.jnt_qposadr[j]]
-                d.qvel[m.jnt_dofadr[j]] = 0.0
-        d.ctrl[:] = 0.0
-
-    def reset_simulation(self) -> None:
-        """reset_world plus sim time back to zero and sensor schedules restarted."""
-        self.reset_world()
-        self.data.time = 0.0
-        self._next_due.clear()
-
-    def world_properties(self) -> dict[str, Any]:
-        return {"sim_time": self.time, "model_names": list(self.models), "rendering_enabled": True}
 
     # -------------------------------------------------------------------- rendering
     def renderer(self, width: int, height: int) -> mujoco.Renderer:

@@ -82,14 +82,13 @@ class WheeledDrive(DrivePlugin):
         self.radius = p.wheelDiameter / 2
         self.cmd = (0.0, 0.0)
         self.last_cmd_t = -math.inf
-        self.speed = np.zeros(2)  # current wheel surface speed targets, m/s (left, right)
         self.reset()
 
     def reset(self) -> None:
         self.cmd = (0.0, 0.0)
-        self.speed = np.zeros(2)
+        self.speed = (0.0, 0.0)  # wheel surface speed targets, m/s (left, right)
         self.pose = np.zeros(3)  # encoder odometry x, y, yaw in the odom frame
-        self.prev_angles: np.ndarray | None = None
+        self.prev_angles: tuple[float, float] | None = None
         self.prev_t: float | None = None
         self.twist = np.zeros(2)
 
@@ -119,6 +118,10 @@ class WheeledDrive(DrivePlugin):
         self.qadr, _ = joint_addresses(engine, self.ctx.model, self.left + self.right)
         self.root = engine.root_body(self.ctx.model)
         self.nl = len(self.left)
+        self.act_left = [int(a) for a in self.act[: self.nl]]
+        self.act_right = [int(a) for a in self.act[self.nl :]]
+        self.q_left = [int(a) for a in self.qadr[: self.nl]]
+        self.q_right = [int(a) for a in self.qadr[self.nl :]]
 
     def command(self, vx: float, wz: float, t: float) -> None:
         if not (math.isfinite(vx) and math.isfinite(wz)):
@@ -134,29 +137,34 @@ class WheeledDrive(DrivePlugin):
         timeout = self.params.commandTimeout
         if timeout > 0 and t - self.last_cmd_t > timeout:
             vx, wz = 0.0, 0.0
-        target = np.array([vx - wz * self.sep / 2, vx + wz * self.sep / 2])
+        left = vx - wz * self.sep / 2
+        right = vx + wz * self.sep / 2
         if self.accel > 0:
             dv = self.accel * engine.model.opt.timestep
-            target = self.speed + np.clip(target - self.speed, -dv, dv)
-        self.speed = target
+            left = self.speed[0] + min(max(left - self.speed[0], -dv), dv)
+            right = self.speed[1] + min(max(right - self.speed[1], -dv), dv)
+        self.speed = (left, right)
         ctrl = engine.data.ctrl
-        ctrl[self.act[: self.nl]] = target[0] / self.radius
-        ctrl[self.act[self.nl :]] = target[1] / self.radius
+        for a in self.act_left:
+            ctrl[a] = left / self.radius
+        for a in self.act_right:
+            ctrl[a] = right / self.radius
 
     @property
     def update_rate(self) -> float:
         return self.params.updateRate
 
     def _encoder_step(self, engine, t: float) -> None:
-        q = engine.data.qpos[self.qadr]
-        left, right = q[: self.nl].mean(), q[self.nl :].mean()
+        q = engine.data.qpos
+        left = sum(q[i] for i in self.q_left) / len(self.q_left)
+        right = sum(q[i] for i in self.q_right) / len(self.q_right)
         if self.prev_angles is None:
-            self.prev_angles = np.array([left, right])
+            self.prev_angles = (left, right)
             self.prev_t = t
             return
         dl = (left - self.prev_angles[0]) * self.radius
         dr = (right - self.prev_angles[1]) * self.radius
-        self.prev_angles = np.array([left, right])
+        self.prev_angles = (left, right)
         ds = (dl + dr) / 2
         dth = (dr - dl) / self.sep
         mid = self.pose[2] + dth / 2

@@ -1,0 +1,93 @@
+"""Real-time factor of the simulator: N diff-drive robots with a 360-beam laser at 10 Hz each,
+driving in the Willow Garage map (physics, drives, odometry, p3d, lasers; no runtime).
+
+Targets (issue 4): 10 robots >= 10x real time, 100 robots >= 1x, on one core.
+Usage: python benchmarks/sim_rtf.py [--robots 1 10 50 100] [--seconds 5]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+from pathlib import Path
+
+os.environ.setdefault("NUMBA_NUM_THREADS", "1")
+
+import numpy as np
+from scipy import ndimage
+
+from fleetsim.description import load_robot
+from fleetsim.sim import Engine
+
+ROOT = Path(__file__).resolve().parent.parent
+WILLOW = Path("/work/shared/data/maps/willow-full.yaml")
+ROBOT = ROOT / "tests" / "sim" / "fixtures" / "diffbot.urdf"
+
+
+def free_poses(engine: Engine, n: int, rng: np.random.Generator, clearance: float = 0.6):
+    """``n`` start poses in free space at least ``clearance`` m from walls and each other."""
+    grid = engine.world.occupancy
+    dist = ndimage.distance_transform_edt(~grid.occupied) * grid.resolution
+    rows, cols = np.nonzero(dist > clearance)
+    poses: list[tuple] = []
+    order = rng.permutation(len(rows))
+    for k in order:
+        x = grid.origin[0] + (cols[k] + 0.5) * grid.resolution
+        y = grid.origin[1] + (rows[k] + 0.5) * grid.resolution
+        if all((x - p[0]) ** 2 + (y - p[1]) ** 2 > 1.0 for p in poses):
+            poses.append((x, y, 0.0, 0.0, 0.0, float(rng.uniform(-np.pi, np.pi))))
+        if len(poses) == n:
+            break
+    return poses
+
+
+def run(n: int, seconds: float, seed: int = 0) -> dict:
+    rng = np.random.default_rng(seed)
+    t0 = time.perf_counter()
+    engine = Engine(WILLOW, rng=np.random.default_rng(seed))
+    robot = load_robot(ROBOT)
+    entries = engine.spawn_robots(
+        [(f"r{i}", robot, pose) for i, pose in enumerate(free_poses(engine, n, rng))]
+    )
+    build = time.perf_counter() - t0
+    engine.advance(0.2)  # warm-up (numba compile, contacts settle)
+    cmds = np.c_[rng.uniform(0.1, 0.5, n), rng.uniform(-0.5, 0.5, n)]
+    t0 = time.perf_counter()
+    scans = 0
+    sim0 = engine.time
+    while engine.time - sim0 < seconds - 1e-9:
+        if round((engine.time - sim0) / 0.1) % 20 == 0:
+            cmds = np.c_[rng.uniform(0.1, 0.5, n), rng.uniform(-0.5, 0.5, n)]
+        for e, (vx, wz) in zip(entries, cmds):
+            e.plugins[0].command(vx, wz, engine.time)
+        readings = engine.advance(0.1)
+        scans += sum(1 for r in readings if type(r).__name__ == "ScanReading")
+    wall = time.perf_counter() - t0
+    return {
+        "robots": n,
+        "build_s": build,
+        "sim_s": seconds,
+        "wall_s": wall,
+        "rtf": seconds / wall,
+        "scans": scans,
+        "contacts": len(engine.contacts()),
+    }
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--robots", type=int, nargs="+", default=[1, 10, 50, 100])
+    ap.add_argument("--seconds", type=float, default=5.0)
+    args = ap.parse_args()
+    print(f"{'robots':>6} {'build s':>8} {'sim s':>6} {'wall s':>7} {'RTF':>7} {'scans':>6}")
+    for n in args.robots:
+        r = run(n, args.seconds)
+        print(
+            f"{r['robots']:>6} {r['build_s']:>8.2f} {r['sim_s']:>6.1f} {r['wall_s']:>7.2f} "
+            f"{r['rtf']:>7.2f} {r['scans']:>6}"
+        )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,175 @@
+"""Queries and teleports on an ``Engine``: poses, twists, contacts, model state, resets.
+
+A mixin of ``Engine`` (the seam between building/stepping the world and reading/setting its
+state); every method works on ``self.model`` / ``self.data`` and the model index.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import mujoco
+import numpy as np
+
+from fleetsim.errors import SimulationError, did_you_mean
+from fleetsim.sim.build import quat_from_rpy
+
+
+@dataclass(frozen=True)
+class Contact:
+    """A contact between a robot and something else (not the floor)."""
+
+    model1: str
+    link1: str
+    model2: str
+    link2: str
+    position: tuple[float, float, float]
+    depth: float  # penetration, m (positive when overlapping)
+
+
+class StateQueries:
+    """Pose, twist, contact and reset methods of ``Engine``."""
+
+    def entry(self, name: str) -> Any:
+        if name not in self.models:
+            raise SimulationError(f"no model named '{name}'{did_you_mean(name, self.models)}")
+        return self.models[name]
+
+    @property
+    def time(self) -> float:
+        return float(self.data.time)
+
+    def joint_id(self, model: str, joint: str) -> int:
+        return mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_JOINT, f"{model}/{joint}")
+
+    def body_id(self, model: str, link: str) -> int:
+        return mujoco.mj_name2id(self.model, mujoco.mjtObj.mjOBJ_BODY, f"{model}/{link}")
+
+    def link_id(self, model: str, link: str) -> int:
+        """Body id of ``model``'s link; error naming the model's links when missing."""
+        bid = self.body_id(model, link)
+        if bid < 0:
+            links = [
+                self.model.body(b).name.split("/", 1)[1]
+                for b in range(1, self.model.nbody)
+                if self._model_names[self._body_model[b]] == model
+            ]
+            raise SimulationError(
+                f"model '{model}' has no link '{link}'{did_you_mean(link, links)}"
+            )
+        return bid
+
+    def root_body(self, name: str) -> int:
+        return self.model.body(self.entry(name).bodies[0]).id
+
+    def model_pose(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """World position (3,) m and orientation quaternion (w, x, y, z) of the model root."""
+        b = self.root_body(name)
+        return self.data.xpos[b].copy(), self.data.xquat[b].copy()
+
+    def model_twist(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """Linear (3,) m/s and angular (3,) rad/s velocity of the model root, world frame."""
+        j = self._free_joint(name)
+        if j < 0:
+            return np.zeros(3), np.zeros(3)
+        qa, va = self.model.jnt_qposadr[j], self.model.jnt_dofadr[j]
+        ang = np.zeros(3)
+        mujoco.mju_rotVecQuat(ang, self.data.qvel[va + 3 : va + 6], self.data.qpos[qa + 3 : qa + 7])
+        return self.data.qvel[va : va + 3].copy(), ang
+
+    def link_pose(self, model: str, link: str) -> tuple[np.ndarray, np.ndarray]:
+        b = self.link_id(model, link)
+        return self.data.xpos[b].copy(), self.data.xquat[b].copy()
+
+    def _free_joint(self, name: str) -> int:
+        b = self.root_body(name)
+        if self.model.body_jntnum[b] == 0:
+            return -1
+        j = int(self.model.body_jntadr[b])
+        return j if self.model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE else -1
+
+    def set_model_state(
+        self, name: str, position=None, orientation=None, linear=None, angular=None
+    ) -> None:
+        """Teleport a movable model: position (3,), quaternion (w, x, y, z), world twist."""
+        j = self._free_joint(name)
+        if j < 0:
+            raise SimulationError(f"model '{name}' is static; its state cannot be set")
+        qa, va = self.model.jnt_qposadr[j], self.model.jnt_dofadr[j]
+        if position is not None:
+            self.data.qpos[qa : qa + 3] = position
+        if orientation is not None:
+            q = np.asarray(orientation, float)
+            self.data.qpos[qa + 3 : qa + 7] = q / np.linalg.norm(q)
+        quat = self.data.qpos[qa + 3 : qa + 7]
+        if linear is not None:
+            self.data.qvel[va : va + 3] = linear
+        if angular is not None:  # free-joint angular velocity is in the body frame
+            w = np.zeros(3)
+            qi = np.zeros(4)
+            mujoco.mju_negQuat(qi, quat)
+            mujoco.mju_rotVecQuat(w, np.asarray(angular, float), qi)
+            self.data.qvel[va + 3 : va + 6] = w
+        mujoco.mj_forward(self.model, self.data)
+
+    def contacts(self) -> list[Contact]:
+        """Current contacts between a robot and anything else except the floor (planes)."""
+        out = []
+        m, d = self.model, self.data
+        names = self._model_names
+        plane = mujoco.mjtGeom.mjGEOM_PLANE
+        for c in d.contact[: d.ncon] if d.ncon else []:
+            g1, g2 = int(c.geom1), int(c.geom2)
+            if m.geom_type[g1] == plane or m.geom_type[g2] == plane:
+                continue
+            i1, i2 = self.geom_model[g1], self.geom_model[g2]
+            if i1 == i2:
+                continue
+            e1 = self.models[names[i1]] if i1 >= 0 else None
+            e2 = self.models[names[i2]] if i2 >= 0 else None
+            if not ((e1 and e1.kind == "robot") or (e2 and e2.kind == "robot")):
+                continue
+            b1, b2 = m.body(int(m.geom_bodyid[g1])).name, m.body(int(m.geom_bodyid[g2])).name
+            out.append(
+                Contact(
+                    names[i1] if i1 >= 0 else "world",
+                    b1.split("/", 1)[-1],
+                    names[i2] if i2 >= 0 else "world",
+                    b2.split("/", 1)[-1],
+                    tuple(float(v) for v in c.pos),
+                    float(-c.dist),
+                )
+            )
+        return out
+
+    # -------------------------------------------------------------------- resets
+    def reset_world(self) -> None:
+        """Put every model back at its initial pose with zero velocity (time keeps running)."""
+        for name, e in self.models.items():
+            if not e.static and self._free_joint(name) >= 0:
+                self.set_model_state(
+                    name, e.pose0[:3], quat_from_rpy(*e.pose0[3:]), np.zeros(3), np.zeros(3)
+                )
+        self._reset_joints()
+        for p in self.plugins():
+            p.reset()
+        mujoco.mj_forward(self.model, self.data)
+
+    def _reset_joints(self) -> None:
+        m, d = self.model, self.data
+        for j in range(m.njnt):
+            if m.jnt_type[j] != mujoco.mjtJoint.mjJNT_FREE:
+                d.qpos[m.jnt_qposadr[j]] = m.qpos0[m.jnt_qposadr[j]]
+                d.qvel[m.jnt_dofadr[j]] = 0.0
+        d.ctrl[:] = 0.0
+
+    def reset_simulation(self) -> None:
+        """reset_world plus sim time back to zero and sensor schedules restarted."""
+        self.reset_world()
+        self.data.time = 0.0
+        self._next_due.clear()
+        self._min_due = 0.0
+
+    def world_properties(self) -> dict[str, Any]:
+        return {"sim_time": self.time, "model_names": list(self.models), "rendering_enabled": True}

@@ -85,6 +85,7 @@ class Amcl(Node):
             geometry_msgs.PoseArray, "particlecloud", queue_size=2, latch=True
         )
         self.tf_pub = TransformBroadcaster(self) if p.tf_broadcast else None
+        _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now, not at the first scan
         self.create_subscription(sensor_msgs.LaserScan, "scan", self.on_scan, queue_size=1)
         self.create_subscription(
             geometry_msgs.PoseWithCovarianceStamped, "initialpose", self.on_initial_pose, 2

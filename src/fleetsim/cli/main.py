@@ -33,7 +33,7 @@ SUBAPPS = [
     ("fleetsim.cli.bag", "app", "bag", "MCAP recordings: info, play, record."),
 ]
 # modules with a register(app) function that add single commands
-COMMANDS = ["fleetsim.cli.render"]
+COMMANDS = ["fleetsim.cli.render", "fleetsim.cli.launch"]
 
 err_console = Console(stderr=True)
 

@@ -1,0 +1,145 @@
+"""`fleetsim launch`: run a launch file (or a shipped scenario by name) headless.
+
+Shows a progress bar (sim time, real-time factor) and, at the end, a results table per robot.
+With ``--until-goals`` the run ends when every robot's goals are done, and the exit status is 0
+only if all were reached without a collision.
+"""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+
+import typer
+from rich.console import Console
+from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
+from rich.table import Table
+
+from fleetsim.errors import LaunchError
+
+SCENARIOS = Path(__file__).resolve().parent.parent / "assets" / "launch"
+console = Console(stderr=True)
+
+
+def scenarios() -> dict[str, Path]:
+    """Shipped scenarios: name -> launch file."""
+    out = {}
+    for p in sorted(SCENARIOS.glob("*.launch")) + sorted(SCENARIOS.glob("*.launch.yaml")):
+        out[p.name.split(".")[0]] = p
+    return out
+
+
+def resolve_launch_file(name: str) -> Path:
+    p = Path(name)
+    if p.is_file():
+        return p
+    known = scenarios()
+    if name in known:
+        return known[name]
+    raise LaunchError(
+        f"'{name}' is neither a launch file nor a shipped scenario; scenarios: "
+        f"{', '.join(known) or 'none'} (fleetsim launch --list)"
+    )
+
+
+def parse_launch_args(items: list[str]) -> dict[str, str]:
+    out = {}
+    for item in items:
+        key, sep, value = item.partition(":=")
+        if not sep or not key:
+            raise LaunchError(f"launch argument '{item}' is not of the form name:=value")
+        out[key] = value
+    return out
+
+
+def results_table(monitor) -> Table:
+    t = Table(title="results")
+    for col in ("robot", "goals reached", "time [s]", "path [m]", "collisions", "last status"):
+        t.add_column(col)
+    for r in monitor.results():
+        t.add_row(
+            r.namespace,
+            f"{r.goals_reached}/{r.goals_sent}",
+            "-" if r.time_of_last_result is None else f"{r.time_of_last_result:.1f}",
+            f"{r.path_length:.1f}",
+            str(r.collisions),
+            r.last_text or "-",
+        )
+    return t
+
+
+def run_launch(
+    file: str,
+    args: dict[str, str],
+    duration: float | None = None,
+    until_goals: bool = False,
+    record: str | None = None,
+    viz: bool = False,
+    realtime: bool = False,
+    seed: int = 0,
+    progress: bool = True,
+):
+    """Run a launch file; returns the finished session's monitor."""
+    from fleetsim.launch.runner import LaunchSession, load_plan
+
+    if duration is None and not until_goals:
+        raise LaunchError("give --duration S, --until-goals, or both")
+    plan = load_plan(resolve_launch_file(file), args, seed=seed)
+    rate = 1.0 if realtime else None
+    with LaunchSession(plan, seed=seed, viz=viz, record=record) as session:
+        rt = session.runtime
+        total = duration if duration is not None else 3600.0
+        until = session.monitor.all_goals_done if until_goals else None
+        wall0 = time.monotonic()
+        with Progress(
+            TextColumn("[bold]{task.description}"),
+            BarColumn(),
+            TextColumn("sim {task.completed:.1f}/{task.total:.0f} s"),
+            TextColumn("{task.fields[rtf]}"),
+            TimeElapsedColumn(),
+            console=console,
+            disable=not progress,
+            transient=False,
+        ) as bar:
+            task = bar.add_task(Path(file).name, total=total, rtf="")
+            step = 1.0
+            while rt.now() < total - 1e-9:
+                end = min(total, rt.now() + step)
+                rt.run(duration=end - rt.now(), until=until, rate=rate)
+                wall = time.monotonic() - wall0
+                bar.update(task, completed=rt.now(), rtf=f"{rt.now() / max(wall, 1e-9):.1f}x RT")
+                if until is not None and until():
+                    break
+        console.print(results_table(session.monitor))
+        if record:
+            console.print(f"recorded to {record}")
+        return session.monitor
+
+
+def register(app: typer.Typer) -> None:
+    @app.command("launch")
+    def launch(
+        file: str = typer.Argument(
+            None, help="A launch file (.launch XML or .yaml) or a scenario."
+        ),
+        args: list[str] = typer.Argument(None, help="Launch arguments name:=value."),
+        duration: float = typer.Option(None, "--duration", help="Sim seconds to run."),
+        until_goals: bool = typer.Option(False, "--until-goals", help="Stop when goals are done."),
+        record: str = typer.Option(None, "--record", help="Record every topic to this MCAP file."),
+        viz: bool = typer.Option(False, "--viz", help="Serve the live view to Foxglove."),
+        realtime: bool = typer.Option(False, "--realtime", help="Pace the run to the wall clock."),
+        seed: int = typer.Option(0, "--seed", help="The run's random seed."),
+        list_: bool = typer.Option(False, "--list", help="List the shipped scenarios."),
+    ) -> None:
+        """Run a launch file headless, then print a results table per robot."""
+        if list_:
+            for name, path in scenarios().items():
+                typer.echo(f"{name}\t{path}")
+            return
+        if not file:
+            raise LaunchError("name a launch file or a scenario (fleetsim launch --list)")
+        monitor = run_launch(
+            file, parse_launch_args(args or []), duration, until_goals, record, viz, realtime, seed
+        )
+        if until_goals and not monitor.success():
+            raise typer.Exit(1)

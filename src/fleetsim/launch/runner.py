@@ -1,0 +1,129 @@
+"""Running a `LaunchPlan`: one runtime, parameters first, then every node in file order.
+
+Viewer nodes (``rviz``, ``gazebo_ros/gzclient``) open the Foxglove live view when the run has
+one (``--viz``) and are otherwise noted and skipped: fleetsim runs headless.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from fleetsim.errors import FleetsimError, LaunchError
+from fleetsim.launch.model import LaunchPlan, NodeSpec
+from fleetsim.launch.monitor import RunMonitor
+from fleetsim.launch.registry import resolve_node
+from fleetsim.runtime import Runtime
+
+_log = logging.getLogger("fleetsim.launch")
+
+#: nodes that show things to people: the live view stands in for all of them
+VIEWERS = {("rviz", "rviz"), ("gazebo_ros", "gzclient"), ("rqt_gui", "rqt_gui")}
+
+
+def load_plan(path: str | Path, args: dict[str, str] | None = None, seed: int = 0) -> LaunchPlan:
+    """Read a launch file of either kind (``.launch``/``.xml`` or ``.yaml``)."""
+    from fleetsim.launch.xml_frontend import load_xml
+    from fleetsim.launch.yaml_frontend import load_yaml
+
+    path = Path(path)
+    if not path.is_file():
+        raise LaunchError(f"launch file {path} does not exist")
+    if path.suffix in (".yaml", ".yml"):
+        return load_yaml(path, args, seed=seed)
+    return load_xml(path, args, seed=seed)
+
+
+@dataclass
+class LaunchSession:
+    """A plan's nodes, alive in one runtime."""
+
+    plan: LaunchPlan
+    seed: int = 0
+    viz: bool = False
+    record: str | Path | None = None
+    runtime: Runtime = field(init=False)
+    nodes: dict[str, Any] = field(default_factory=dict, init=False)
+    skipped: list[str] = field(default_factory=list, init=False)
+    recorder: Any = field(default=None, init=False)
+    live: Any = field(default=None, init=False)
+    monitor: RunMonitor = field(init=False)
+
+    def __post_init__(self) -> None:
+        self.runtime = Runtime(self.seed)
+        try:
+            self._start()
+        except BaseException:
+            self.close()
+            raise
+
+    def _start(self) -> None:
+        rt = self.runtime
+        self.plan.apply_params(rt.params)
+        if self.record is not None:
+            from fleetsim.record import Recorder
+
+            self.recorder = Recorder(rt, self.record)
+        for note in self.plan.notes:
+            _log.info(note)
+        for spec in self.plan.nodes:
+            self._start_node(spec)
+        self.monitor = RunMonitor(rt, self.plan, self.nodes)
+
+    def _start_node(self, spec: NodeSpec) -> None:
+        if (spec.pkg, spec.type) in VIEWERS:
+            if self.viz and self.live is None:
+                from fleetsim.viz import LiveServer
+
+                self.live = LiveServer(self.runtime)
+                _log.info(f"{spec.full_name}: live view at {self.live.url} (open it in Foxglove)")
+            elif not self.viz:
+                self.skipped.append(spec.full_name)
+                _log.info(f"{spec.full_name} ({spec.pkg}/{spec.type}) skipped: run with --viz")
+            return
+        cls = resolve_node(spec.pkg, spec.type, spec.source)
+        try:
+            node = cls(
+                self.runtime,
+                name=spec.name,
+                namespace=spec.namespace,
+                remaps=spec.remaps,
+                args=spec.args,
+            )
+        except FleetsimError as e:
+            raise LaunchError(f"{spec.source}: node {spec.full_name} failed to start: {e}") from e
+        self.nodes[spec.full_name] = node
+
+    def run(self, duration: float | None = None, until_goals: bool = False, rate=None) -> None:
+        """Run for ``duration`` s of sim time, or until every robot's goals are done."""
+        until = self.monitor.all_goals_done if until_goals else None
+        if duration is None and until is None:
+            raise LaunchError("give a duration (--duration S) or --until-goals")
+        self.runtime.run(duration=duration, until=until, rate=rate)
+
+    def close(self) -> None:
+        """Shut the run down; the recording is finalised whatever happened."""
+        errors = []
+        for closer in (self.runtime.shutdown, self._close_recorder, self._close_live):
+            try:
+                closer()
+            except Exception as e:  # keep closing the rest
+                errors.append(e)
+        if errors:
+            raise errors[0]
+
+    def _close_recorder(self) -> None:
+        if self.recorder is not None:
+            self.recorder.close()
+
+    def _close_live(self) -> None:
+        if self.live is not None:
+            self.live.close()
+
+    def __enter__(self) -> LaunchSession:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()

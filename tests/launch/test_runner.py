@@ -1,0 +1,58 @@
+"""Running plans: nodes in namespaces with tf_prefix, viewers skipped, clear failures."""
+
+from pathlib import Path
+
+import pytest
+
+from fleetsim.errors import LaunchError
+from fleetsim.launch.runner import LaunchSession, load_plan
+
+ROBOTS = """<launch>
+  <node pkg="rviz" type="rviz" name="rviz"/>
+  <group ns="lizi1">
+    <param name="tf_prefix" value="lizi1"/>
+    <node pkg="tf" type="static_transform_publisher" name="laser"
+          args="0.1 0 0.2 0 0 0 base_link laser_link 100"/>
+  </group>
+  <group ns="lizi2">
+    <param name="tf_prefix" value="lizi2"/>
+    <node pkg="tf2_ros" type="static_transform_publisher" name="laser"
+          args="0.3 0 0.2 0 0 0 base_link laser_link"/>
+  </group>
+</launch>
+"""
+
+
+def test_group_ns_and_tf_prefix_give_prefixed_frames(tmp_path: Path):
+    f = tmp_path / "robots.launch"
+    f.write_text(ROBOTS)
+    with LaunchSession(load_plan(f)) as s:
+        buf = s.runtime.tf_buffer  # a listener hears what is published after it starts
+        s.runtime.run(duration=0.5)
+        assert {"lizi1/base_link", "lizi1/laser_link", "lizi2/laser_link"} <= set(buf.all_frames())
+        t = buf.lookup_transform("lizi2/base_link", "lizi2/laser_link", 0.0)
+        assert t.transform.translation.x == pytest.approx(0.3)
+        assert s.skipped == ["/rviz"]
+        assert sorted(s.nodes) == ["/lizi1/laser", "/lizi2/laser"]
+
+
+def test_unknown_node_fails_with_file_and_line(tmp_path: Path):
+    f = tmp_path / "bad.launch"
+    f.write_text('<launch>\n<node pkg="tf" type="no_such" name="x"/>\n</launch>')
+    with pytest.raises(LaunchError, match=r"bad.launch:2 <node>: node tf/no_such is unknown"):
+        LaunchSession(load_plan(f))
+
+
+def test_node_errors_name_the_node(tmp_path: Path):
+    f = tmp_path / "bad.launch"
+    f.write_text(
+        '<launch>\n<node pkg="tf" type="static_transform_publisher" name="x" args="1 2"/>\n'
+        "</launch>"
+    )
+    with pytest.raises(LaunchError, match=r"bad.launch:2 <node>: node /x failed to start"):
+        LaunchSession(load_plan(f))
+
+
+def test_missing_file():
+    with pytest.raises(LaunchError, match="does not exist"):
+        load_plan("/nope/x.launch")

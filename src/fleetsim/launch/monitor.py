@@ -13,6 +13,7 @@ from typing import Any
 
 from fleetsim.launch.model import LaunchPlan
 from fleetsim.msgs import actionlib_msgs, move_base_msgs
+from fleetsim.runtime import names
 
 SAMPLE_PERIOD = 0.1  # s of sim time between ground-truth samples
 
@@ -49,7 +50,9 @@ class RunMonitor:
             if (spec.pkg, spec.type) == ("move_base", "move_base"):
                 ns = spec.namespace
                 r = self.robots.setdefault(ns, RobotResult(ns))
-                base = spec.full_name
+                # move_base serves its action in the robot's namespace, whatever the node's name
+                # (the lesson names the node move_base_node)
+                base = names.join(ns, "move_base")
                 graph.subscribe(
                     f"{base}/goal",
                     move_base_msgs.MoveBase.ActionGoal,

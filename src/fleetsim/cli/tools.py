@@ -15,8 +15,8 @@ from typing import Any
 
 import typer
 
-from fleetsim.errors import MessageError, TransportError
-from fleetsim.transport.client import Received, SimulationClient
+from fleetsim.errors import TransportError
+from fleetsim.transport.client import SimulationClient
 
 CONNECT_HELP = "Simulation endpoint (zenoh locator); default $FLEETSIM_ZENOH or tcp/127.0.0.1:7447."
 Connect = typer.Option(None, "--connect", "-c", envvar="FLEETSIM_ZENOH", help=CONNECT_HELP)
@@ -48,15 +48,6 @@ def _client(connect: str | None, timeout: float = 2.0):
 
 def _global(name: str) -> str:
     return name if name.startswith("/") else "/" + name
-
-
-def _until(count: int | None, timeout: float | None, got: list) -> None:
-    """Wait (wall clock) until ``count`` items arrived in ``got`` or ``timeout`` passed."""
-    deadline = None if timeout is None else _wall.monotonic() + timeout
-    while count is None or len(got) < count:
-        if deadline is not None and _wall.monotonic() > deadline:
-            return
-        _wall.sleep(0.02)
 
 
 # -- topic ------------------------------------------------------------------------------------
@@ -105,30 +96,10 @@ def topic_echo(
     connect: str | None = Connect,
 ) -> None:
     """Print messages on TOPIC as YAML documents (like rostopic echo)."""
-    from fleetsim.transport.textout import message_yaml
+    from fleetsim.transport.topic_tools import echo
 
-    name = _global(topic)
-    limit = 1 if once else count
-    got: list[Received] = []
     with _client(connect) as c:
-        if name not in c.graph()["topics"]:
-            typer.echo(f"WARNING: topic [{name}] does not appear to be published yet", err=True)
-        c.subscribe(name, got.append)
-        printed = 0
-        deadline = None if timeout is None else _wall.monotonic() + timeout
-        while limit is None or printed < limit:
-            if printed < len(got):
-                r = got[printed]
-                printed += 1
-                if isinstance(r.msg, Exception):
-                    raise r.msg
-                typer.echo(message_yaml(r.msg, no_arrays=noarr) + "---")
-                continue
-            if deadline is not None and _wall.monotonic() > deadline:
-                if limit is not None:
-                    raise TransportError(f"{name}: {printed} of {limit} messages in {timeout:g} s")
-                return
-            _wall.sleep(0.01)
+        echo(c, _global(topic), typer.echo, 1 if once else count, timeout, noarr)
 
 
 @topic_app.command("hz")
@@ -139,30 +110,10 @@ def topic_hz(
     connect: str | None = Connect,
 ) -> None:
     """Publishing rate of TOPIC in sim time (like rostopic hz), reported every second."""
-    from fleetsim.transport.textout import RateStats
+    from fleetsim.transport.topic_tools import hz
 
-    name = _global(topic)
-    stats = RateStats(window)
-    clock = {"t": None}
     with _client(connect) as c:
-        has_clock = "/clock" in c.graph()["topics"]
-        if has_clock:
-            c.subscribe("/clock", lambda r: clock.__setitem__("t", _clock_of(r)), latched=False)
-        c.subscribe(
-            name,
-            lambda r: stats.add(clock["t"] if has_clock and clock["t"] is not None else r.wall),
-            latched=False,
-        )
-        typer.echo(f"subscribed to [{name}]")
-        end = None if duration is None else _wall.monotonic() + duration
-        while end is None or _wall.monotonic() < end:
-            _wall.sleep(1.0 if end is None else max(0.0, min(1.0, end - _wall.monotonic())))
-            report = stats.report()
-            typer.echo(stats.format(report) if report else "no new messages")
-
-
-def _clock_of(r: Received) -> float | None:
-    return None if isinstance(r.msg, Exception) else r.msg.clock.to_sec()
+        hz(c, _global(topic), typer.echo, window, duration)
 
 
 @topic_app.command("pub")
@@ -179,33 +130,13 @@ def topic_pub(
     connect: str | None = Connect,
 ) -> None:
     """Publish one message (or at RATE Hz) on TOPIC; ``stamp: now`` means the sim time."""
-    from fleetsim.msgs import from_dict, get_type
-    from fleetsim.transport.textout import fill_now, parse_yaml_arg
+    from fleetsim.transport.textout import parse_yaml_arg
+    from fleetsim.transport.topic_tools import publish
 
     name = _global(topic)
-    if rate is not None and not rate > 0:
-        raise MessageError(f"topic pub: rate must be > 0 Hz, got {rate}")
-    cls = get_type(msg_type)
     data = parse_yaml_arg(values, f"topic pub {name}")
     with _client(connect) as c:
-        msg = from_dict(cls, fill_now(data, c.sim_time()), where=f"topic pub {name}")
-        pub = c.publisher(name, cls)
-        if not pub.wait_for_subscribers(wait):
-            typer.echo(f"WARNING: no subscriber on {name} yet; publishing anyway", err=True)
-        if rate is None or once:
-            pub.publish(msg)
-            typer.echo(f"publishing and latching message for {name} once")
-            _wall.sleep(0.1)  # let the sample leave before the session closes
-            return
-        sent = 0
-        period = 1.0 / rate
-        next_t = _wall.monotonic()
-        while count is None or sent < count:
-            pub.publish(msg)
-            sent += 1
-            next_t += period
-            _wall.sleep(max(0.0, next_t - _wall.monotonic()))
-        _wall.sleep(0.1)
+        publish(c, name, msg_type, data, typer.echo, None if once else rate, count, wait)
 
 
 # -- service ----------------------------------------------------------------------------------

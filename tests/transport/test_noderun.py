@@ -1,0 +1,81 @@
+"""``fleetsim node run``: a node in another process, on the simulation's clock and parameters."""
+
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import pytest
+
+from fleetsim.errors import LaunchError, TransportError
+from fleetsim.transport.noderun import load_node_class, parse_assignments, run_node
+
+ROOT = Path(__file__).resolve().parents[2]
+
+
+def test_parse_assignments():
+    assert parse_assignments(["a:=1", "b:=[1, 2]", "c:=x", "d:="], "--param") == {
+        "a": 1,
+        "b": [1, 2],
+        "c": "x",
+        "d": "",
+    }
+    assert parse_assignments(["scan:=/lizi1/scan"], "--remap") == {"scan": "/lizi1/scan"}
+    with pytest.raises(LaunchError, match=r"--remap 'scan' must look like NAME:=VALUE"):
+        parse_assignments(["scan"], "--remap")
+    with pytest.raises(LaunchError, match=r"--param 'a:=\[1': the value is not YAML"):
+        parse_assignments(["a:=[1"], "--param")
+
+
+def test_load_node_class_errors():
+    from transport.helper_nodes import Echo
+
+    assert load_node_class("transport.helper_nodes:Echo") is Echo
+    with pytest.raises(LaunchError, match=r"has no Node subclass named 'Nope'"):
+        load_node_class("transport.helper_nodes:Nope")
+    with pytest.raises(LaunchError, match=r"has no Node subclass named 'param'"):
+        load_node_class("transport.helper_nodes:param")
+
+
+def test_no_clock_is_a_clear_error(endpoint):
+    from fleetsim.runtime import Runtime
+    from fleetsim.transport import ZenohBridge
+
+    rt = Runtime()
+    peer = ZenohBridge(rt, listen=[endpoint], publish_clock=False)
+    try:
+        with pytest.raises(TransportError, match=r"no /clock from a simulation at .* within 0.3 s"):
+            run_node("transport.helper_nodes:Echo", connect=endpoint, clock_timeout=0.3)
+    finally:
+        peer.close()
+
+
+def test_node_in_another_process_exchanges_messages(sim):
+    sim.runtime.params.set("/lizi1/echo/prefix", "from-sim:")
+    code = (
+        "import logging, sys\n"
+        "logging.basicConfig(level=logging.INFO, stream=sys.stdout)\n"
+        "from fleetsim.transport.noderun import run_node\n"
+        "from fleetsim.runtime import Runtime\n"
+        f"run_node('transport.helper_nodes:Echo', '/lizi1', connect='{sim.endpoint}',\n"
+        "         remaps={'chatter': '/chatter', 'back': '/back', 'trigger': '/trigger'},\n"
+        "         params={'period': 0.05}, until=float(sys.argv[1]))\n"
+    )
+    env = dict(os.environ, PYTHONPATH=f"{ROOT / 'src'}{os.pathsep}{ROOT / 'tests'}")
+    until = sim.runtime.now() + 3.0
+    t0 = time.monotonic()
+    r = subprocess.run(
+        [sys.executable, "-c", code, str(until)],
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert r.returncode == 0, r.stderr
+    assert "/lizi1/echo joined the simulation at" in r.stdout
+    assert time.monotonic() - t0 < 20
+    back = [m.data for m in sim.talker.back]
+    assert len(back) >= 5
+    assert all(b.startswith("from-sim:t=") for b in back)  # the simulation's parameter
+    assert sim.talker.calls >= 1  # the remote node called the simulation's service

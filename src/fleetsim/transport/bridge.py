@@ -29,11 +29,7 @@ from typing import Any
 from fleetsim.errors import FleetsimError, TransportError
 from fleetsim.transport.clock_follow import ClockFollowing
 from fleetsim.transport.graphinfo import graph_snapshot
-from fleetsim.transport.keys import (
-    DEFAULT_ENDPOINT,
-    Keys,
-    open_session,
-)
+from fleetsim.transport.keys import Keys, default_endpoint, open_session
 from fleetsim.transport.paramserver import answer_param_request
 from fleetsim.transport.services import ServiceBridging
 from fleetsim.transport.topics import TopicBridging
@@ -56,7 +52,7 @@ class ZenohBridge(TopicBridging, ServiceBridging, ClockFollowing):
     runtime : the runtime whose graph is shared.
     mode : ``"peer"`` for a simulation (listens; tools and nodes connect to it) or
         ``"client"`` for a process joining one (``fleetsim node run``, tools).
-    listen : endpoints a peer listens on; default ``["tcp/127.0.0.1:7447"]`` for a peer.
+    listen : endpoints a peer listens on; default ``$FLEETSIM_ZENOH`` or ``tcp/127.0.0.1:7447``.
     connect : endpoints to connect to (a simulation, or a zenoh router for multi-host runs).
     domain : key domain (``fleetsim/<domain>/...``); default ``$FLEETSIM_DOMAIN`` or ``0``.
     poll_period : sim-time period of the inbox pump, seconds.
@@ -92,7 +88,7 @@ class ZenohBridge(TopicBridging, ServiceBridging, ClockFollowing):
         if not poll_period > 0:
             raise TransportError(f"bridge poll_period must be > 0 s, got {poll_period!r}")
         if listen is None:
-            listen = [DEFAULT_ENDPOINT] if mode == "peer" else []
+            listen = [default_endpoint()] if mode == "peer" else []
         self.runtime = runtime
         self.graph = runtime.graph
         self.keys = Keys(domain)
@@ -174,6 +170,9 @@ class ZenohBridge(TopicBridging, ServiceBridging, ClockFollowing):
             return
         self._dirty = True
         if event == "advertise":
+            if name == "/clock" and self._clock_pub is not None and obj is not self._clock_pub:
+                clock, self._clock_pub = self._clock_pub, None  # the simulator publishes it
+                clock.destroy()
             self._export_topic(name, obj)
         elif event == "unadvertise":
             self._unexport_topic(name)

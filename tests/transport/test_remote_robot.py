@@ -1,0 +1,65 @@
+"""Scenario: the simulator in this process, a robot's controller in another, over Zenoh.
+
+The controller (``helper_nodes.GoToPoint``) runs in a subprocess started through
+``fleetsim node run``'s function, on the simulation's /clock, reading ``/r/odom`` and sending
+``/r/cmd_vel``; the simulator's ground truth must end within the controller's tolerance.
+"""
+
+import os
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fleetsim.msgs import nav_msgs, std_msgs
+from fleetsim.runtime import Node, Runtime
+
+ROOT = Path(__file__).resolve().parents[2]
+DIFFBOT = ROOT / "tests" / "sim" / "fixtures" / "diffbot.urdf"
+
+pytestmark = pytest.mark.scenario
+
+
+def test_controller_in_another_process_drives_the_robot_to_its_goal(endpoint):
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    from fleetsim.description import load_robot
+    from fleetsim.sim.node import Simulator
+    from transport.conftest import SimThread
+
+    rt = Runtime(seed=3)
+    rt.params.set("/r/go_to_point", {"goal_x": 1.2, "goal_y": 0.6, "xy_goal_tolerance": 0.1})
+    sim = Simulator(rt)
+    sim.spawn_robot("r", load_robot(DIFFBOT))
+    watcher = Node(rt, "watcher")
+    arrived, odom = [], []
+    watcher.create_subscription(std_msgs.Bool, "/r/arrived", lambda m: arrived.append(rt.now()))
+    watcher.create_subscription(nav_msgs.Odometry, "/r/odom", odom.append, queue_size=1)
+    code = (
+        "import sys\n"
+        "from fleetsim.transport.noderun import run_node\n"
+        f"run_node('transport.helper_nodes:GoToPoint', '/r', connect='{endpoint}',\n"
+        "         until=float(sys.argv[1]))\n"
+    )
+    env = dict(os.environ, PYTHONPATH=f"{ROOT / 'src'}{os.pathsep}{ROOT / 'tests'}")
+    with SimThread(rt, endpoint, rate=2.0):
+        until = rt.now() + 12.0
+        t0 = time.monotonic()
+        r = subprocess.run(
+            [sys.executable, "-c", code, str(until)],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        assert r.returncode == 0, r.stderr
+        position, _ = sim.engine.model_pose("r")
+    assert time.monotonic() - t0 < 20
+    assert arrived, "the remote controller never reported arrival"
+    p = odom[-1].pose.pose.position
+    assert np.hypot(p.x - 1.2, p.y - 0.6) < 0.1  # by its odometry, within its tolerance
+    drift = np.hypot(p.x - position[0], p.y - position[1])
+    print(f"arrived at t={arrived[0]:.2f} s; truth {position[:2]}, odometry drift {drift:.3f} m")
+    assert np.hypot(position[0] - 1.2, position[1] - 0.6) < 0.1 + drift + 1e-6

@@ -297,15 +297,19 @@ class Amcl(Node):
         if rate is not None and rate > 0 and now - self._last_cloud_time < 1.0 / rate:
             return
         self._last_cloud_time = now
+        if self.cloud_pub.get_num_connections() == 0:
+            return  # nobody listens: skip building thousands of Pose messages
         parts = self.filter.particles
         half = 0.5 * parts[:, 2]
-        sz, cw = np.sin(half), np.cos(half)
+        Pose, Point, Quaternion = geometry_msgs.Pose, geometry_msgs.Point, geometry_msgs.Quaternion
         poses = [
-            geometry_msgs.Pose(
-                position=geometry_msgs.Point(x=float(x), y=float(y), z=0.0),
-                orientation=geometry_msgs.Quaternion(x=0.0, y=0.0, z=float(z), w=float(w)),
+            Pose(position=Point(x=x, y=y, z=0.0), orientation=Quaternion(x=0.0, y=0.0, z=z, w=w))
+            for x, y, z, w in zip(
+                parts[:, 0].tolist(),
+                parts[:, 1].tolist(),
+                np.sin(half).tolist(),
+                np.cos(half).tolist(),
             )
-            for (x, y, _), z, w in zip(parts, sz, cw)
         ]
         header = std_msgs.Header(stamp=stamp, frame_id=self.global_frame)
         self.cloud_pub.publish(geometry_msgs.PoseArray(header=header, poses=poses))

@@ -176,3 +176,14 @@ def test_spawn_sdf_model_and_world_properties():
     e.advance(1.0)
     assert e.model_pose("box")[0][2] == pytest.approx(0.1, abs=2e-3)
     assert e.world_properties()["model_names"] == ["ground_plane", "box"]
+
+
+def test_idle_robot_stays_put(diffbot):
+    e = Engine(None)
+    e.spawn_robot("r", diffbot, (2.0, 1.0, 0, 0, 0, 0.3))
+    heights = []
+    for _ in range(40):
+        e.advance(0.05)
+        heights.append(e.model_pose("r")[0][2])
+    assert np.hypot(*(e.model_pose("r")[0][:2] - [2.0, 1.0])) < 1e-3
+    assert max(heights) < 1e-3  # no hopping on its contacts

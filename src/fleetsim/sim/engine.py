@@ -322,10 +322,13 @@ class Engine(StateQueries):
             else:
                 r = p.measure(self, t)
                 if r is not None:
+                    r.namespace = p.ctx.namespace
                     out.append(r)
         self._min_due = min_due
         if lasers:
-            out += self.lasers.measure(self, lasers, t)
+            for r, p in zip(self.lasers.measure(self, lasers, t), lasers):
+                r.namespace = p.ctx.namespace
+                out.append(r)
         return out
 
     # -------------------------------------------------------------------- rendering

@@ -20,6 +20,6 @@ def test_skid_steer_odometry_drifts_when_turning(skidbot):
     odom, truth = last(readings, "odom"), last(readings, "base_pose_ground_truth")
     turned_truth = yaw_of(truth.orientation)
     turned_odom = yaw_of(odom.orientation)
-    assert turned_truth > 0.3  # it does turn
+    assert turned_truth > 0.15  # it does turn
     assert abs(turned_odom - turned_truth) > 0.2  # but the wheels slip: odometry drifts
     assert np.linalg.norm(odom.position[:2] - truth.position[:2]) > 0.02

@@ -206,6 +206,7 @@ class OdometryReading:
     angular: np.ndarray  # (3,) rad/s in child frame
     publish_tf: bool = True
     covariance: float = 0.0  # diagonal pose/twist covariance
+    namespace: str = "/"  # ROS namespace the topic resolves in (set by the engine)
 
 
 @dataclass
@@ -222,6 +223,7 @@ class ScanReading:
     range_max: float
     ranges: np.ndarray  # (N,) float32 m, inf where nothing is hit
     intensities: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float32))
+    namespace: str = "/"  # ROS namespace the topic resolves in (set by the engine)
 
 
 @dataclass
@@ -236,6 +238,7 @@ class ImageReading:
     depth_topic: str = ""
     depth_info_topic: str = ""
     depth: np.ndarray | None = None  # (H, W) float32 m, for depth cameras
+    namespace: str = "/"  # ROS namespace the topic resolves in (set by the engine)
 
 
 @dataclass
@@ -246,6 +249,7 @@ class JointStateReading:
     position: np.ndarray
     velocity: np.ndarray
     effort: np.ndarray
+    namespace: str = "/"  # ROS namespace the topic resolves in (set by the engine)
 
 
 def plugin_class(filename: str) -> type[Plugin] | None:

@@ -1,0 +1,114 @@
+"""Plugin readings as ROS messages (pure conversions, used by the ``Simulator`` node)."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fleetsim.msgs import builtin_interfaces, gazebo_msgs, geometry_msgs, nav_msgs, sensor_msgs
+from fleetsim.sim.plugins.base import (
+    ImageReading,
+    JointStateReading,
+    OdometryReading,
+    ScanReading,
+)
+from fleetsim.sim.queries import Contact
+
+
+def stamp(t: float) -> builtin_interfaces.Time:
+    return builtin_interfaces.Time.from_sec(max(0.0, t))
+
+
+def odometry_msg(r: OdometryReading) -> nav_msgs.Odometry:
+    msg = nav_msgs.Odometry()
+    msg.header.stamp = stamp(r.stamp)
+    msg.header.frame_id = r.frame_id
+    msg.child_frame_id = r.child_frame_id
+    p, q = msg.pose.pose.position, msg.pose.pose.orientation
+    p.x, p.y, p.z = (float(v) for v in r.position)
+    q.x, q.y, q.z, q.w = (float(v) for v in r.orientation)
+    lin, ang = msg.twist.twist.linear, msg.twist.twist.angular
+    lin.x, lin.y, lin.z = (float(v) for v in r.linear)
+    ang.x, ang.y, ang.z = (float(v) for v in r.angular)
+    if r.covariance:
+        cov = np.zeros(36)
+        cov[::7] = r.covariance
+        msg.pose.covariance = cov.copy()
+        msg.twist.covariance = cov.copy()
+    return msg
+
+
+def odometry_tf(r: OdometryReading) -> geometry_msgs.TransformStamped:
+    t = geometry_msgs.TransformStamped()
+    t.header.stamp = stamp(r.stamp)
+    t.header.frame_id = r.frame_id
+    t.child_frame_id = r.child_frame_id
+    tr, q = t.transform.translation, t.transform.rotation
+    tr.x, tr.y, tr.z = (float(v) for v in r.position)
+    q.x, q.y, q.z, q.w = (float(v) for v in r.orientation)
+    return t
+
+
+def scan_msg(r: ScanReading) -> sensor_msgs.LaserScan:
+    msg = sensor_msgs.LaserScan()
+    msg.header.stamp = stamp(r.stamp)
+    msg.header.frame_id = r.frame_id
+    msg.angle_min, msg.angle_max = r.angle_min, r.angle_max
+    msg.angle_increment, msg.time_increment = r.angle_increment, r.time_increment
+    msg.scan_time, msg.range_min, msg.range_max = r.scan_time, r.range_min, r.range_max
+    msg.ranges = r.ranges
+    msg.intensities = r.intensities
+    return msg
+
+
+def image_msg(t: float, frame_id: str, img: np.ndarray, encoding: str) -> sensor_msgs.Image:
+    msg = sensor_msgs.Image()
+    msg.header.stamp = stamp(t)
+    msg.header.frame_id = frame_id
+    msg.height, msg.width = int(img.shape[0]), int(img.shape[1])
+    msg.encoding = encoding
+    data = np.ascontiguousarray(img)
+    msg.step = int(data.strides[0])
+    msg.data = data.view(np.uint8).reshape(-1)
+    return msg
+
+
+def camera_info_msg(r: ImageReading) -> sensor_msgs.CameraInfo:
+    msg = sensor_msgs.CameraInfo()
+    msg.header.stamp = stamp(r.stamp)
+    msg.header.frame_id = r.frame_id
+    msg.height, msg.width = int(r.image.shape[0]), int(r.image.shape[1])
+    msg.distortion_model = "plumb_bob"
+    msg.d = np.zeros(5)
+    msg.k = r.K.reshape(-1).astype(np.float64)
+    msg.r = np.eye(3).reshape(-1)
+    p = np.zeros((3, 4))
+    p[:, :3] = r.K
+    msg.p = p.reshape(-1)
+    return msg
+
+
+def joint_state_msg(r: JointStateReading) -> sensor_msgs.JointState:
+    msg = sensor_msgs.JointState()
+    msg.header.stamp = stamp(r.stamp)
+    msg.name = list(r.names)
+    msg.position = np.asarray(r.position, np.float64)
+    msg.velocity = np.asarray(r.velocity, np.float64)
+    msg.effort = np.asarray(r.effort, np.float64)
+    return msg
+
+
+def contacts_msg(t: float, contacts: list[Contact]) -> gazebo_msgs.ContactsState:
+    msg = gazebo_msgs.ContactsState()
+    msg.header.stamp = stamp(t)
+    msg.header.frame_id = "world"
+    for c in contacts:
+        s = gazebo_msgs.ContactState()
+        s.info = f"{c.model1} touches {c.model2}"
+        s.collision1_name = f"{c.model1}::{c.link1}"
+        s.collision2_name = f"{c.model2}::{c.link2}"
+        v = geometry_msgs.Vector3()
+        v.x, v.y, v.z = c.position
+        s.contact_positions = [v]
+        s.depths = np.array([c.depth])
+        msg.states.append(s)
+    return msg

@@ -1,0 +1,186 @@
+"""The ``Simulator`` node (``gazebo_ros/gzserver``): the engine on the runtime's clock.
+
+A physics timer (priority -100) advances the ``Engine`` up to the current sim time, publishes
+every reading that fell due (odometry and its tf, scans, images, joint states, ground truth),
+robot contacts on ``/gazebo/robot_contacts`` and ``/clock``. Drive plugins listen on their
+robot's ``commandTopic``. World services (``/gazebo/*``, ``/link_attacher_node/*``) live in
+``sim.services``. Topics resolve in the robot's namespace; frames get its ``tf_prefix`` (the
+``tf_prefix`` parameter found from the namespace up, else the namespace itself).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from fleetsim.msgs import geometry_msgs, nav_msgs, rosgraph_msgs, sensor_msgs
+from fleetsim.runtime import Node, param
+from fleetsim.runtime import names as rnames
+from fleetsim.sim import messages as conv
+from fleetsim.sim.engine import Engine, ModelEntry
+from fleetsim.sim.plugins.base import (
+    DrivePlugin,
+    ImageReading,
+    JointStateReading,
+    OdometryReading,
+    ScanReading,
+)
+from fleetsim.sim.services import WorldServices
+
+EMPTY_WORLDS = ("", "worlds/empty.world", "empty", "empty.world")
+
+
+@dataclass(frozen=True)
+class SimulatorParams:
+    world_name: str = param("", help="SDF .world or map .yaml; empty: ground plane and sun")
+    paused: bool = param(False, help="start with physics paused")
+    max_step_size: float = param(0.004, unit="s", range=(1e-4, 0.02), help="physics step")
+    update_period: float = param(
+        0.01,
+        unit="s",
+        range=(1e-4, 1.0),
+        help="how often physics catches up with sim time and publishes",
+    )
+    pub_clock_frequency: float = param(
+        100.0, unit="Hz", range=(0.0, None), help="/clock rate (0: every update)"
+    )
+    wall_height: float = param(1.0, unit="m", range=(0.01, None), help="map-world wall height")
+    publish_contacts: bool = param(True, help="publish robot contacts on ~robot_contacts")
+
+
+class Simulator(Node):
+    """The simulator node; ``args[0]`` (as gzserver takes it) or ``~world_name`` is the world."""
+
+    Params = SimulatorParams
+
+    def __init__(self, runtime, name: str = "gazebo", namespace: str = "/", **kw: Any) -> None:
+        super().__init__(runtime, name, namespace, **kw)
+        p = self.params
+        world = next((a for a in self.args if not a.startswith("-")), p.world_name)
+        source = None if world in EMPTY_WORLDS else Path(world)
+        self.engine = Engine(
+            source, timestep=p.max_step_size, rng=self.rng, wall_height=p.wall_height
+        )
+        self.engine.paused = p.paused
+        self.offset = runtime.now() - self.engine.time  # sim time = physics time + offset
+        self._pubs: dict[tuple[str, type], Any] = {}
+        self._subs: dict[str, list] = {}
+        from fleetsim.tf import TransformBroadcaster
+
+        self.tf = TransformBroadcaster(self)
+        self.clock_pub = self.create_publisher(rosgraph_msgs.Clock, "/clock", queue_size=10)
+        self.contacts_pub = self.create_publisher(
+            conv.gazebo_msgs.ContactsState, "~robot_contacts", queue_size=10
+        )
+        self._last_clock = -1.0
+        self.services = WorldServices(self)
+        self.create_timer(p.update_period, self.on_update, priority=-100)
+
+    # ------------------------------------------------------------------ models
+    def tf_prefix_for(self, namespace: str) -> str:
+        """tf_prefix of a robot namespace: the ``tf_prefix`` parameter, else the namespace."""
+        found = self.runtime.params.search("tf_prefix", rnames.join(namespace, "spawned_model"))
+        if found is not None:
+            value = self.runtime.params.get(found)
+            return str(value).strip("/") if value else ""
+        return namespace.strip("/")
+
+    def spawn_robot(
+        self, name: str, robot: Any, pose=(0, 0, 0, 0, 0, 0), namespace: str | None = None
+    ) -> ModelEntry:
+        """Spawn a robot and wire its drive commands (see ``Engine.spawn_robot``)."""
+        ns = rnames.validate_namespace(namespace if namespace else f"/{name}")
+        entry = self.engine.spawn_robot(name, robot, pose, ns, self.tf_prefix_for(ns))
+        self._wire(entry)
+        self.get_logger().info("spawned '%s' in namespace %s", name, ns)
+        return entry
+
+    def _wire(self, entry: ModelEntry) -> None:
+        subs = []
+        for p in entry.plugins:
+            if isinstance(p, DrivePlugin):
+                topic = self.topic(entry, p.params.commandTopic)
+
+                def on_cmd(msg, plugin=p):
+                    plugin.command(msg.linear.x, msg.angular.z, self.engine.time)
+
+                subs.append(
+                    self.create_subscription(geometry_msgs.Twist, topic, on_cmd, queue_size=1)
+                )
+        self._subs[entry.name] = subs
+
+    def delete_model(self, name: str) -> None:
+        self.engine.delete_model(name)
+        for sub in self._subs.pop(name, []):
+            sub.destroy()
+
+    @staticmethod
+    def topic(entry: ModelEntry, name: str) -> str:
+        return rnames.resolve(name, entry.namespace)
+
+    def _publisher(self, topic: str, msg_type: type):
+        key = (topic, msg_type)
+        if key not in self._pubs:
+            self._pubs[key] = self.create_publisher(msg_type, topic, queue_size=10)
+        return self._pubs[key]
+
+    # ------------------------------------------------------------------ stepping
+    def on_update(self) -> None:
+        target = self.now() - self.offset
+        if self.engine.paused:
+            self.offset = self.now() - self.engine.time
+            readings = []
+        else:
+            readings = self.engine.advance(target - self.engine.time)
+        self.publish(readings)
+        p = self.params
+        period = 1.0 / p.pub_clock_frequency if p.pub_clock_frequency > 0 else 0.0
+        if self.now() - self._last_clock >= period - 1e-9:
+            self._last_clock = self.now()
+            self.clock_pub.publish(rosgraph_msgs.Clock(clock=self.now_msg()))
+        if p.publish_contacts and not self.engine.paused:
+            contacts = self.engine.contacts()
+            if contacts:
+                self.contacts_pub.publish(conv.contacts_msg(self.now(), contacts))
+
+    def publish(self, readings: list) -> None:
+        """Turn plugin readings into messages on their robots' topics."""
+        tfs = []
+        for r in readings:
+            ns = r.namespace
+            off = self.offset
+            if isinstance(r, OdometryReading):
+                r.stamp += off
+                self._publisher(rnames.resolve(r.topic, ns), nav_msgs.Odometry).publish(
+                    conv.odometry_msg(r)
+                )
+                if r.publish_tf:
+                    tfs.append(conv.odometry_tf(r))
+            elif isinstance(r, ScanReading):
+                r.stamp += off
+                self._publisher(rnames.resolve(r.topic, ns), sensor_msgs.LaserScan).publish(
+                    conv.scan_msg(r)
+                )
+            elif isinstance(r, JointStateReading):
+                r.stamp += off
+                self._publisher(rnames.resolve(r.topic, ns), sensor_msgs.JointState).publish(
+                    conv.joint_state_msg(r)
+                )
+            elif isinstance(r, ImageReading):
+                r.stamp += off
+                self._publish_image(r, ns)
+        if tfs:
+            self.tf.send_transform(tfs)
+
+    def _publish_image(self, r: ImageReading, ns: str) -> None:
+        img = conv.image_msg(r.stamp, r.frame_id, r.image, r.encoding)
+        self._publisher(rnames.resolve(r.topic, ns), sensor_msgs.Image).publish(img)
+        info = conv.camera_info_msg(r)
+        self._publisher(rnames.resolve(r.info_topic, ns), sensor_msgs.CameraInfo).publish(info)
+        if r.depth is not None:
+            d = conv.image_msg(r.stamp, r.frame_id, r.depth, "32FC1")
+            self._publisher(rnames.resolve(r.depth_topic, ns), sensor_msgs.Image).publish(d)
+            self._publisher(rnames.resolve(r.depth_info_topic, ns), sensor_msgs.CameraInfo).publish(
+                info
+            )

@@ -1,0 +1,123 @@
+"""The Simulator node on a runtime: topics, tf, /clock, namespaces and world services."""
+
+import numpy as np
+import pytest
+
+from fleetsim.msgs import gazebo_msgs, gazebo_ros_link_attacher, geometry_msgs, std_srvs
+from fleetsim.runtime import Node, Runtime
+from fleetsim.sim.node import Simulator
+
+from .conftest import FIXTURES, WILLOW
+
+
+def collect(node, msg_type, topic, store):
+    node.create_subscription(msg_type, topic, store.append, queue_size=100)
+
+
+@pytest.fixture
+def sim():
+    rt = Runtime(seed=3)
+    sim = Simulator(rt, args=[str(WILLOW)])
+    probe = Node(rt, "probe")
+    return rt, sim, probe
+
+
+def spawn(probe, name, pose, ns=""):
+    client = probe.create_client(gazebo_msgs.SpawnModel, "/gazebo/spawn_urdf_model")
+    req = gazebo_msgs.SpawnModel.Request()
+    req.model_name = name
+    req.model_xml = (FIXTURES / "diffbot.urdf").read_text()
+    req.robot_namespace = ns
+    req.initial_pose.position.x, req.initial_pose.position.y = pose
+    req.initial_pose.orientation.w = 1.0
+    return client.call(req)
+
+
+def test_two_namespaces_do_not_share_commands(sim):
+    from fleetsim.msgs import nav_msgs, rosgraph_msgs, sensor_msgs, tf2_msgs
+
+    rt, s, probe = sim
+    assert spawn(probe, "lizi1", (22.0, 15.0)).success
+    assert spawn(probe, "lizi2", (24.0, 15.0), ns="/lizi2").success
+    odom1, scans2, tf, clock = [], [], [], []
+    collect(probe, nav_msgs.Odometry, "/lizi1/odom", odom1)
+    collect(probe, sensor_msgs.LaserScan, "/lizi2/scan", scans2)
+    collect(probe, tf2_msgs.TFMessage, "/tf", tf)
+    collect(probe, rosgraph_msgs.Clock, "/clock", clock)
+    cmd = probe.create_publisher(geometry_msgs.Twist, "/lizi1/cmd_vel", queue_size=1)
+    probe.create_timer(
+        0.1, lambda: cmd.publish(geometry_msgs.Twist(linear=geometry_msgs.Vector3(x=0.3)))
+    )
+    rt.run(duration=2.0)
+    p1, _ = s.engine.model_pose("lizi1")
+    p2, _ = s.engine.model_pose("lizi2")
+    assert p1[0] > 22.4  # lizi1 drove
+    assert np.hypot(p2[0] - 24.0, p2[1] - 15.0) < 0.01  # lizi2 did not move
+    assert odom1 and odom1[-1].header.frame_id == "lizi1/odom"
+    assert odom1[-1].child_frame_id == "lizi1/base_footprint"
+    assert odom1[-1].header.stamp.to_sec() <= rt.now() + 1e-9
+    assert len(scans2) == pytest.approx(20, abs=1)  # 10 Hz
+    assert scans2[-1].header.frame_id == "lizi2/laser_link" and len(scans2[-1].ranges) == 360
+    frames = {(t.header.frame_id, t.child_frame_id) for m in tf for t in m.transforms}
+    assert ("lizi2/odom", "lizi2/base_footprint") in frames
+    assert clock and clock[-1].clock.to_sec() == pytest.approx(rt.now(), abs=0.011)
+
+
+def test_world_services(sim):
+    rt, s, probe = sim
+    assert spawn(probe, "bot", (10.0, 10.0)).success
+    dup = spawn(probe, "bot", (11.0, 10.0))
+    assert not dup.success and "already exists" in dup.status_message
+    get = probe.create_client(gazebo_msgs.GetModelState, "/gazebo/get_model_state")
+    setc = probe.create_client(gazebo_msgs.SetModelState, "/gazebo/set_model_state")
+    req = gazebo_msgs.SetModelState.Request()
+    req.model_state.model_name = "bot"
+    req.model_state.pose.position.x, req.model_state.pose.position.y = 11.0, 9.0
+    req.model_state.pose.orientation.w = 1.0
+    assert setc.call(req).success
+    st = get.call(gazebo_msgs.GetModelState.Request(model_name="bot"))
+    assert st.success and st.pose.position.x == pytest.approx(11.0)
+    missing = get.call(gazebo_msgs.GetModelState.Request(model_name="nobody"))
+    assert not missing.success and "no model named 'nobody'" in missing.status_message
+    props = probe.create_client(
+        gazebo_msgs.GetWorldProperties, "/gazebo/get_world_properties"
+    ).call()
+    assert props.model_names == ["ground_plane", "map_walls", "bot"]
+    empty = std_srvs.Empty.Request()
+    probe.create_client(std_srvs.Empty, "/gazebo/pause_physics").call(empty)
+    t0 = s.engine.time
+    rt.run(duration=0.5)
+    assert s.engine.time == t0
+    probe.create_client(std_srvs.Empty, "/gazebo/unpause_physics").call(empty)
+    rt.run(duration=0.5)
+    assert s.engine.time == pytest.approx(t0 + 0.5, abs=0.011)
+    sdf = probe.create_client(gazebo_msgs.SpawnModel, "/gazebo/spawn_sdf_model")
+    sreq = gazebo_msgs.SpawnModel.Request(
+        model_name="marker",
+        model_xml=(
+            "<sdf version='1.6'><model name='m'><link name='link'><inertial><mass>0.1</mass>"
+            "</inertial><collision name='c'><geometry><box><size>.1 .1 .1</size></box>"
+            "</geometry></collision></link></model></sdf>"
+        ),
+    )
+    sreq.initial_pose.position.x, sreq.initial_pose.position.z = 10.0, 0.5
+    assert sdf.call(sreq).success
+    att = probe.create_client(gazebo_ros_link_attacher.Attach, "/link_attacher_node/attach")
+    ok = att.call(
+        gazebo_ros_link_attacher.Attach.Request(
+            model_name_1="bot", link_name_1="base_link", model_name_2="marker", link_name_2="link"
+        )
+    )
+    assert ok.ok
+    bad = att.call(
+        gazebo_ros_link_attacher.Attach.Request(
+            model_name_1="bot", link_name_1="nope", model_name_2="marker", link_name_2="link"
+        )
+    )
+    assert not bad.ok
+    dele = probe.create_client(gazebo_msgs.DeleteModel, "/gazebo/delete_model")
+    assert dele.call(gazebo_msgs.DeleteModel.Request(model_name="bot")).success
+    rt.run(duration=0.1)
+    assert "bot" not in s.engine.models
+    probe.create_client(std_srvs.Empty, "/gazebo/reset_simulation").call(empty)
+    assert s.engine.time == 0.0

@@ -229,3 +229,36 @@ def test_three_robots_with_per_robot_initial_poses():
     for k, robot in enumerate(robots, start=1):
         est = map_pose_of_base(rt, f"lizi{k}")
         assert np.hypot(*(est[:2] - robot.true[:2])) < 0.25
+
+
+def test_map_topic_first_map_only_throttle_and_no_tf():
+    rt = Runtime()
+    rt.params.set(
+        "/amcl",
+        {
+            "use_map_topic": True,
+            "first_map_only": True,
+            "gui_publish_rate": 1.0,
+            "tf_broadcast": False,
+            "initial_pose_x": 1.5,
+            "initial_pose_y": 5.0,
+            "update_min_d": 0.05,
+        },
+    )
+    helper = Node(rt, "helper")
+    map_pub = helper.create_publisher(nav_msgs.OccupancyGrid, "/map", latch=True)
+    map_pub.publish(grid_msg())  # latched: delivered when amcl subscribes
+    FakeRobot(rt, "/", ROUTE)
+    amcl = Amcl(rt, "amcl")
+    out = Listener(rt, "/")
+    rt.run(duration=5.0)
+    assert amcl.map_received and "/static_map" not in rt.graph.services
+    first = amcl.filter.grid
+    other = grid_msg()
+    other.data = np.zeros_like(other.data)
+    map_pub.publish(other)
+    rt.run(duration=0.2)
+    assert amcl.filter.grid is first  # first_map_only
+    assert 4 <= len(out.clouds) <= 6  # about 1 Hz over 5 s although the filter updated more
+    assert len(out.poses) > 8
+    assert not rt.tf_buffer.can_transform("map", "odom")  # tf_broadcast false

@@ -82,7 +82,10 @@ class AmclParams:
         (math.pi / 12.0) ** 2, unit="rad^2", range=(0.0, None), help="initial covariance yaw*yaw"
     )
     gui_publish_rate: float | None = param(
-        None, unit="Hz", range=(0.0, None), help="particlecloud rate (None: off)"
+        None,
+        unit="Hz",
+        range=(0.0, None),
+        help="max particlecloud rate (None: no limit, every update)",
     )
     save_pose_rate: float | None = param(
         0.5,

@@ -18,6 +18,8 @@ NODES: dict[tuple[str, str], str] = {
     ("tf2_ros", "static_transform_publisher"): "fleetsim.tf.static_transform_publisher:StaticTransformPublisher",
     ("robot_state_publisher", "robot_state_publisher"): "fleetsim.description.robot_state_publisher:RobotStatePublisher",
     ("robot_state_publisher", "state_publisher"): "fleetsim.description.robot_state_publisher:RobotStatePublisher",
+    ("amcl", "amcl"): "fleetsim.localization.amcl.node:Amcl",
+    ("gazebo_ros", "spawn_model"): "fleetsim.sim.spawn_model:SpawnModel",
     ("joint_state_publisher", "joint_state_publisher"): "fleetsim.description.joint_state_publisher:JointStatePublisher",
 }  # fmt: skip
 

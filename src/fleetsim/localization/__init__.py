@@ -1,0 +1,1 @@
+"""Localization: amcl and fake_localization."""

@@ -1,0 +1,177 @@
+"""The ``fake_localization`` node: perfect localization from the simulator's ground truth.
+
+As ROS's fake_localization: each ``base_pose_ground_truth`` (nav_msgs/Odometry, the pose of the
+robot's base in the simulator's world) is turned into the ``global_frame_id -> odom_frame_id``
+transform that makes ``map -> odom -> base`` equal to that pose, using ``odom -> base`` from tf
+at the message's stamp. The transform is dated ``transform_tolerance`` into the future, as
+amcl's is. The same pose goes out on ``amcl_pose`` (PoseWithCovarianceStamped, latched) and as
+the single pose of ``particlecloud`` (PoseArray, latched).
+
+``delta_x``, ``delta_y``, ``delta_yaw`` give the simulator's origin in the map; the pose
+published is ``offset * ground_truth`` with ``offset = (-delta_x, -delta_y, -delta_yaw)``, as
+fake_localization.cpp builds it. An ``initialpose`` (PoseWithCovarianceStamped in the global
+frame) shifts the offset so that the robot is localized at that pose from then on.
+
+Frames: ``odom_frame_id`` and ``base_frame_id`` get the robot's ``tf_prefix`` (a frame already
+spelled with the prefix, as the seeds' launch files write ``$(arg robot_name)/odom``, is left
+alone); ``global_frame_id`` (default ``/map``) is resolved the same way, so ``/map`` is ``map``.
+A message whose transform is not in tf yet is kept (up to 100, as ROS's message filter) and
+retried when the next one arrives.
+"""
+
+from __future__ import annotations
+
+from collections import deque
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from fleetsim.errors import ExtrapolationError, TransformError
+from fleetsim.msgs import geometry_msgs, nav_msgs, std_msgs
+from fleetsim.msgs.builtin_interfaces import Time
+from fleetsim.runtime import Node, param
+from fleetsim.tf import TransformBroadcaster, make_transform_stamped, resolve_frame_once
+from fleetsim.tf.names import normalize_frame
+from fleetsim.tf.quaternions import quaternion_from_yaw, quaternion_normalize
+from fleetsim.tf.transforms import compose_transforms, inverse_transform
+
+#: messages waiting for their odom -> base transform (tf2_ros::MessageFilter's queue size)
+QUEUE_SIZE = 100
+
+
+@dataclass(frozen=True)
+class FakeLocalizationParams:
+    """``fake_localization`` private parameters (ROS names and defaults)."""
+
+    odom_frame_id: str = param("odom", help="odometry frame (tf_prefix applied)")
+    base_frame_id: str = param("base_link", help="robot base frame (tf_prefix applied)")
+    global_frame_id: str = param("/map", help="frame the pose is published in")
+    delta_x: float = param(0.0, unit="m", help="x of the simulator origin in the map")
+    delta_y: float = param(0.0, unit="m", help="y of the simulator origin in the map")
+    delta_yaw: float = param(0.0, unit="rad", help="yaw of the simulator origin in the map")
+    transform_tolerance: float = param(
+        0.1, unit="s", range=(0.0, None), help="how far into the future the tf is dated"
+    )
+
+
+def _pose_arrays(pose: Any) -> tuple[np.ndarray, np.ndarray]:
+    p, q = pose.position, pose.orientation
+    return np.array([p.x, p.y, p.z]), quaternion_normalize([q.x, q.y, q.z, q.w])
+
+
+def _pose_msg(t: np.ndarray, q: np.ndarray) -> geometry_msgs.Pose:
+    return geometry_msgs.Pose(
+        position=geometry_msgs.Point(x=float(t[0]), y=float(t[1]), z=float(t[2])),
+        orientation=geometry_msgs.Quaternion(
+            x=float(q[0]), y=float(q[1]), z=float(q[2]), w=float(q[3])
+        ),
+    )
+
+
+class FakeLocalization(Node):
+    """Publishes ``map -> odom`` from ground truth, for one robot namespace."""
+
+    Params = FakeLocalizationParams
+
+    def __init__(
+        self, runtime, name: str = "fake_localization", namespace: str = "/", **kw: Any
+    ) -> None:
+        super().__init__(runtime, name, namespace, **kw)
+        p: FakeLocalizationParams = self.params
+        prefix = self.tf_prefix
+        self.odom_frame = resolve_frame_once(prefix, p.odom_frame_id)
+        self.base_frame = resolve_frame_once(prefix, p.base_frame_id)
+        self.global_frame = resolve_frame_once(prefix, p.global_frame_id)
+        # offset = (-delta_x, -delta_y) translation, -delta_yaw rotation (fake_localization.cpp)
+        self.offset = (np.array([-p.delta_x, -p.delta_y, 0.0]), quaternion_from_yaw(-p.delta_yaw))
+        self._pending: deque[nav_msgs.Odometry] = deque(maxlen=QUEUE_SIZE)
+        self._warned: set[str] = set()
+        self.tf_pub = TransformBroadcaster(self)
+        _ = self.tf_buffer  # the runtime's buffer listens to /tf from now on
+        self.pose_pub = self.create_publisher(
+            geometry_msgs.PoseWithCovarianceStamped, "amcl_pose", queue_size=1, latch=True
+        )
+        self.cloud_pub = self.create_publisher(
+            geometry_msgs.PoseArray, "particlecloud", queue_size=1, latch=True
+        )
+        self.create_subscription(
+            nav_msgs.Odometry, "base_pose_ground_truth", self.on_ground_truth, QUEUE_SIZE
+        )
+        self.create_subscription(
+            geometry_msgs.PoseWithCovarianceStamped, "initialpose", self.on_initial_pose, 1
+        )
+
+    def _warn_once(self, key: str, text: str) -> None:
+        if key not in self._warned:
+            self._warned.add(key)
+            self.get_logger().warning(text)
+
+    # -- ground truth --------------------------------------------------------------------------
+    def on_ground_truth(self, msg: nav_msgs.Odometry) -> None:
+        """Queue the message and publish every queued one whose odom -> base is in tf."""
+        self._pending.append(msg)
+        while self._pending:
+            if not self._update(self._pending[0]):
+                return
+            self._pending.popleft()
+
+    def _update(self, msg: nav_msgs.Odometry) -> bool:
+        """Publish tf and pose for one message; False when tf cannot answer yet."""
+        stamp = msg.header.stamp
+        try:
+            t_ob, q_ob = self.tf_buffer.lookup_arrays(self.odom_frame, self.base_frame, stamp)
+        except ExtrapolationError as err:
+            newest = self._newest_odom_time()
+            if newest is not None and newest > stamp.to_sec():
+                self._warn_once("old", f"dropping ground truth older than tf's history: {err}")
+                return True  # too old ever to be answered: drop it
+            return False
+        except TransformError as err:
+            self._warn_once(
+                "lookup",
+                f"waiting for tf {self.odom_frame} -> {self.base_frame}: {err}; is odometry "
+                "published, and are odom_frame_id / base_frame_id / tf_prefix right?",
+            )
+            return False
+        t_mb, q_mb = compose_transforms(*self.offset, *_pose_arrays(msg.pose.pose))
+        # map -> odom = (map -> base) * (odom -> base)^-1
+        t_mo, q_mo = compose_transforms(t_mb, q_mb, *inverse_transform(t_ob, q_ob))
+        future = Time.from_nsec(stamp.to_nsec() + round(self.params.transform_tolerance * 1e9))
+        self.tf_pub.send_transform(
+            make_transform_stamped(self.global_frame, self.odom_frame, future, t_mo, q_mo)
+        )
+        header = std_msgs.Header(stamp=stamp, frame_id=self.global_frame)
+        pose = _pose_msg(t_mb, q_mb)
+        self.pose_pub.publish(
+            geometry_msgs.PoseWithCovarianceStamped(
+                header=header, pose=geometry_msgs.PoseWithCovariance(pose=pose)
+            )
+        )
+        self.cloud_pub.publish(geometry_msgs.PoseArray(header=header, poses=[pose]))
+        return True
+
+    def _newest_odom_time(self) -> float | None:
+        try:
+            return self.tf_buffer.latest_common_time(self.odom_frame, self.base_frame)
+        except TransformError:
+            return None
+
+    # -- initial pose ----------------------------------------------------------------------------
+    def on_initial_pose(self, msg: geometry_msgs.PoseWithCovarianceStamped) -> None:
+        """Shift the offset so that the robot is now at ``msg``'s pose (initPoseReceived)."""
+        frame = normalize_frame(msg.header.frame_id) if msg.header.frame_id else ""
+        if frame != self.global_frame:
+            self.get_logger().warning(
+                f"Frame ID of 'initialpose' ({frame}) is different from the global frame "
+                f"{self.global_frame}"
+            )
+        try:
+            t_bm, q_bm = self.tf_buffer.lookup_arrays(
+                self.base_frame, self.global_frame, msg.header.stamp
+            )
+        except TransformError as err:
+            self.get_logger().warning(f"ignoring initialpose: failed to look up the robot: {err}")
+            return
+        delta = compose_transforms(*_pose_arrays(msg.pose.pose), t_bm, q_bm)
+        self.offset = compose_transforms(*delta, *self.offset)

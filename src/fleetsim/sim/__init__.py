@@ -4,6 +4,10 @@
 the node that publishes its readings and serves the ``/gazebo/*`` services.
 """
 
+import os
+
+os.environ.setdefault("MUJOCO_GL", "egl")  # headless rendering; must precede importing mujoco
+
 from fleetsim.sim.engine import Engine, ModelEntry, load_world
 from fleetsim.sim.queries import Contact
 

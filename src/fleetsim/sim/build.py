@@ -66,7 +66,18 @@ def new_world_spec(timestep: float = 0.002) -> mujoco.MjSpec:
     spec.visual.global_.offwidth = 1920
     spec.visual.global_.offheight = 1080
     spec.visual.map.zfar = 200.0
+    spec.visual.headlight.ambient = [0.35, 0.35, 0.35]
+    spec.visual.headlight.diffuse = [0.5, 0.5, 0.5]
     spec.stat.extent = 20.0
+    spec.add_texture(
+        name="__sky",
+        type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
+        builtin=mujoco.mjtBuiltin.mjBUILTIN_GRADIENT,
+        width=64,
+        height=64,
+        rgb1=[0.75, 0.82, 0.9],
+        rgb2=[0.95, 0.95, 0.95],
+    )
     return spec
 
 

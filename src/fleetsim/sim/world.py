@@ -10,8 +10,6 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
-import numpy as np
-
 from fleetsim.sim.mapworld import OccupancyMap, load_map, wall_boxes
 
 Pose = tuple[float, float, float, float, float, float]
@@ -116,7 +114,7 @@ def world_from_map(yaml_path: str | Path, wall_height: float = 1.0) -> WorldDesc
         for i, b in enumerate(boxes)
     ]
     h, w = grid.occupied.shape
-    extent = float(np.hypot(h, w) * grid.resolution) * 2 + 20.0
+    extent = float(max(h, w) * grid.resolution) + 20.0
     walls = ModelDesc(
         "map_walls", static=True, links=[LinkDesc("link", geoms=geoms)], source=str(yaml_path)
     )

@@ -78,3 +78,35 @@ def test_depth_camera_measures_the_wall_distance():
     # camera at x = 0.1 (laser_link); the wall face at 2.0 - 0.05
     assert float(np.nanmedian(img.depth[20:28, 28:36])) == pytest.approx(1.85, abs=0.02)
     assert img.depth_topic == "front_camera/depth/image_raw"
+
+
+def test_texture_reads_correctly_on_the_plus_x_face(tmp_path):
+    from PIL import Image
+
+    tex = np.zeros((64, 64, 3), np.uint8)
+    tex[:, 32:] = 255  # right half white
+    tex[:16, :32, 0] = 255  # top-left red
+    Image.fromarray(tex).save(tmp_path / "tex.png")
+    marker = ModelDesc(
+        "marker",
+        (1.0, 0, 0.3, 0, 0, np.pi),
+        True,
+        [
+            LinkDesc(
+                "link",
+                geoms=[
+                    GeomDesc(
+                        "box", (0.01, 0.4, 0.4), collide=False, texture=str(tmp_path / "tex.png")
+                    )
+                ],
+            )
+        ],
+    )
+    e = Engine(WorldDesc("w", [ground_plane(), marker]))
+    ent = e.spawn_robot("r", camera_robot("camera", "libgazebo_ros_camera.so"))
+    img = next(p for p in ent.plugins if p.name == "cam_plugin").render(e).astype(float)
+    # the marker covers columns ~24-44 and rows ~4-27 of the 64 x 48 image
+    left, right = img[14:26, 25:31].mean(), img[14:26, 34:42].mean()
+    assert right > left + 150
+    top_left = img[7:10, 25:31].mean(axis=(0, 1))
+    assert top_left[0] > 150 and top_left[1] < 80

@@ -78,6 +78,7 @@ def run_launch(
     realtime: bool = False,
     seed: int = 0,
     progress: bool = True,
+    listen: str | None = None,
 ):
     """Run a launch file; returns the finished session's monitor."""
     from fleetsim.launch.runner import LaunchSession, load_plan
@@ -86,7 +87,7 @@ def run_launch(
         raise LaunchError("give --duration S, --until-goals, or both")
     plan = load_plan(resolve_launch_file(file), args, seed=seed)
     rate = 1.0 if realtime else None
-    with LaunchSession(plan, seed=seed, viz=viz, record=record) as session:
+    with LaunchSession(plan, seed=seed, viz=viz, record=record, listen=listen) as session:
         rt = session.runtime
         total = duration if duration is not None else 3600.0
         until = session.monitor.all_goals_done if until_goals else None
@@ -130,6 +131,12 @@ def register(app: typer.Typer) -> None:
         realtime: bool = typer.Option(False, "--realtime", help="Pace the run to the wall clock."),
         seed: int = typer.Option(0, "--seed", help="The run's random seed."),
         list_: bool = typer.Option(False, "--list", help="List the shipped scenarios."),
+        listen: str = typer.Option(
+            None,
+            "--listen",
+            help="Zenoh endpoint for tools (default $FLEETSIM_ZENOH or tcp/127.0.0.1:7447).",
+        ),
+        no_bridge: bool = typer.Option(False, "--no-bridge", help="Do not listen for tools."),
     ) -> None:
         """Run a launch file headless, then print a results table per robot."""
         if list_:
@@ -138,8 +145,19 @@ def register(app: typer.Typer) -> None:
             return
         if not file:
             raise LaunchError("name a launch file or a scenario (fleetsim launch --list)")
+        from fleetsim.transport.keys import default_endpoint
+
+        endpoint = None if no_bridge else (listen or default_endpoint())
         monitor = run_launch(
-            file, parse_launch_args(args or []), duration, until_goals, record, viz, realtime, seed
+            file,
+            parse_launch_args(args or []),
+            duration,
+            until_goals,
+            record,
+            viz,
+            realtime,
+            seed,
+            listen=endpoint,
         )
         if until_goals and not monitor.success():
             raise typer.Exit(1)

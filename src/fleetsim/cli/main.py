@@ -31,9 +31,14 @@ SUBAPPS = [
     ("fleetsim.cli.urdf", "app", "urdf", "Robot descriptions: check, graph, export."),
     ("fleetsim.cli.sim", "app", "sim", "The simulator: world snapshots."),
     ("fleetsim.cli.bag", "app", "bag", "MCAP recordings: info, play, record."),
+    ("fleetsim.cli.tools", "topic_app", "topic", "Topics of a running simulation."),
+    ("fleetsim.cli.tools", "service_app", "service", "Services of a running simulation."),
+    ("fleetsim.cli.tools", "param_app", "param", "Parameters of a running simulation."),
+    ("fleetsim.cli.tools", "node_app", "node", "Nodes: list them, or run one in this process."),
+    ("fleetsim.cli.tools", "tf_app", "tf", "tf of a running simulation: echo, tree."),
 ]
 # modules with a register(app) function that add single commands
-COMMANDS = ["fleetsim.cli.render", "fleetsim.cli.launch"]
+COMMANDS = ["fleetsim.cli.render", "fleetsim.cli.launch", "fleetsim.cli.tools"]
 
 err_console = Console(stderr=True)
 
@@ -71,12 +76,7 @@ def demo(
 
 def _add_subapps() -> None:
     for module, attr, name, help_text in SUBAPPS:
-        try:
-            mod = importlib.import_module(module)
-        except ModuleNotFoundError as e:
-            if e.name == module:  # not written yet
-                continue
-            raise
+        mod = importlib.import_module(module)
         app.add_typer(getattr(mod, attr), name=name, help=help_text)
     for module in COMMANDS:
         importlib.import_module(module).register(app)

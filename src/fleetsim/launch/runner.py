@@ -44,11 +44,14 @@ class LaunchSession:
     seed: int = 0
     viz: bool = False
     record: str | Path | None = None
+    #: Zenoh endpoint the run listens on for tools and other processes; None: no bridge
+    listen: str | None = None
     runtime: Runtime = field(init=False)
     nodes: dict[str, Any] = field(default_factory=dict, init=False)
     skipped: list[str] = field(default_factory=list, init=False)
     recorder: Any = field(default=None, init=False)
     live: Any = field(default=None, init=False)
+    bridge: Any = field(default=None, init=False)
     monitor: RunMonitor = field(init=False)
 
     def __post_init__(self) -> None:
@@ -71,6 +74,11 @@ class LaunchSession:
         for spec in self.plan.nodes:
             self._start_node(spec)
         self.monitor = RunMonitor(rt, self.plan, self.nodes)
+        if self.listen is not None:
+            from fleetsim.transport import ZenohBridge
+
+            self.bridge = ZenohBridge(rt, listen=[self.listen])
+            _log.info(f"listening for fleetsim tools on {self.listen}")
 
     def _start_node(self, spec: NodeSpec) -> None:
         if (spec.pkg, spec.type) in VIEWERS:
@@ -106,13 +114,23 @@ class LaunchSession:
     def close(self) -> None:
         """Shut the run down; the recording is finalised whatever happened."""
         errors = []
-        for closer in (self.runtime.shutdown, self._close_recorder, self._close_live):
+        closers = (
+            self.runtime.shutdown,
+            self._close_bridge,
+            self._close_recorder,
+            self._close_live,
+        )
+        for closer in closers:
             try:
                 closer()
             except Exception as e:  # keep closing the rest
                 errors.append(e)
         if errors:
             raise errors[0]
+
+    def _close_bridge(self) -> None:
+        if self.bridge is not None:
+            self.bridge.close()
 
     def _close_recorder(self) -> None:
         if self.recorder is not None:

@@ -188,6 +188,12 @@ class Graph:
         self._changed("subscribe", name, sub)
         return sub
 
+    def deliver(self, sub: Subscription, msg: Any) -> None:
+        """Queue ``msg`` for one subscription, as a publish would (bridges use this to hand
+        messages from other processes to local subscribers)."""
+        sub.queue.append(msg)
+        self._pending.append(sub)
+
     def drain(self) -> int:
         """Deliver every pending message in FIFO order; returns how many were delivered."""
         pending = self._pending

@@ -194,5 +194,4 @@ class TopicBridging:
         for sub in targets:
             if sub in own or sub.topic is not topic or sub not in topic.subscriptions:
                 continue
-            sub.queue.append(msg)
-            sub._pending.append(sub)
+            self.graph.deliver(sub, msg)

@@ -16,9 +16,13 @@ def world_bounds(engine) -> tuple[np.ndarray, np.ndarray]:
     keep = m.geom_type != mujoco.mjtGeom.mjGEOM_PLANE
     if not keep.any():
         return np.array([-5.0, -5.0, 0.0]), np.array([5.0, 5.0, 1.0])
-    r = m.geom_rbound[keep][:, None]
-    pos = d.geom_xpos[keep]
-    return (pos - r).min(axis=0), (pos + r).max(axis=0)
+    R = np.abs(d.geom_xmat[keep].reshape(-1, 3, 3))
+    aabb = m.geom_aabb[keep]
+    centre = d.geom_xpos[keep] + np.einsum(
+        "gij,gj->gi", d.geom_xmat[keep].reshape(-1, 3, 3), aabb[:, :3]
+    )
+    half = np.einsum("gij,gj->gi", R, aabb[:, 3:])
+    return (centre - half).min(axis=0), (centre + half).max(axis=0)
 
 
 def overview_image(

@@ -77,13 +77,14 @@ class WorldDesc:
     occupancy: OccupancyMap | None = None  # set for map worlds
 
 
-def ground_plane(size: float = 100.0) -> ModelDesc:
+def ground_plane(size: float = 100.0, centre: tuple[float, float] = (0.0, 0.0)) -> ModelDesc:
     """Gazebo's ``model://ground_plane``: a static 100 x 100 m plane (mu 100, mu2 50)."""
     geom = GeomDesc(
         "plane", (size, size), name="collision", rgba=(0.7, 0.7, 0.7, 1.0), friction=(100.0, 50.0)
     )
     return ModelDesc(
         "ground_plane",
+        (centre[0], centre[1], 0.0, 0.0, 0.0, 0.0),
         static=True,
         links=[LinkDesc("link", geoms=[geom])],
         source="model://ground_plane",
@@ -115,12 +116,14 @@ def world_from_map(yaml_path: str | Path, wall_height: float = 1.0) -> WorldDesc
     ]
     h, w = grid.occupied.shape
     extent = float(max(h, w) * grid.resolution) + 20.0
+    lo, hi = boxes[:, :2].min(axis=0), boxes[:, :2].max(axis=0)
+    centre = (float((lo[0] + hi[0]) / 2), float((lo[1] + hi[1]) / 2)) if len(boxes) else (0, 0)
     walls = ModelDesc(
         "map_walls", static=True, links=[LinkDesc("link", geoms=geoms)], source=str(yaml_path)
     )
     return WorldDesc(
         name=Path(yaml_path).stem,
-        models=[ground_plane(extent), walls],
+        models=[ground_plane(extent, centre), walls],
         lights=[sun()],
         source=str(yaml_path),
         occupancy=grid,

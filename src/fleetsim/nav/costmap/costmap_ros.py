@@ -1,0 +1,401 @@
+"""Costmap2DROS: a `LayeredCostmap` wired to topics and tf inside a node (costmap_2d's wrapper).
+
+move_base creates two, ``global_costmap`` and ``local_costmap``; each reads its parameters from
+``~<name>/`` (both the plugins form and the pre-Hydro form, see `LayeredCostmap.from_params`)
+and then, as costmap_2d does:
+
+* each static layer subscribes to its ``map_topic`` (default ``map``) resolved in the *node's*
+  namespace, as StaticLayer's global node handle does: ``/lizi1/map`` for a move_base in
+  ``/lizi1`` unless the launch file remaps ``map`` (the lesson remaps it to ``/map``);
+* each observation source subscribes to its ``topic`` (same resolution) as ``LaserScan`` or
+  ``PointCloud2``; readings are projected (laser_geometry's projectLaser) and moved into the
+  costmap's ``global_frame`` with tf at the message's stamp; a reading whose stamp tf cannot
+  answer is moved with the newest transform when that is within ``transform_tolerance`` of the
+  stamp, and dropped (with a warning) otherwise;
+* every ``1 / update_frequency`` s the robot pose (``robot_base_frame`` in ``global_frame``,
+  newest tf, stale beyond ``transform_tolerance``) drives one layered update, and the robot
+  footprint is published on ``~<name>/footprint`` (PolygonStamped);
+* every ``1 / publish_frequency`` s the master grid goes out on ``~<name>/costmap``
+  (OccupancyGrid, latched, costs translated as costmap_2d's publisher does). The whole grid is
+  sent each time (there is no ``costmap_updates`` topic).
+
+Frames get the robot's ``tf_prefix`` as ``tf::resolve`` applies it: ``/map`` is ``map``,
+``base_link`` is ``lizi1/base_link`` (a frame already spelled ``lizi1/base_link`` is kept), and
+a bare ``map`` is ``lizi1/map`` - write ``global_frame: /map`` for the shared map, as the
+lesson's files do; the node warns when the prefixed frame is unknown but the bare one exists.
+
+Nothing blocks: before the map or tf arrive the costmap is simply not `ready` (warned about,
+retried every cycle) and move_base waits.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+
+from fleetsim.errors import FleetsimError, TransformError
+from fleetsim.msgs import geometry_msgs, get_type, nav_msgs, sensor_msgs, std_msgs
+from fleetsim.nav.costmap.footprint import footprint_at
+from fleetsim.nav.costmap.layer import Bounds, Layer
+from fleetsim.nav.costmap.layered_costmap import LayeredCostmap
+from fleetsim.nav.costmap.obstacle_layer import ObstacleLayer, laser_scan_points
+from fleetsim.nav.costmap.static_layer import StaticLayer
+from fleetsim.nav.errors import CostmapError, MapError
+from fleetsim.nav.map_server import grid_msg_from_map, map_from_grid_msg
+from fleetsim.tf import resolve_frame_once
+from fleetsim.tf.names import normalize_frame
+
+_CLOUD_DTYPES = {7: "f4", 8: "f8"}  # PointField.FLOAT32, FLOAT64
+
+
+def points_from_cloud2(msg: Any, where: str = "PointCloud2") -> np.ndarray:
+    """The x, y, z of a PointCloud2 (FLOAT32 or FLOAT64 fields), NaN points dropped: (N, 3) m."""
+    fields = {f.name: f for f in msg.fields}
+    missing = [k for k in "xyz" if k not in fields]
+    if missing:
+        raise CostmapError(f"{where}: the cloud has no field(s) {', '.join(missing)}")
+    n = int(msg.width) * int(msg.height)
+    step = int(msg.point_step)
+    raw = np.asarray(msg.data, dtype=np.uint8)
+    row = int(msg.row_step) or step * int(msg.width)
+    if raw.size < row * (int(msg.height) - 1) + step * int(msg.width) or n == 0:
+        return np.zeros((0, 3))
+    endian = ">" if msg.is_bigendian else "<"
+    out = np.empty((n, 3))
+    rows = raw[: row * int(msg.height)].reshape(int(msg.height), row)[:, : step * int(msg.width)]
+    flat = np.ascontiguousarray(rows).reshape(n, step)
+    for i, k in enumerate("xyz"):
+        f = fields[k]
+        kind = _CLOUD_DTYPES.get(int(f.datatype))
+        if kind is None:
+            raise CostmapError(f"{where}: field '{k}' has datatype {f.datatype}; need FLOAT32/64")
+        size = int(kind[1])
+        col = np.ascontiguousarray(flat[:, f.offset : f.offset + size])
+        out[:, i] = col.view(endian + kind).ravel()
+    return out[np.isfinite(out).all(axis=1)]
+
+
+class ExtraBounds(Layer):
+    """A layer that only widens the next update's bounds (costmap_2d's addExtraBounds)."""
+
+    def __init__(self) -> None:
+        super().__init__("extra_bounds")
+        self.pending = Bounds()
+
+    def add(self, min_x: float, min_y: float, max_x: float, max_y: float) -> None:
+        self.pending.include(min_x, min_y, max_x, max_y)
+
+    def update_bounds(self, robot_x: float, robot_y: float, robot_yaw: float, bounds: Bounds):
+        if not self.pending.empty:
+            p = self.pending
+            bounds.include(p.min_x, p.min_y, p.max_x, p.max_y)
+            self.pending = Bounds()
+
+
+class Costmap2DROS:
+    """One costmap inside ``node``, named ``name`` (``~name/`` holds its parameters)."""
+
+    def __init__(self, node: Any, name: str) -> None:
+        self.node = node
+        self.name = name
+        self.ns = f"{node.full_name}/{name}"
+        raw = node.runtime.params.get(self.ns, {})
+        if not isinstance(raw, dict):
+            raise CostmapError(f"{self.ns}: the costmap parameters must be a mapping, got {raw!r}")
+        self.layered = LayeredCostmap.from_params(raw, self.ns)
+        self.extra = ExtraBounds()
+        self.layered.add_layer(self.extra)
+        p = self.params = self.layered.params
+        prefix = node.tf_prefix
+        self.global_frame = resolve_frame_once(prefix, p.global_frame)
+        self.robot_base_frame = resolve_frame_once(prefix, p.robot_base_frame)
+        self._bare_global = normalize_frame(p.global_frame)
+        self.stopped = False
+        self.initialized = False  # one update ran with every static layer holding a map
+        self.update_count = 0
+        self.last_pose: tuple[float, float, float] | None = None
+        self._warned: dict[str, float] = {}
+        self._last_reading: dict[tuple[str, str], float] = {}
+        self._subs: list[Any] = []
+        _ = node.tf_buffer  # listen to /tf from now on
+        self.costmap_pub = node.create_publisher(
+            nav_msgs.OccupancyGrid, f"~{name}/costmap", queue_size=1, latch=True
+        )
+        self.footprint_pub = node.create_publisher(
+            geometry_msgs.PolygonStamped, f"~{name}/footprint", queue_size=1
+        )
+        for layer in self.layered.layers:
+            if isinstance(layer, StaticLayer):
+                self._subscribe_map(layer)
+            elif isinstance(layer, ObstacleLayer):
+                for source in layer.buffers:
+                    self._subscribe_source(layer, source)
+        if p.update_frequency > 0:
+            node.create_timer(1.0 / p.update_frequency, self.update)
+        if p.publish_frequency > 0:
+            node.create_timer(1.0 / p.publish_frequency, self.publish)
+
+    # -- helpers -----------------------------------------------------------------------------
+    @property
+    def costmap(self):
+        """The master `Costmap2D` (planners and controllers read it)."""
+        return self.layered.costmap
+
+    @property
+    def footprint(self) -> np.ndarray:
+        """The padded footprint polygon, (K, 2) m in the robot frame."""
+        return self.layered.footprint
+
+    def _warn(self, key: str, text: str, period: float = 5.0) -> None:
+        """Warn at most once every ``period`` s of sim time per key (ROS_WARN_THROTTLE)."""
+        now = self.node.now()
+        last = self._warned.get(key)
+        if last is None or now - last >= period:
+            self._warned[key] = now
+            self.node.get_logger().warning(f"{self.name}: {text}")
+
+    def _static_layers(self) -> list[StaticLayer]:
+        return [la for la in self.layered.layers if isinstance(la, StaticLayer)]
+
+    # -- inputs --------------------------------------------------------------------------------
+    def _subscribe_map(self, layer: StaticLayer) -> None:
+        topic = layer.params.map_topic
+        if layer.params.subscribe_to_updates:
+            self._warn("updates", "subscribe_to_updates is not supported; only full maps are read")
+
+        def on_map(msg: Any) -> None:
+            if self.stopped:
+                return
+            where = f"{self.ns}/{layer.name}: {self.node.resolve_name(topic)}"
+            try:
+                occupancy = map_from_grid_msg(msg, where)
+            except MapError as err:
+                self.node.get_logger().error(f"ignoring map: {err}")
+                return
+            frame = normalize_frame(msg.header.frame_id) if msg.header.frame_id else ""
+            if frame and frame != self.global_frame:
+                self._warn(
+                    "map_frame",
+                    f"the map on {where} is in frame '{frame}' but the costmap's global_frame is "
+                    f"'{self.global_frame}'; the map is used as if it were in the global frame",
+                )
+            layer.set_map(occupancy)
+
+        self._subs.append(self.node.create_subscription(nav_msgs.OccupancyGrid, topic, on_map, 1))
+
+    def _subscribe_source(self, layer: ObstacleLayer, source: str) -> None:
+        sp = layer.buffers[source].params
+        where = f"{self.ns}/{layer.name}/{source}"
+        if sp.data_type == "LaserScan":
+            msg_type, convert = sensor_msgs.LaserScan, self._scan_points
+        elif sp.data_type == "PointCloud2":
+            msg_type, convert = sensor_msgs.PointCloud2, self._cloud2_points
+        else:
+            try:
+                msg_type = get_type("sensor_msgs/PointCloud")
+            except FleetsimError:
+                raise CostmapError(
+                    f"{where}: data_type PointCloud (sensor_msgs/PointCloud, ROS 1's old cloud) "
+                    "is not available; publish PointCloud2 and set data_type: PointCloud2, or "
+                    "use data_type: LaserScan"
+                ) from None
+            convert = self._cloud1_points
+        sensor_frame = (
+            resolve_frame_once(self.node.tf_prefix, sp.sensor_frame) if sp.sensor_frame else ""
+        )
+
+        def on_reading(msg: Any) -> None:
+            if self.stopped:
+                return
+            try:
+                points = convert(msg, sp, where)
+            except CostmapError as err:
+                self._warn(f"bad:{where}", f"ignoring a reading: {err}")
+                return
+            frame = normalize_frame(msg.header.frame_id)
+            stamp = msg.header.stamp.to_sec()
+            moved = self._to_global(frame, stamp, where)
+            if moved is None:
+                return
+            rot, trans = moved
+            origin = trans
+            if sensor_frame and sensor_frame != frame:
+                at = self._to_global(sensor_frame, stamp, where)
+                if at is None:
+                    return
+                origin = at[1]
+            layer.add_observation(source, origin, points @ rot.T + trans, stamp)
+            self._last_reading[(layer.name, source)] = self.node.now()
+
+        self._subs.append(self.node.create_subscription(msg_type, sp.topic, on_reading, 1))
+
+    @staticmethod
+    def _scan_points(msg: Any, sp: Any, where: str) -> np.ndarray:
+        return laser_scan_points(
+            msg.ranges,
+            msg.angle_min,
+            msg.angle_increment,
+            msg.range_min,
+            msg.range_max,
+            sp.inf_is_valid,
+        )
+
+    @staticmethod
+    def _cloud2_points(msg: Any, sp: Any, where: str) -> np.ndarray:
+        return points_from_cloud2(msg, where)
+
+    @staticmethod
+    def _cloud1_points(msg: Any, sp: Any, where: str) -> np.ndarray:
+        return np.array([[p.x, p.y, p.z] for p in msg.points], dtype=np.float64).reshape(-1, 3)
+
+    def _to_global(self, frame: str, stamp: float, where: str):
+        """(rotation (3, 3), translation (3,)) of ``frame`` in the global frame, or None."""
+        buf = self.node.tf_buffer
+        try:
+            m = buf.lookup_matrix(self.global_frame, frame, stamp)
+        except TransformError as err:
+            try:
+                latest = buf.latest_common_time(self.global_frame, frame)
+                if abs(latest - stamp) > self.params.transform_tolerance and stamp > 0:
+                    raise err
+                m = buf.lookup_matrix(self.global_frame, frame, 0.0)
+            except TransformError as final:
+                self._warn(
+                    f"tf:{where}", f"dropping a reading of {where} in frame '{frame}': {final}"
+                )
+                self._hint_frame()
+                return None
+        return m[:3, :3], m[:3, 3]
+
+    def _hint_frame(self) -> None:
+        if self.global_frame == self._bare_global:
+            return
+        known = self.node.tf_buffer.all_frames()
+        if self.global_frame not in known and self._bare_global in known:
+            self._warn(
+                "hint",
+                f"global_frame '{self.params.global_frame}' resolves to '{self.global_frame}' "
+                f"under tf_prefix, which tf does not know; write '/{self._bare_global}' for the "
+                "shared frame",
+                period=60.0,
+            )
+
+    # -- outputs and state ---------------------------------------------------------------------
+    def robot_pose(self) -> tuple[float, float, float] | None:
+        """The robot's (x, y, yaw) in the global frame from the newest tf, or None (warned)."""
+        buf = self.node.tf_buffer
+        try:
+            pose = buf.lookup_pose2d(self.global_frame, self.robot_base_frame, 0.0)
+            stamp = buf.latest_common_time(self.global_frame, self.robot_base_frame)
+        except TransformError as err:
+            self._warn("pose", f"cannot get the robot pose: {err}")
+            self._hint_frame()
+            return None
+        now = self.node.now()
+        if stamp > 0 and now - stamp > self.params.transform_tolerance:
+            self._warn(
+                "timeout",
+                f"transform timeout. Current time: {now:.4f}, global_pose stamp: {stamp:.4f}, "
+                f"tolerance: {self.params.transform_tolerance:.4f}",
+            )
+            return None
+        return pose
+
+    def update(self) -> bool:
+        """One costmap update at the current robot pose; False when it could not run."""
+        if self.stopped:
+            return False
+        pose = self.robot_pose()
+        if pose is None:
+            return False
+        missing = [la.name for la in self._static_layers() if la.map_grid is None]
+        if missing:
+            self._warn("map", f"waiting for the map on {', '.join(self._map_topics())}")
+        self.layered.update_map(*pose)
+        self.last_pose = pose
+        self.update_count += 1
+        self.initialized = self.initialized or not missing
+        self._publish_footprint(pose)
+        return True
+
+    def _map_topics(self) -> list[str]:
+        return [self.node.resolve_name(la.params.map_topic) for la in self._static_layers()]
+
+    def _publish_footprint(self, pose: tuple[float, float, float]) -> None:
+        if self.footprint_pub.get_num_connections() == 0:
+            return
+        poly = footprint_at(self.footprint, *pose)
+        self.footprint_pub.publish(
+            geometry_msgs.PolygonStamped(
+                header=std_msgs.Header(stamp=self.node.now_msg(), frame_id=self.global_frame),
+                polygon=geometry_msgs.Polygon(
+                    points=[geometry_msgs.Point32(x=float(x), y=float(y)) for x, y in poly]
+                ),
+            )
+        )
+
+    def publish(self) -> None:
+        """Publish the master grid on ``~<name>/costmap``."""
+        if not self.initialized or self.stopped:
+            return
+        self.costmap_pub.publish(
+            grid_msg_from_map(self.layered.occupancy_grid(), self.global_frame, self.node.now_msg())
+        )
+
+    def is_current(self) -> bool:
+        """Updated, and every source with an ``expected_update_rate`` heard from within it."""
+        if not self.initialized or self.stopped:
+            return False
+        now = self.node.now()
+        for layer in self.layered.layers:
+            if not isinstance(layer, ObstacleLayer):
+                continue
+            for source, buf in layer.buffers.items():
+                rate = buf.params.expected_update_rate
+                if rate <= 0:
+                    continue
+                last = self._last_reading.get((layer.name, source), -math.inf)
+                if now - last > rate:
+                    topic = self.node.resolve_name(buf.params.topic)
+                    self._warn(
+                        f"stale:{source}",
+                        f"the observation source '{source}' ({topic}) has not been updated for "
+                        f"{now - last:.2f} s (expected_update_rate {rate:g} s)",
+                    )
+                    return False
+        return True
+
+    def reset_layers(self) -> None:
+        """Forget all sensor data (clear_costmaps); the static map is re-applied next update."""
+        self.layered.reset_layers()
+
+    def mark_full_update(self) -> None:
+        """Recompute the whole grid at the next update (after a layer was cleared directly)."""
+        m = self.costmap
+        self.extra.add(
+            m.origin_x,
+            m.origin_y,
+            m.origin_x + m.size_x * m.resolution,
+            m.origin_y + m.size_y * m.resolution,
+        )
+
+    def stop(self) -> None:
+        """Stop updating and reading sensors (shutdown_costmaps)."""
+        self.stopped = True
+        self.initialized = False
+
+    def start(self) -> None:
+        """Resume after `stop`; ready again after the next update."""
+        if self.stopped:
+            self.stopped = False
+            self._last_reading.clear()
+            for layer in self.layered.layers:
+                if isinstance(layer, StaticLayer):
+                    layer.reset()
+
+    def destroy(self) -> None:
+        for sub in self._subs:
+            sub.destroy()
+        self._subs.clear()

@@ -1,0 +1,198 @@
+"""Costmap2DROS: parameters under ~name, map and sensor topics, tf, update/publish, readiness."""
+
+import math
+
+import numpy as np
+import pytest
+from nav_world import KinematicRobot, fill, room_grid, room_map
+
+from fleetsim.msgs import geometry_msgs, nav_msgs, sensor_msgs, std_msgs
+from fleetsim.msgs.builtin_interfaces import Time
+from fleetsim.nav.costmap import LETHAL_OBSTACLE, NO_INFORMATION
+from fleetsim.nav.costmap.costmap_ros import Costmap2DROS, points_from_cloud2
+from fleetsim.nav.errors import CostmapError
+from fleetsim.nav.fake_localization import FakeLocalization
+from fleetsim.nav.map_server import grid_msg_from_map
+from fleetsim.runtime import Node, Runtime
+
+COMMON = {  # a costmap_common_params.yaml in the lesson's style (pre-Hydro form)
+    "obstacle_range": 2.5,
+    "raytrace_range": 3.0,
+    "robot_radius": 0.2,
+    "inflation_radius": 0.4,
+    "observation_sources": "scan",
+    "scan": {"data_type": "LaserScan", "topic": "scan", "marking": True, "clearing": True},
+}
+GLOBAL = {"global_frame": "/map", "robot_base_frame": "base_link", "update_frequency": 5.0,
+          "publish_frequency": 1.0, "static_map": True}  # fmt: skip
+LOCAL = {"global_frame": "odom", "robot_base_frame": "base_link", "update_frequency": 5.0,
+         "publish_frequency": 2.0, "static_map": False, "rolling_window": True,
+         "width": 3.0, "height": 3.0, "resolution": 0.05}  # fmt: skip
+
+
+class MapPub(Node):
+    def __init__(self, rt, occupancy=None):
+        super().__init__(rt, "map_server")
+        self.pub = self.create_publisher(nav_msgs.OccupancyGrid, "map", 1, latch=True)
+        self.pub.publish(grid_msg_from_map(occupancy or room_map(), "map"))
+
+
+def host(rt, name, extra=None, remaps=None, ns="/lizi1"):
+    base = GLOBAL if name == "global_costmap" else LOCAL
+    rt.params.update(f"{ns}/move_base/{name}", {**COMMON, **base, **(extra or {})})
+    node = Node(rt, "move_base", ns, remaps=remaps)
+    return node, Costmap2DROS(node, name)
+
+
+def world(name="global_costmap", extra=None, start=(1.0, 1.0, 0.0), remap=True, robot=True):
+    rt = Runtime()
+    rt.params.set("/lizi1/tf_prefix", "lizi1")
+    MapPub(rt)
+    bot = KinematicRobot(rt, start=start) if robot else None
+    FakeLocalization(rt, namespace="/lizi1")
+    node, cm = host(rt, name, extra, {"map": "/map"} if remap else None)
+    return rt, bot, node, cm
+
+
+def test_global_costmap_reads_the_map_marks_walls_and_publishes():
+    rt, bot, node, cm = world()
+    assert (cm.global_frame, cm.robot_base_frame) == ("map", "lizi1/base_link")
+    got = []
+    Node(rt, "viewer").create_subscription(
+        nav_msgs.OccupancyGrid, "/lizi1/move_base/global_costmap/costmap", got.append
+    )
+    foot = []
+    Node(rt, "viewer2").create_subscription(
+        geometry_msgs.PolygonStamped, "/lizi1/move_base/global_costmap/footprint", foot.append
+    )
+    rt.run(duration=1.05)
+    assert cm.initialized and cm.is_current()
+    m = cm.costmap
+    assert (m.size_x, m.size_y, m.resolution) == (160, 120, 0.05)
+    assert m.costs[0, 0] == LETHAL_OBSTACLE and m.costs[20, 80] == LETHAL_OBSTACLE  # wall x=4
+    assert m.costs[60, 80] == 0  # the door
+    assert 0 < m.costs[20, 74] < LETHAL_OBSTACLE  # inflated, 0.25 m from the wall
+    assert m.costs[60, 40] == 0
+    assert len(got) == 1 and got[0].header.frame_id == "map"
+    assert got[0].data.reshape(120, 160)[0, 0] == 100
+    assert foot and foot[-1].header.frame_id == "map"
+    xs = [p.x for p in foot[-1].polygon.points]
+    assert min(xs) == pytest.approx(1.0 - 0.21, abs=1e-3)  # radius 0.2 + padding 0.01
+
+
+def test_map_topic_resolves_in_the_node_namespace_unless_remapped():
+    rt, bot, node, cm = world(remap=False)
+    assert [s.node for s in rt.graph.topics["/lizi1/map"].subscriptions] == [node]
+    rt.run(duration=0.5)
+    assert not cm.initialized  # nothing on /lizi1/map
+
+
+def test_scan_marks_an_unmapped_obstacle_in_the_odom_frame_and_clears_it():
+    extra = room_grid()
+    fill(extra, 2.0, 0.8, 2.2, 1.2)  # a 0.2 m box 1 m ahead of the robot, not on the map
+    rt, bot, node, cm = world("local_costmap", start=(1.0, 1.0, math.pi / 2))
+    bot.set_world(extra)
+    rt.run(duration=1.0)
+    # odom is the start pose (yaw 90 deg): map (2.0..2.2, 0.8..1.2) is odom x -0.2..0.2, y -1..-1.2
+    m = cm.costmap
+    cell = m.world_to_map(0.0, -1.02)
+    assert m.costs[cell[1], cell[0]] == LETHAL_OBSTACLE
+    assert m.origin_x == pytest.approx(-1.5, abs=0.05) and m.size_x == 60
+    bot.set_world(room_grid())  # the box is taken away
+    rt.run(duration=1.0)
+    assert m.costs[cell[1], cell[0]] < LETHAL_OBSTACLE
+
+
+def test_pose_waits_for_tf_and_warns(caplog):
+    rt, bot, node, cm = world(robot=False)
+    rt.run(duration=0.5)
+    assert cm.robot_pose() is None and not cm.initialized
+    assert "cannot get the robot pose" in caplog.text
+    KinematicRobot(rt)  # tf arrives late: the costmap starts on its own
+    rt.run(duration=0.5)
+    assert cm.initialized
+
+
+def test_stale_tf_is_a_transform_timeout(caplog):
+    rt, bot, node, cm = world(extra={"transform_tolerance": 0.3})
+    rt.run(duration=0.5)
+    assert cm.robot_pose() is not None
+    bot.destroy()  # tf stops
+    rt.run(duration=1.0)
+    assert cm.robot_pose() is None
+    assert "transform timeout" in caplog.text
+
+
+def test_bare_global_frame_gets_the_prefix_and_a_hint(caplog):
+    rt, bot, node, cm = world(extra={"global_frame": "map"})
+    assert cm.global_frame == "lizi1/map"
+    rt.run(duration=0.5)
+    assert not cm.initialized
+    assert "write '/map' for the shared frame" in caplog.text
+
+
+def test_point_cloud_source_and_cloud_parsing():
+    pts = np.array([[1.0, 2.0, 0.5], [np.nan, 0.0, 0.0], [-3.0, 0.25, 1.0]], dtype=np.float32)
+    fields = [sensor_msgs.PointField(name=k, offset=4 * i, datatype=7, count=1)
+              for i, k in enumerate("xyz")]  # fmt: skip
+    cloud = sensor_msgs.PointCloud2(
+        header=std_msgs.Header(frame_id="lizi1/laser", stamp=Time.from_sec(0.5)),
+        height=1, width=3, fields=fields, point_step=12, row_step=36,
+        data=np.frombuffer(pts.tobytes(), dtype=np.uint8),
+    )  # fmt: skip
+    got = points_from_cloud2(cloud)
+    np.testing.assert_allclose(got, pts[[0, 2]].astype(np.float64))
+    bad = sensor_msgs.PointCloud2(fields=fields[:2])
+    with pytest.raises(CostmapError, match=r"no field\(s\) z"):
+        points_from_cloud2(bad)
+    extra = {"observation_sources": "cloud",
+             "cloud": {"data_type": "PointCloud2", "topic": "points", "marking": True}}  # fmt: skip
+    rt, bot, node, cm = world(extra=extra)
+    pub = Node(rt, "camera", "/lizi1").create_publisher(sensor_msgs.PointCloud2, "points")
+    rt.run(duration=0.5)
+    pub.publish(cloud)  # laser at map (1.1, 1.0, 0.2): point (1, 2) lands at (2.1, 3.0)
+    rt.run(duration=0.25)
+    c = cm.costmap.world_to_map(2.1, 3.0)
+    assert cm.costmap.costs[c[1], c[0]] == LETHAL_OBSTACLE
+
+
+def test_old_point_cloud_type_is_refused():
+    rt = Runtime()
+    extra = {"observation_sources": "c", "c": {"data_type": "PointCloud", "topic": "c"}}
+    with pytest.raises(CostmapError, match=r"lizi1/move_base/global_costmap/obstacle_layer/c: "
+                       r"data_type PointCloud"):  # fmt: skip
+        host(rt, "global_costmap", extra)
+
+
+def test_expected_update_rate_makes_a_silent_sensor_stale(caplog):
+    extra = {"scan": {**COMMON["scan"], "expected_update_rate": 0.3}}
+    rt, bot, node, cm = world(extra=extra)
+    rt.run(duration=0.6)
+    assert cm.is_current()
+    bot.scan_timer.cancel()
+    rt.run(duration=0.6)
+    assert not cm.is_current()
+    assert "'scan' (/lizi1/scan) has not been updated" in caplog.text
+
+
+def test_reset_stop_start_and_full_update_after_a_direct_clear():
+    extra = room_grid()
+    fill(extra, 2.0, 0.8, 2.2, 1.2)
+    rt, bot, node, cm = world()
+    bot.set_world(extra)
+    rt.run(duration=0.6)
+    c = cm.costmap.world_to_map(2.05, 1.0)
+    assert cm.costmap.costs[c[1], c[0]] == LETHAL_OBSTACLE
+    layer = cm.layered.layer("obstacle_layer")
+    layer.grid.costs[:] = NO_INFORMATION  # what a clearing recovery does to the layer
+    cm.mark_full_update()
+    bot.scan_timer.cancel()  # no new readings
+    layer.buffers["scan"].observations = []
+    cm.update()
+    assert cm.costmap.costs[c[1], c[0]] == 0
+    cm.stop()
+    assert not cm.is_current() and not cm.update()
+    cm.start()
+    assert cm.update() and cm.is_current()
+    cm.reset_layers()
+    assert cm.update() and cm.costmap.costs[0, 0] == LETHAL_OBSTACLE

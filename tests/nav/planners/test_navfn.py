@@ -95,3 +95,58 @@ def test_unknown_space_respects_allow_unknown():
     assert len(NavFn(m).create_plan((0.5, 1.0, 0), (3.5, 1.0, 0))) > 2
     with pytest.raises(NoPathFound):
         NavFn(m, NavfnParams(allow_unknown=False)).create_plan((0.5, 1.0, 0), (3.5, 1.0, 0))
+
+
+def navfn_reference(costarr, nx, goal):
+    """navfn's propNavFnDijkstra + updateCell transcribed line by line (float32 scalars)."""
+    f32 = np.float32
+    ns = costarr.size
+    pot = np.full(ns, POT_HIGH, np.float32)
+    pending = np.zeros(ns, bool)
+    cur, nxt, over = [], [], []
+
+    def push(buf, n):
+        if 0 <= n < ns and not pending[n] and costarr[n] < 254:
+            buf.append(n)
+            pending[n] = True
+
+    pot[goal] = 0
+    for n in (goal + 1, goal - 1, goal - nx, goal + nx):
+        push(cur, n)
+    cur_t = f32(254)
+    while cur or nxt:
+        for n in cur:
+            pending[n] = False
+        for n in cur:
+            le, ri, up, dn = pot[n - 1], pot[n + 1], pot[n - nx], pot[n + nx]
+            tc, ta = min(le, ri), min(up, dn)
+            hf = f32(costarr[n])
+            dc = tc - ta
+            if dc < 0:
+                dc, ta = -dc, tc
+            if dc >= hf:
+                p = f32(ta + hf)
+            else:
+                d = f32(dc / hf)
+                p = f32(ta + hf * (f32(-0.2301) * d * d + f32(0.5307) * d + f32(0.7040)))
+            if p < pot[n]:
+                pot[n] = p
+                buf = nxt if p < cur_t else over
+                for m, v in ((n - 1, le), (n + 1, ri), (n - nx, up), (n + nx, dn)):
+                    if v > p + f32(0.707106781) * f32(costarr[m]):
+                        push(buf, m)
+        cur, nxt = nxt, []
+        if not cur:
+            cur_t = f32(cur_t + 100)
+            cur, over = over, []
+    return pot
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_potential_is_navfns_bit_for_bit(seed):
+    rng = np.random.default_rng(seed)
+    costs = random_grid(rng, 16, 20)
+    costarr = navfn_costs(costs, True)
+    src = int(rng.choice(np.flatnonzero(costarr < 254)))
+    pot, _ = navfn_potential(costarr, 20, src, 0, False, 10**6)
+    assert np.array_equal(pot, navfn_reference(costarr, 20, src))

@@ -78,7 +78,8 @@ def densified_plan(plan_xy: np.ndarray, resolution: float) -> np.ndarray:
         return p.copy()
     seg = np.diff(p, axis=0)
     n = np.maximum(1, np.ceil(np.hypot(seg[:, 0], seg[:, 1]) / resolution).astype(np.int64))
-    t = np.concatenate([np.arange(k) / k for k in n])
+    first = np.repeat(np.cumsum(n) - n, n)  # index of each segment's first point
+    t = (np.arange(first.shape[0]) - first) / np.repeat(n, n)  # 0, 1/k, ..., (k-1)/k
     starts = np.repeat(p[:-1], n, axis=0)
     out = starts + np.repeat(seg, n, axis=0) * t[:, None]
     return np.concatenate([out, p[-1:]], axis=0)

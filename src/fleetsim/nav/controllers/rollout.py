@@ -13,7 +13,82 @@ import math
 import numpy as np
 from numba import njit
 
+from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
 from fleetsim.nav.costmap.footprint import footprint_cost_at
+
+_SLACK = 1e-6  # cells: margin for rounding when bounding where an outline point can land
+
+
+def reach_offsets(outline: np.ndarray, resolution: float) -> np.ndarray:
+    """Cell offsets an outline point can land in, relative to the robot centre's cell.
+
+    The centre lies anywhere in its cell and every outline point within ``R`` (the largest
+    outline point norm) of it, so a point's cell ``(di, dj)`` away is possible only when the
+    two cells' squares come within ``R``: ``max(|di| - 1, 0)^2 + max(|dj| - 1, 0)^2 <= (R /
+    resolution)^2``, at any orientation.
+
+    outline : (M, 2) m, robot frame. Returns (P, 2) int64 (di, dj) offsets.
+    """
+    r = float(np.hypot(outline[:, 0], outline[:, 1]).max()) / resolution + _SLACK
+    k = math.ceil(r) + 1
+    d = np.arange(-k, k + 1)
+    di, dj = np.meshgrid(d, d)
+    gx = np.maximum(np.abs(di) - 1, 0)
+    gy = np.maximum(np.abs(dj) - 1, 0)
+    keep = gx * gx + gy * gy <= r * r
+    return np.stack((di[keep], dj[keep]), axis=1).astype(np.int64)
+
+
+@njit(cache=True)
+def footprint_cost_bounds(costs, offsets):
+    """Per cell, the highest cost any footprint outline point can touch from there.
+
+    costs : (H, W) uint8 costmap. offsets : (P, 2) int64 from `reach_offsets` (symmetric,
+    row by row a run ``-a(dj)..a(dj)``).
+    Returns (H, W) uint8: the maximum of ``costs`` over the cell + offsets, 255
+    (NO_INFORMATION) when some offset leaves the grid. A pose whose cell's bound is below
+    LETHAL_OBSTACLE has a legal footprint with cost at most that bound.
+
+    Computed separably: running row maxima of growing half-width over a grid padded with
+    255, then for each row offset the maximum of the row maxima of that row's half-width.
+    """
+    h, w = costs.shape
+    k = 0
+    for i in range(offsets.shape[0]):
+        k = max(k, abs(offsets[i, 0]), abs(offsets[i, 1]))
+    half = np.full(2 * k + 1, -1, dtype=np.int64)  # half-width of each row offset dj
+    for i in range(offsets.shape[0]):
+        j = offsets[i, 1] + k
+        half[j] = max(half[j], abs(offsets[i, 0]))
+    hp, wp = h + 2 * k, w + 2 * k
+    pad = np.full((hp, wp), 255, dtype=np.uint8)
+    pad[k : k + h, k : k + w] = costs
+    rows = np.empty((k + 1, hp, w), dtype=np.uint8)  # rows[a]: max over x-a..x+a
+    for y in range(hp):
+        for x in range(w):
+            rows[0, y, x] = pad[y, x + k]
+    for a in range(1, k + 1):
+        for y in range(hp):
+            for x in range(w):
+                v = rows[a - 1, y, x]
+                lo = pad[y, x + k - a]
+                hi = pad[y, x + k + a]
+                if lo > v:
+                    v = lo
+                if hi > v:
+                    v = hi
+                rows[a, y, x] = v
+    out = np.zeros((h, w), dtype=np.uint8)
+    for j in range(2 * k + 1):
+        a = half[j]
+        if a < 0:
+            continue
+        for y in range(h):
+            for x in range(w):
+                v = rows[a, y + j, x]
+                if v > out[y, x]:
+                    out[y, x] = v
+    return out
 
 
 @njit(cache=True, inline="always")
@@ -88,8 +163,13 @@ def trajectory_costs(
     simple_attractor,
     final_goal,
     poses_out,
+    bounds,
 ):
     """Score every sample's rollout as TrajectoryPlanner::generateTrajectory.
+
+    The footprint is laid on the grid only where it can matter: when the cell's bound (see
+    `footprint_cost_bounds`) is legal and no higher than the trajectory's highest cost so far,
+    the footprint cannot change the result, so it is skipped (the result is the same).
 
     Parameters
     ----------
@@ -106,6 +186,7 @@ def trajectory_costs(
     plan_cells : (K, 2) int64 plan cells in the map, for heading scoring.
     simple_attractor : score by squared distance to ``final_goal`` (2,) instead of the maps.
     poses_out : (S, T, 3) float64 written with each rollout's poses (T >= max num_steps).
+    bounds : (H, W) uint8 from `footprint_cost_bounds` for ``costs`` and ``outline``.
 
     Returns
     -------
@@ -134,11 +215,14 @@ def trajectory_costs(
                 break
             cx = int(fx)
             cy = int(fy)
-            fp = footprint_cost_at(costs, origin[0], origin[1], resolution, outline, x, y, th)
-            if fp < 0.0:
-                cost = -1.0
-                break
-            occ = max(occ, fp, float(costs[cy, cx]))
+            occ = max(occ, float(costs[cy, cx]))
+            bound = bounds[cy, cx]
+            if bound >= LETHAL_OBSTACLE or bound > occ:
+                fp = footprint_cost_at(costs, origin[0], origin[1], resolution, outline, x, y, th)
+                if fp < 0.0:
+                    cost = -1.0
+                    break
+                occ = max(occ, fp)
             if simple_attractor:
                 goal_d = (x - final_goal[0]) ** 2 + (y - final_goal[1]) ** 2
             else:

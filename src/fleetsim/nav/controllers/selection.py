@@ -33,31 +33,38 @@ def velocity_samples(
     min_vth = max(p.min_vel_theta, vel[2] - p.acc_lim_theta * window)
     dvx = (max_vx - min_vx) / (p.vx_samples - 1) if p.vx_samples > 1 else 0.0
     dvth = (max_vth - min_vth) / (p.vtheta_samples - 1) if p.vtheta_samples > 1 else 0.0
+    # the sample table, built with NumPy in createTrajectories' order (same float operations)
+    vxs = min_vx + np.arange(p.vx_samples) * dvx
+    vths = min_vth + np.arange(p.vtheta_samples) * dvth
+    forward = np.zeros((p.vx_samples, p.vtheta_samples, 3))
+    forward[:, :, 0] = vxs[:, None]
+    forward[:, 1:, 2] = vths[None, :-1]  # each vx first with vtheta 0, then the sweep
+    strafe = np.array([[0.1, 0.1, 0.0], [0.1, -0.1, 0.0]]) if p.holonomic_robot else None
+    in_place = np.zeros((p.vtheta_samples, 3))
+    mn = p.min_in_place_vel_theta
+    in_place[:, 2] = np.where(vths > 0, np.maximum(vths, mn), np.minimum(vths, -mn))
+    sideways = None
+    if p.holonomic_robot:
+        sideways = np.zeros((len(p.y_vels), 3))
+        sideways[:, 1] = np.asarray(p.y_vels, dtype=np.float64)
+    escape = np.array([[p.escape_vel, 0.0, 0.0]])
     groups: dict[str, slice] = {}
-    rows: list[tuple[float, float, float]] = []
-
-    def add(name: str, items: list[tuple[float, float, float]]) -> None:
-        groups[name] = slice(len(rows), len(rows) + len(items))
-        rows.extend(items)
-
-    forward = []
-    for i in range(p.vx_samples):
-        vx = min_vx + i * dvx
-        forward.append((vx, 0.0, 0.0))
-        forward.extend((vx, 0.0, min_vth + j * dvth) for j in range(p.vtheta_samples - 1))
-    add("forward", forward)
-    add("strafe", [(0.1, 0.1, 0.0), (0.1, -0.1, 0.0)] if p.holonomic_robot else [])
-    in_place = []
-    for i in range(p.vtheta_samples):
-        v = min_vth + i * dvth
-        lim = max(v, p.min_in_place_vel_theta) if v > 0 else min(v, -p.min_in_place_vel_theta)
-        in_place.append((0.0, 0.0, lim))
-    add("in_place", in_place)
-    add("sideways", [(0.0, float(v), 0.0) for v in p.y_vels] if p.holonomic_robot else [])
-    add("escape", [(p.escape_vel, 0.0, 0.0)])
-    raw_vth = np.array([min_vth + i * dvth for i in range(p.vtheta_samples)])
-    tp._in_place_raw = raw_vth
-    return np.array(rows, dtype=np.float64).reshape(-1, 3), groups, dvth
+    parts = []
+    n = 0
+    for name, part in (
+        ("forward", forward.reshape(-1, 3)),
+        ("strafe", strafe),
+        ("in_place", in_place),
+        ("sideways", sideways),
+        ("escape", escape),
+    ):
+        k = 0 if part is None else part.shape[0]
+        groups[name] = slice(n, n + k)
+        n += k
+        if k:
+            parts.append(part)
+    tp._in_place_raw = vths
+    return np.concatenate(parts, axis=0), groups, dvth
 
 
 def _ahead_goal_dist(tp: TrajectoryPlanner, index: int) -> float | None:
@@ -109,16 +116,12 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
     costs = tp._score(samples, pose, vel)
     best, best_cost = -1, -1.0
 
-    def better(i: int, allow_equal: bool) -> bool:
-        c = costs[i]
-        if c < 0:
-            return False
-        return best_cost < 0 or c < best_cost or (allow_equal and c <= best_cost)
-
-    if not tp.escaping:
-        for i in range(g["forward"].start, g["strafe"].stop):
-            if better(i, False):
-                best, best_cost = i, costs[i]
+    if not tp.escaping:  # the first sample of least legal cost among forward and strafe
+        first = costs[g["forward"].start : g["strafe"].stop]
+        legal = first >= 0
+        if legal.any():
+            best = g["forward"].start + int(np.argmin(np.where(legal, first, np.inf)))
+            best_cost = costs[best]
     heading_dist = math.inf
     raw = tp._in_place_raw
     for k, i in enumerate(range(g["in_place"].start, g["in_place"].stop)):

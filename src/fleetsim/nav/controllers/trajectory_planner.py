@@ -33,7 +33,12 @@ from fleetsim.nav.controllers.base import (
     VelocityCommand,
 )
 from fleetsim.nav.controllers.map_grid import distances_from_targets, plan_cells_in_map
-from fleetsim.nav.controllers.rollout import num_steps_of, trajectory_costs
+from fleetsim.nav.controllers.rollout import (
+    footprint_cost_bounds,
+    num_steps_of,
+    reach_offsets,
+    trajectory_costs,
+)
 from fleetsim.nav.controllers.selection import choose_trajectory
 from fleetsim.nav.controllers.trajectory_params import TrajectoryPlannerParams
 from fleetsim.nav.costmap.costmap_2d import Costmap2D
@@ -68,6 +73,7 @@ class TrajectoryPlanner(LocalPlanner):
         self.params = p = params or TrajectoryPlannerParams()
         self.footprint = np.asarray(footprint, dtype=np.float64)
         self.outline = outline_points(self.footprint, costmap.resolution)
+        self.reach = reach_offsets(self.outline, costmap.resolution)
         self.sim_period = 1.0 / p.controller_frequency
         self.angular_sim_granularity = p.angular_sim_granularity or p.sim_granularity
         scale = costmap.resolution if p.meter_scoring else 1.0
@@ -177,15 +183,31 @@ class TrajectoryPlanner(LocalPlanner):
 
     def _update_maps(self, local: np.ndarray, pose: tuple[float, float, float]) -> None:
         m = self.costmap
-        passable = np.zeros(m.costs.shape, dtype=bool)
-        rows, cols = polygon_cells(m, footprint_at(self.footprint, *pose))
-        passable[rows, cols] = True
+        no_cells = np.zeros(m.costs.shape, dtype=bool)
+        polygon = footprint_at(self.footprint, *pose)
+        passable = no_cells
+        if self._obstacle_near(polygon):  # else the cells under the robot change nothing
+            passable = np.zeros(m.costs.shape, dtype=bool)
+            rows, cols = polygon_cells(m, polygon)
+            passable[rows, cols] = True
         targets = plan_cells_in_map(m, local[:, :2])
         self.plan_cells = targets
         self.path_dist = distances_from_targets(m.costs, targets, passable)
         goal = targets[-1:] if targets.shape[0] else targets
-        self.goal_dist = distances_from_targets(m.costs, goal, np.zeros_like(passable))
+        self.goal_dist = distances_from_targets(m.costs, goal, no_cells)
         self.final_goal = self.plan[-1, :2].copy()
+        self.cost_bounds = footprint_cost_bounds(m.costs, self.reach)
+
+    def _obstacle_near(self, polygon: np.ndarray) -> bool:
+        """Whether a cell the MapGrid treats as an obstacle (cost >= INSCRIBED) lies in the
+        polygon's bounding box, grown by a cell (the only cells `polygon_cells` can return)."""
+        m = self.costmap
+        cells, _ = m.cells_of(polygon)
+        x0 = max(int(cells[:, 0].min()) - 1, 0)
+        x1 = min(int(cells[:, 0].max()) + 2, m.size_x)
+        y0 = max(int(cells[:, 1].min()) - 1, 0)
+        y1 = min(int(cells[:, 1].max()) + 2, m.size_y)
+        return bool(x1 > x0 and y1 > y0 and m.costs[y0:y1, x0:x1].max() >= 253)
 
     # -- scoring ----------------------------------------------------------------------------------
     def _score(self, samples: np.ndarray, pose, vel) -> np.ndarray:
@@ -215,6 +237,7 @@ class TrajectoryPlanner(LocalPlanner):
             p.simple_attractor,
             self.final_goal,
             self._poses,
+            self.cost_bounds,
         )
 
     def check_trajectory(self, pose, vel, sample) -> bool:

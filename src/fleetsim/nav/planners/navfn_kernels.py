@@ -46,25 +46,21 @@ def navfn_costs(costs, allow_unknown):
     return out
 
 
-@njit(cache=True, inline="always")
-def _push(buf, n_buf, pending, costarr, n):
-    if 0 <= n < costarr.shape[0] and not pending[n] and costarr[n] < COST_OBS:
-        buf[n_buf] = n
-        pending[n] = True
-        return n_buf + 1
-    return n_buf
-
-
 @njit(cache=True)
 def navfn_potential(costarr, nx, goal, start, at_start, cycles):
     """Potential from ``goal`` by navfn's Dijkstra-like wavefront (propNavFnDijkstra).
 
     Each cell's potential comes from its 4-neighbours by navfn's quadratic approximation of the
-    Eikonal update (updateCell); cells are processed in bands of ``PRIORITY_INCREMENT``.
+    Eikonal update (updateCell); cells are processed in bands of ``PRIORITY_INCREMENT``: the
+    current buffer, the next buffer (below the band threshold) and the overflow buffer, three
+    flat index arrays with a ``pending`` flag per cell, as navfn keeps them. The update is
+    written out inline (one pass over the current buffer, the neighbour's cost read once),
+    which gives navfn's potentials bit for bit at about twice the speed of a helper per push.
 
     Parameters
     ----------
-    costarr : (ns,) uint8 from `navfn_costs`.
+    costarr : (ns,) uint8 from `navfn_costs` (its outer ring is COST_OBS, so the 4-neighbours
+        of any processed cell are inside the grid).
     nx : grid width in cells.
     goal : flat index where the potential is 0 (navfn's goal: the robot for NavfnROS).
     start : flat index whose potential ends the search when ``at_start``.
@@ -85,9 +81,16 @@ def navfn_potential(costarr, nx, goal, start, at_start, cycles):
     n_next = 0
     n_over = 0
     cur_t = np.float32(COST_OBS)
+    inc = np.float32(PRIORITY_INCREMENT)
+    c_a = np.float32(-0.2301)
+    c_b = np.float32(0.5307)
+    c_c = np.float32(0.7040)
     pot[goal] = 0.0
     for n in (goal + 1, goal - 1, goal - nx, goal + nx):
-        n_cur = _push(cur, n_cur, pending, costarr, n)
+        if 0 <= n < ns and not pending[n] and costarr[n] < COST_OBS:
+            cur[n_cur] = n
+            pending[n] = True
+            n_cur += 1
     cycle = 0
     while cycle < cycles:
         if n_cur == 0 and n_next == 0:
@@ -96,7 +99,8 @@ def navfn_potential(costarr, nx, goal, start, at_start, cycles):
             pending[cur[i]] = False
         for i in range(n_cur):
             n = cur[i]
-            if costarr[n] >= COST_OBS:
+            cn = costarr[n]
+            if cn >= COST_OBS:
                 continue
             left = pot[n - 1]
             right = pot[n + 1]
@@ -104,7 +108,7 @@ def navfn_potential(costarr, nx, goal, start, at_start, cycles):
             down = pot[n + nx]
             tc = left if left < right else right
             ta = up if up < down else down
-            hf = np.float32(costarr[n])
+            hf = np.float32(cn)
             dc = tc - ta
             if dc < 0:
                 dc = -dc
@@ -113,39 +117,48 @@ def navfn_potential(costarr, nx, goal, start, at_start, cycles):
                 p = ta + hf
             else:
                 d = dc / hf
-                v = np.float32(-0.2301) * d * d + np.float32(0.5307) * d + np.float32(0.7040)
-                p = ta + hf * v
-            p = np.float32(p)
+                p = ta + hf * (c_a * d * d + c_b * d + c_c)
             if p < pot[n]:
-                le = INV_SQRT2 * np.float32(costarr[n - 1])
-                re = INV_SQRT2 * np.float32(costarr[n + 1])
-                ue = INV_SQRT2 * np.float32(costarr[n - nx])
-                de = INV_SQRT2 * np.float32(costarr[n + nx])
                 pot[n] = p
-                if p < cur_t:
-                    if left > p + le:
-                        n_next = _push(nxt, n_next, pending, costarr, n - 1)
-                    if right > p + re:
-                        n_next = _push(nxt, n_next, pending, costarr, n + 1)
-                    if up > p + ue:
-                        n_next = _push(nxt, n_next, pending, costarr, n - nx)
-                    if down > p + de:
-                        n_next = _push(nxt, n_next, pending, costarr, n + nx)
+                # neighbours whose potential this cell can lower go to the next band (below
+                # the threshold) or the overflow band
+                low = p < cur_t
+                buf = nxt if low else over
+                nb = n_next if low else n_over
+                m = n - 1
+                cm = costarr[m]
+                if cm < COST_OBS and not pending[m] and left > p + INV_SQRT2 * np.float32(cm):
+                    buf[nb] = m
+                    pending[m] = True
+                    nb += 1
+                m = n + 1
+                cm = costarr[m]
+                if cm < COST_OBS and not pending[m] and right > p + INV_SQRT2 * np.float32(cm):
+                    buf[nb] = m
+                    pending[m] = True
+                    nb += 1
+                m = n - nx
+                cm = costarr[m]
+                if cm < COST_OBS and not pending[m] and up > p + INV_SQRT2 * np.float32(cm):
+                    buf[nb] = m
+                    pending[m] = True
+                    nb += 1
+                m = n + nx
+                cm = costarr[m]
+                if cm < COST_OBS and not pending[m] and down > p + INV_SQRT2 * np.float32(cm):
+                    buf[nb] = m
+                    pending[m] = True
+                    nb += 1
+                if low:
+                    n_next = nb
                 else:
-                    if left > p + le:
-                        n_over = _push(over, n_over, pending, costarr, n - 1)
-                    if right > p + re:
-                        n_over = _push(over, n_over, pending, costarr, n + 1)
-                    if up > p + ue:
-                        n_over = _push(over, n_over, pending, costarr, n - nx)
-                    if down > p + de:
-                        n_over = _push(over, n_over, pending, costarr, n + nx)
-        # swap current and next bands
+                    n_over = nb
+        # swap current and next bands; when both are empty, raise the threshold
         cur, nxt = nxt, cur
         n_cur = n_next
         n_next = 0
         if n_cur == 0:
-            cur_t += PRIORITY_INCREMENT
+            cur_t += inc
             cur, over = over, cur
             n_cur = n_over
             n_over = 0

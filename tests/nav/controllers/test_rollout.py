@@ -1,0 +1,127 @@
+"""Rollout kernels: the footprint bound map and the footprint skip against brute force."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from fleetsim.nav.controllers.map_grid import densified_plan
+from fleetsim.nav.controllers.rollout import (
+    footprint_cost_bounds,
+    num_steps_of,
+    reach_offsets,
+    trajectory_costs,
+)
+from fleetsim.nav.costmap.footprint import footprint_cost_at, footprint_from_radius, outline_points
+
+
+def bounds_reference(costs, offsets):
+    h, w = costs.shape
+    out = np.zeros_like(costs)
+    for y in range(h):
+        for x in range(w):
+            v = 0
+            for dx, dy in offsets:
+                if not (0 <= x + dx < w and 0 <= y + dy < h):
+                    v = 255
+                    break
+                v = max(v, int(costs[y + dy, x + dx]))
+            out[y, x] = v
+    return out
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    seed=st.integers(0, 2**31),
+    radius=st.floats(0.02, 0.4),
+    shape=st.tuples(st.integers(1, 30), st.integers(1, 30)),
+)
+def test_bounds_match_brute_force(seed, radius, shape):
+    rng = np.random.default_rng(seed)
+    costs = rng.integers(0, 256, shape).astype(np.uint8)
+    offsets = reach_offsets(outline_points(footprint_from_radius(radius), 0.05), 0.05)
+    assert np.array_equal(footprint_cost_bounds(costs, offsets), bounds_reference(costs, offsets))
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**31),
+    x=st.floats(0.0, 2.0),
+    y=st.floats(0.0, 2.0),
+    yaw=st.floats(-4.0, 4.0),
+)
+def test_outline_points_land_within_reach(seed, x, y, yaw):
+    """Every outline cell at any pose is the centre cell plus one of the reach offsets."""
+    rng = np.random.default_rng(seed)
+    fp = footprint_from_radius(0.1 + 0.3 * rng.random()) * rng.uniform(0.5, 1.5, (16, 1))
+    outline = outline_points(fp, 0.05)
+    offsets = {tuple(o) for o in reach_offsets(outline, 0.05)}
+    c, s = np.cos(yaw), np.sin(yaw)
+    px = (x + c * outline[:, 0] - s * outline[:, 1]) / 0.05
+    py = (y + s * outline[:, 0] + c * outline[:, 1]) / 0.05
+    cx, cy = np.floor(x / 0.05), np.floor(y / 0.05)
+    for dx, dy in zip(np.floor(px) - cx, np.floor(py) - cy):
+        assert (int(dx), int(dy)) in offsets
+
+
+def random_map(rng, h=60, w=70):
+    costs = np.zeros((h, w), np.uint8)
+    for _ in range(6):
+        cy, cx = rng.integers(0, h), rng.integers(0, w)
+        yy, xx = np.mgrid[:h, :w]
+        d = np.hypot(yy - cy, xx - cx)
+        costs = np.maximum(costs, np.clip(253 - 25 * (d - 2), 0, 253).astype(np.uint8))
+        costs[d < 2] = 254
+    costs[rng.random((h, w)) < 0.005] = 255
+    return costs
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_skipping_footprints_changes_no_cost(seed):
+    """With the real bounds and with bounds that force every footprint: the same costs."""
+    rng = np.random.default_rng(seed)
+    costs = random_map(rng)
+    res, origin = 0.05, np.array([-0.5, 0.25])
+    outline = outline_points(footprint_from_radius(0.15), res)
+    samples = np.stack(
+        [rng.uniform(-0.1, 0.8, 300), np.zeros(300), rng.uniform(-1.0, 1.0, 300)], axis=1
+    )
+    steps = num_steps_of(samples, 2.0, 0.025, 0.025, False)
+    dist = rng.integers(0, 50, costs.shape).astype(np.float64)
+    seen = set()
+    for _ in range(5):
+        pose = np.array([origin[0] + 0.5, origin[1] + 0.5, 0.3])
+        while footprint_cost_at(costs, origin[0], origin[1], res, outline, *pose) < 0:
+            pose[:2] = origin + rng.uniform(0.3, 3.0, 2)
+        args = (
+            samples, pose, np.array([0.2, 0.0, 0.1]), np.array([2.5, 2.5, 3.2]), 2.0, steps,
+            costs, origin, res, outline, dist, dist, np.array([0.6, 0.8, 0.01]),
+            np.array([0.0, 0.8]), np.zeros((0, 2), np.int64), False, np.zeros(2),
+        )  # fmt: skip
+        poses_a = np.zeros((300, int(steps.max()), 3))
+        poses_b = np.zeros_like(poses_a)
+        bounds = footprint_cost_bounds(costs, reach_offsets(outline, res))
+        a = trajectory_costs(*args, poses_a, bounds)
+        b = trajectory_costs(*args, poses_b, np.full(costs.shape, 255, np.uint8))
+        assert np.array_equal(a, b)
+        assert np.array_equal(poses_a[a >= 0], poses_b[a >= 0])
+        seen |= {float(np.sign(c)) for c in a}
+        legal = a >= 0
+        if not legal.any():
+            continue
+        # a legal rollout's footprint is legal at each of its poses
+        i = int(np.flatnonzero(legal)[0])
+        for k in range(int(steps[i])):
+            x, y, th = poses_a[i, k]
+            assert footprint_cost_at(costs, origin[0], origin[1], res, outline, x, y, th) >= 0
+    assert seen >= {-1.0, 1.0}  # both collisions and legal rollouts were compared
+
+
+def test_densified_plan_matches_per_segment_reference():
+    rng = np.random.default_rng(3)
+    for _ in range(50):
+        p = rng.normal(size=(int(rng.integers(2, 20)), 2)) * rng.uniform(0.01, 3.0)
+        seg = np.diff(p, axis=0)
+        n = np.maximum(1, np.ceil(np.hypot(seg[:, 0], seg[:, 1]) / 0.05).astype(int))
+        ref = [a + (np.arange(k) / k)[:, None] * d for a, d, k in zip(p[:-1], seg, n)]
+        assert np.array_equal(densified_plan(p, 0.05), np.concatenate([*ref, p[-1:]]))

@@ -76,6 +76,7 @@ class Engine(StateQueries):
         wall_height: float = 1.0,
     ) -> None:
         self.world = load_world(world, wall_height)
+        self.wall_height = wall_height
         self.rng = rng if rng is not None else np.random.default_rng(0)
         self.spec, bodies = spec_from_world(self.world, timestep)
         self.models: dict[str, ModelEntry] = {

@@ -1,9 +1,10 @@
 """All planar lasers of the world in one batched ray cast.
 
-The static world (geoms welded to the world) is sliced into primitives and binned once per
-compile; movable geoms (robots, loose models) are sliced and binned again at every sweep (they
-are few). Each ray is cast against the static grid, then against the movable grid up to the
-static hit, skipping the geoms of the robot that carries the laser.
+Static world: in a map world the extruded walls are the occupied cells themselves, so rays walk
+the occupancy grid (``raycast.ranges_from_occupancy``); every other static geom is sliced into
+primitives binned once per compile (``raycast.ranges_from_primitives``). Movable models (robots,
+loose objects) are sliced at every sweep and tested only by the beams that fall inside their
+bounding circle (``raycast.ranges_with_bodies``), skipping the robot that carries the laser.
 """
 
 from __future__ import annotations
@@ -15,50 +16,113 @@ from fleetsim.sim import raycast
 from fleetsim.sim.slices import primitives_of
 
 STATIC_CELL = 0.5  # m
-DYNAMIC_CELL = 1.0  # m
 
 
 class LaserBatch:
     def __init__(self) -> None:
         self.static_grid: raycast.PrimitiveGrid | None = None
         self.dynamic_ids = np.zeros(0, np.int64)
+        self.occupancy = None
+        self.wall_height = 0.0
 
     def bind(self, engine) -> None:
         m = engine.model
         collide = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
         real = m.geom_type != mujoco.mjtGeom.mjGEOM_PLANE
         static = m.body_weldid[m.geom_bodyid] == 0
+        grid = engine.world.occupancy
+        use_grid = grid is not None and grid.origin[2] == 0.0 and "map_walls" in engine.models
+        if not use_grid:
+            self.occupancy = None
+        else:
+            walls = engine._model_names.index("map_walls")
+            static = static & (engine.geom_model != walls)
+            if self.occupancy is not grid:
+                self.clearance = raycast.clearance_from_occupancy(grid.occupied)
+            self.occupancy = grid
+            self.wall_height = engine.wall_height
         sid = np.flatnonzero(collide & real & static)
-        self.dynamic_ids = np.flatnonzero(collide & real & ~static)
+        self.dynamic_ids = np.flatnonzero(collide & real & (m.body_weldid[m.geom_bodyid] != 0))
         prims, _ = primitives_of(m, engine.data, sid)
         self.static_grid = raycast.grid_from_primitives(prims, None, STATIC_CELL)
 
-    def dynamic_grid(self, engine) -> raycast.PrimitiveGrid:
+    def bodies(self, engine):
+        """Movable primitives grouped by model: centres (B, 2), radii (B,), owners (B,),
+        CSR starts (B + 1,) and primitives (P, 7) sorted by owner."""
         prims, geoms = primitives_of(engine.model, engine.data, self.dynamic_ids)
-        return raycast.grid_from_primitives(prims, engine.geom_model[geoms], DYNAMIC_CELL)
-
-    def ranges(self, engine, origins, angles, range_min, range_max, owner) -> np.ndarray:
-        """(R,) ranges (m, inf: no hit) of rays from ``origins`` (R, 3) at world yaws ``angles``."""
-        r = raycast.cast(self.static_grid, origins, angles, range_min, range_max, owner)
-        if len(self.dynamic_ids):
-            limit = np.minimum(r, range_max)
-            r2 = raycast.cast(self.dynamic_grid(engine), origins, angles, range_min, limit, owner)
-            r = np.minimum(r, r2)
-        return r
+        owner = engine.geom_model[geoms]
+        order = np.argsort(owner, kind="stable")
+        prims, owner = prims[order], owner[order]
+        ids, start = np.unique(owner, return_index=True)
+        start = np.append(start, len(owner)).astype(np.int64)
+        seg = prims[:, 0] == raycast.SEGMENT
+        lo = np.where(
+            seg[:, None], np.minimum(prims[:, 1:3], prims[:, 3:5]), prims[:, 1:3] - prims[:, 3:4]
+        )
+        hi = np.where(
+            seg[:, None], np.maximum(prims[:, 1:3], prims[:, 3:5]), prims[:, 1:3] + prims[:, 3:4]
+        )
+        lo_b = np.minimum.reduceat(lo, start[:-1], axis=0) if len(ids) else np.zeros((0, 2))
+        hi_b = np.maximum.reduceat(hi, start[:-1], axis=0) if len(ids) else np.zeros((0, 2))
+        centres = (lo_b + hi_b) / 2
+        radii = np.linalg.norm(hi_b - lo_b, axis=1) / 2
+        return centres, radii, ids.astype(np.int64), start, np.ascontiguousarray(prims)
 
     def measure(self, engine, lasers: list, t: float) -> list:
         """Readings of ``lasers`` (``LaserPlugin``) from one batched cast."""
-        parts = [lz.rays(engine) for lz in lasers]
-        origins = np.concatenate([p[0] for p in parts])
-        angles = np.concatenate([p[1] for p in parts])
-        rmin = np.concatenate([np.full(len(p[1]), lz.range_min) for p, lz in zip(parts, lasers)])
-        rmax = np.concatenate([np.full(len(p[1]), lz.range_max) for p, lz in zip(parts, lasers)])
-        owner = np.concatenate([np.full(len(p[1]), p[2], np.int64) for p in parts])
-        ranges = self.ranges(engine, origins, angles, rmin, rmax, owner)
-        out = []
-        k = 0
-        for p, lz in zip(parts, lasers):
-            n = len(p[1])
-            out.append(lz.reading(ranges[k : k + n], t, engine.rng))
-            k += n
-        return out
+        n = len(lasers)
+        origins = np.empty((n, 3))
+        angle0 = np.empty(n)
+        inc = np.array([lz.increment for lz in lasers])
+        nb = np.array([lz.samples for lz in lasers], np.int64)
+        owner = np.empty(n, np.int64)
+        for i, lz in enumerate(lasers):
+            origins[i], angle0[i], owner[i] = lz.pose(engine)
+        offsets = np.concatenate([[0], np.cumsum(nb)[:-1]]).astype(np.int64)
+        rmin = np.array([lz.range_min for lz in lasers])
+        rmax = np.array([lz.range_max for lz in lasers])
+        beam = np.concatenate([np.arange(k) for k in nb])
+        which = np.repeat(np.arange(n), nb)
+        ray_o = origins[which]
+        ray_a = angle0[which] + beam * inc[which]
+        ray_min, ray_max, ray_owner = rmin[which], rmax[which], owner[which]
+        if len(self.static_grid.prims):
+            ranges = raycast.cast(self.static_grid, ray_o, ray_a, ray_min, ray_max, ray_owner)
+        else:
+            ranges = np.full(len(ray_a), np.inf)
+        if self.occupancy is not None:
+            g = self.occupancy
+            walls = raycast.ranges_from_occupancy(
+                ray_o,
+                ray_a,
+                ray_min,
+                ray_max,
+                g.occupied,
+                self.clearance,
+                g.origin[0],
+                g.origin[1],
+                g.resolution,
+                self.wall_height,
+            )
+            ranges = np.minimum(ranges, walls)
+        if len(self.dynamic_ids):
+            centres, radii, ids, start, prims = self.bodies(engine)
+            raycast.ranges_with_bodies(
+                ranges,
+                origins,
+                angle0,
+                inc,
+                nb,
+                offsets,
+                owner,
+                rmin,
+                rmax,
+                centres,
+                radii,
+                ids,
+                start,
+                prims,
+            )
+        return [
+            lz.reading(ranges[o : o + k], t, engine.rng) for lz, o, k in zip(lasers, offsets, nb)
+        ]

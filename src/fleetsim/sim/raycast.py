@@ -274,3 +274,172 @@ def cast(grid: PrimitiveGrid, origins, angles, range_min, range_max, ray_owner) 
         grid.nx,
         grid.ny,
     )
+
+
+@numba.njit(cache=True)
+def _dda_start(ox, oy, dx, dy, t, x0, y0, res):
+    """Grid traversal state of the ray at parameter ``t``: cell, next boundary params, steps."""
+    px = (ox + t * dx - x0) / res
+    py = (oy + t * dy - y0) / res
+    ix = int(np.floor(px))
+    iy = int(np.floor(py))
+    if abs(dx) > 1e-15:
+        tmx = t + ((ix + (1 if dx > 0 else 0)) - px) * res / dx
+    else:
+        tmx = np.inf
+    if abs(dy) > 1e-15:
+        tmy = t + ((iy + (1 if dy > 0 else 0)) - py) * res / dy
+    else:
+        tmy = np.inf
+    return ix, iy, tmx, tmy
+
+
+@numba.njit(cache=True)
+def ranges_from_occupancy(
+    origins, angles, range_min, range_max, occupied, clearance, x0, y0, res, zmax
+):
+    """Ranges of planar rays to the first occupied cell of a grid (walls extruded 0..zmax).
+
+    Parameters
+    ----------
+    origins : (R, 3) float64 ray origins, world (= map) frame, m.
+    angles : (R,) float64 world yaws, rad.
+    range_min, range_max : (R,) float64, m.
+    occupied : (H, W) bool, row 0 at ``y0`` (OccupancyGrid order); cell (i, j) covers
+        ``[x0 + j res, x0 + (j + 1) res) x [y0 + i res, y0 + (i + 1) res)``.
+    clearance : (H, W) float32, distance in cells from each cell centre to the nearest occupied
+        cell centre (``clearance_from_occupancy``); lets rays jump across open space.
+    zmax : wall height, m; rays from above it (or below 0) see nothing.
+
+    Returns
+    -------
+    (R,) float64 distance to the first occupied cell's boundary, ``inf`` when none within range
+    (exactly the boxes a map world is extruded into). A ray starting inside an occupied cell
+    hits at ``range_min``.
+    """
+    h, w = occupied.shape
+    n = origins.shape[0]
+    out = np.full(n, np.inf)
+    for r in range(n):
+        oz = origins[r, 2]
+        if oz < 0.0 or oz > zmax:
+            continue
+        ox = origins[r, 0]
+        oy = origins[r, 1]
+        dx = np.cos(angles[r])
+        dy = np.sin(angles[r])
+        tmax = range_max[r]
+        stepx = 1 if dx > 0 else -1
+        stepy = 1 if dy > 0 else -1
+        tdx = res / abs(dx) if abs(dx) > 1e-15 else np.inf
+        tdy = res / abs(dy) if abs(dy) > 1e-15 else np.inf
+        t = range_min[r]
+        ix, iy, tmx, tmy = _dda_start(ox, oy, dx, dy, t, x0, y0, res)
+        while t <= tmax:
+            if 0 <= ix < w and 0 <= iy < h:
+                if occupied[iy, ix]:
+                    out[r] = t
+                    break
+                safe = clearance[iy, ix] - 1.5  # cells free around any point of this cell
+                if safe > 2.0:
+                    t += safe * res
+                    ix, iy, tmx, tmy = _dda_start(ox, oy, dx, dy, t, x0, y0, res)
+                    continue
+            else:
+                # outside the grid: stop once moving away from it
+                if (ix < 0 and stepx < 0) or (ix >= w and stepx > 0):
+                    break
+                if (iy < 0 and stepy < 0) or (iy >= h and stepy > 0):
+                    break
+            if tmx < tmy:
+                t = tmx
+                tmx += tdx
+                ix += stepx
+            else:
+                t = tmy
+                tmy += tdy
+                iy += stepy
+    return out
+
+
+def clearance_from_occupancy(occupied: np.ndarray) -> np.ndarray:
+    """(H, W) float32 distance (cells) from each cell centre to the nearest occupied centre."""
+    from scipy import ndimage
+
+    if not occupied.any():
+        return np.full(occupied.shape, np.float32(1e6))
+    return ndimage.distance_transform_edt(~occupied).astype(np.float32)
+
+
+@numba.njit(cache=True)
+def ranges_with_bodies(
+    ranges,
+    origins,
+    angle0,
+    increment,
+    nbeams,
+    offsets,
+    laser_owner,
+    range_min,
+    range_max,
+    centres,
+    radii,
+    body_owner,
+    prim_start,
+    prims,
+):
+    """Lower ``ranges`` (in place) where beams hit movable bodies; each laser only tests the
+    beams that fall inside a body's bounding circle (angular culling).
+
+    Parameters
+    ----------
+    ranges : (R,) float64, current ranges (e.g. from the static world), m; updated in place.
+    origins : (L, 3) laser origins, m; angle0, increment : (L,) first beam yaw and spacing, rad.
+    nbeams, offsets : (L,) int, beam count and start index of each laser in ``ranges``.
+    laser_owner : (L,) int model index carrying each laser (its own bodies are skipped).
+    range_min, range_max : (L,) m.
+    centres : (B, 2), radii : (B,) bounding circles of the bodies' primitives, m.
+    body_owner : (B,) int model index; prim_start : (B + 1,) CSR into ``prims`` (P, 7).
+    """
+    two_pi = 2.0 * np.pi
+    for li in range(origins.shape[0]):
+        ox = origins[li, 0]
+        oy = origins[li, 1]
+        oz = origins[li, 2]
+        n = nbeams[li]
+        for b in range(centres.shape[0]):
+            if body_owner[b] == laser_owner[li]:
+                continue
+            cx = centres[b, 0] - ox
+            cy = centres[b, 1] - oy
+            d = np.hypot(cx, cy)
+            if d - radii[b] > range_max[li]:
+                continue
+            if d <= radii[b] or increment[li] <= 0.0:
+                k0 = 0
+                k1 = n - 1
+                shifts = 1
+            else:
+                half = np.arcsin(radii[b] / d)
+                centre = np.arctan2(cy, cx)
+                shifts = 3
+            for s in range(shifts):
+                if shifts == 3:
+                    lo = centre - half + (s - 1) * two_pi - angle0[li]
+                    hi = centre + half + (s - 1) * two_pi - angle0[li]
+                    inc = increment[li]
+                    k0 = max(0, int(np.ceil(lo / inc)))
+                    k1 = min(n - 1, int(np.floor(hi / inc)))
+                for k in range(k0, k1 + 1):
+                    a = angle0[li] + k * increment[li]
+                    dx = np.cos(a)
+                    dy = np.sin(a)
+                    q = offsets[li] + k
+                    for pi in range(prim_start[b], prim_start[b + 1]):
+                        p = prims[pi]
+                        if oz < p[5] or oz > p[6]:
+                            continue
+                        t = _hit_distance(p, ox, oy, dx, dy, range_min[li])
+                        if t < ranges[q] and t <= range_max[li]:
+                            ranges[q] = t
+    return ranges

@@ -71,10 +71,6 @@ class LaserPlugin(SensorPlugin):
         self.rate = float(sensor.update_rate)
         self.pos = np.array(sensor.pose.xyz, float)
         self.quat = quat_from_rpy(*sensor.pose.rpy)
-        n = self.samples
-        self.beams = (
-            np.linspace(self.angle_min, self.angle_max, n) if n > 1 else np.array([self.angle_min])
-        )
         self.frame_id = ctx.frame(self.params.frameName)
 
     @property
@@ -85,8 +81,12 @@ class LaserPlugin(SensorPlugin):
         self.body = engine.link_id(self.ctx.model, self.link)
         self.owner = engine._model_names.index(self.ctx.model)
 
-    def rays(self, engine):
-        """World ray origins (S, 3), world yaws (S,) and the owner model index."""
+    @property
+    def increment(self) -> float:
+        return (self.angle_max - self.angle_min) / max(self.samples - 1, 1)
+
+    def pose(self, engine) -> tuple[np.ndarray, float, int]:
+        """World origin (3,) m, world yaw of the first beam (rad), owner model index."""
         d = engine.data
         R = d.xmat[self.body].reshape(3, 3)
         origin = d.xpos[self.body] + R @ self.pos
@@ -94,8 +94,16 @@ class LaserPlugin(SensorPlugin):
         q = np.zeros(4)
         mujoco.mju_mulQuat(q, d.xquat[self.body], self.quat)
         mujoco.mju_quat2Mat(rs, q)
-        heading = np.arctan2(rs[3], rs[0])
-        return np.tile(origin, (self.samples, 1)), heading + self.beams, self.owner
+        return origin, float(np.arctan2(rs[3], rs[0])) + self.angle_min, self.owner
+
+    def rays(self, engine):
+        """World ray origins (S, 3), world yaws (S,) and the owner model index."""
+        origin, a0, owner = self.pose(engine)
+        return (
+            np.tile(origin, (self.samples, 1)),
+            a0 + self.increment * np.arange(self.samples),
+            owner,
+        )
 
     def reading(self, ranges: np.ndarray, t: float, rng: np.random.Generator) -> ScanReading:
         r = ranges.astype(np.float64)
@@ -103,14 +111,13 @@ class LaserPlugin(SensorPlugin):
             hit = np.isfinite(r)
             r[hit] += self.noise_mean + self.noise_std * rng.standard_normal(int(hit.sum()))
             r[hit] = np.clip(r[hit], self.range_min, self.range_max)
-        inc = (self.angle_max - self.angle_min) / max(self.samples - 1, 1)
         return ScanReading(
             t,
             self.params.topicName,
             self.frame_id,
             self.angle_min,
             self.angle_max,
-            inc,
+            self.increment,
             0.0,
             1.0 / self.rate if self.rate > 0 else 0.0,
             self.range_min,

@@ -187,3 +187,89 @@ class KinematicRobot(Node):
                 ranges=ranges,
             )
         )
+
+
+class MapPublisher(Node):
+    """Publishes the room map latched on /map (what map_server does)."""
+
+    def __init__(self, rt, occupancy: OccupancyMap | None = None):
+        from fleetsim.nav.map_server import grid_msg_from_map
+
+        super().__init__(rt, "map_server")
+        self.pub = self.create_publisher(nav_msgs.OccupancyGrid, "map", 1, latch=True)
+        self.pub.publish(grid_msg_from_map(occupancy or room_map(), "map"))
+
+
+COMMON = {  # costmap_common_params.yaml, pre-Hydro form
+    "obstacle_range": 2.5,
+    "raytrace_range": 3.0,
+    "robot_radius": 0.2,
+    "inflation_radius": 0.5,
+    "cost_scaling_factor": 5.0,
+    "observation_sources": "scan",
+    "scan": {"data_type": "LaserScan", "topic": "scan", "marking": True, "clearing": True},
+}
+GLOBAL = {"global_frame": "/map", "robot_base_frame": "base_link", "update_frequency": 5.0,
+          "publish_frequency": 1.0, "static_map": True}  # fmt: skip
+LOCAL = {"global_frame": "odom", "robot_base_frame": "base_link", "update_frequency": 5.0,
+         "publish_frequency": 2.0, "static_map": False, "rolling_window": True,
+         "width": 3.0, "height": 3.0, "resolution": 0.05}  # fmt: skip
+PLANNER = {"max_vel_x": 0.5, "min_vel_x": 0.1, "max_vel_theta": 1.0, "min_vel_theta": -1.0,
+           "min_in_place_vel_theta": 0.4, "holonomic_robot": False, "xy_goal_tolerance": 0.15,
+           "yaw_goal_tolerance": 0.2, "sim_time": 1.5, "vx_samples": 6, "vtheta_samples": 20,
+           "meter_scoring": True, "pdist_scale": 0.6, "gdist_scale": 0.8,
+           "occdist_scale": 0.01}  # fmt: skip
+
+
+def move_base_params(local=None, glob=None, planner=None, **top):
+    """move_base's private namespace as the lesson's launch file loads it."""
+    return {
+        "global_costmap": {**COMMON, **GLOBAL, **(glob or {})},
+        "local_costmap": {**COMMON, **LOCAL, **(local or {})},
+        "TrajectoryPlannerROS": {**PLANNER, **(planner or {})},
+        **top,
+    }
+
+
+def goal_msg(x, y, yaw=0.0, frame="map"):
+    from fleetsim.msgs import move_base_msgs
+    from fleetsim.nav.move_base_support import pose_stamped
+
+    return move_base_msgs.MoveBaseGoal(target_pose=pose_stamped(x, y, yaw, frame, Time()))
+
+
+class Watcher(Node):
+    """Records what move_base publishes."""
+
+    def __init__(self, rt, ns="/lizi1"):
+        from fleetsim.msgs import move_base_msgs
+
+        super().__init__(rt, "watcher", ns)
+        self.cmds, self.goals, self.plans, self.local, self.feedback = [], [], [], [], []
+        sub = self.create_subscription
+        sub(geometry_msgs.Twist, "cmd_vel", lambda m: self.cmds.append((self.now(), m)), 10)
+        sub(geometry_msgs.PoseStamped, "move_base/current_goal", self.goals.append, 10)
+        sub(nav_msgs.Path, "move_base/NavfnROS/plan", self.plans.append, 10)
+        sub(nav_msgs.Path, "move_base/TrajectoryPlannerROS/local_plan", self.local.append, 10)
+        sub(move_base_msgs.MoveBase.ActionFeedback, "move_base/feedback", self.feedback.append, 10)
+
+
+def nav_world(params=None, start=(1.0, 1.0, 0.0), world=None, with_map=True):
+    """A runtime with the room, a robot in /lizi1, fake_localization, move_base and a client."""
+    from types import SimpleNamespace
+
+    from fleetsim.msgs import move_base_msgs
+    from fleetsim.nav.fake_localization import FakeLocalization
+    from fleetsim.nav.move_base import MoveBase
+    from fleetsim.runtime import Runtime
+
+    rt = Runtime()
+    rt.params.set("/lizi1/tf_prefix", "lizi1")
+    rt.params.update("/lizi1/move_base", params if params is not None else move_base_params())
+    maps = MapPublisher(rt) if with_map else None
+    bot = KinematicRobot(rt, start=start, world=world)
+    FakeLocalization(rt, namespace="/lizi1")
+    mb = MoveBase(rt, "move_base", "/lizi1", remaps={"map": "/map"})
+    watcher = Watcher(rt)
+    client = Node(rt, "client", "/lizi1").create_action_client(move_base_msgs.MoveBase, "move_base")
+    return SimpleNamespace(rt=rt, bot=bot, mb=mb, watch=watcher, client=client, maps=maps)

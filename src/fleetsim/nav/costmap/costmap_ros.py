@@ -119,6 +119,7 @@ class Costmap2DROS:
         self._warned: dict[str, float] = {}
         self._last_reading: dict[tuple[str, str], float] = {}
         self._subs: list[Any] = []
+        self._map_subs: dict[str, Any] = {}
         _ = node.tf_buffer  # listen to /tf from now on
         self.costmap_pub = node.create_publisher(
             nav_msgs.OccupancyGrid, f"~{name}/costmap", queue_size=1, latch=True
@@ -183,7 +184,12 @@ class Costmap2DROS:
                 )
             layer.set_map(occupancy)
 
-        self._subs.append(self.node.create_subscription(nav_msgs.OccupancyGrid, topic, on_map, 1))
+        old = self._map_subs.get(layer.name)
+        if old is not None:
+            old.destroy()
+        sub = self.node.create_subscription(nav_msgs.OccupancyGrid, topic, on_map, 1)
+        self._map_subs[layer.name] = sub
+        self._subs.append(sub)
 
     def _subscribe_source(self, layer: ObstacleLayer, source: str) -> None:
         sp = layer.buffers[source].params
@@ -387,13 +393,14 @@ class Costmap2DROS:
         self.initialized = False
 
     def start(self) -> None:
-        """Resume after `stop`; ready again after the next update."""
+        """Resume after `stop`; static layers subscribe again (getting the latched map, as
+        StaticLayer::activate does); ready again after the next update."""
         if self.stopped:
             self.stopped = False
             self._last_reading.clear()
-            for layer in self.layered.layers:
-                if isinstance(layer, StaticLayer):
-                    layer.reset()
+            for layer in self._static_layers():
+                layer.reset()
+                self._subscribe_map(layer)
 
     def destroy(self) -> None:
         for sub in self._subs:

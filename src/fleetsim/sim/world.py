@@ -96,11 +96,16 @@ def sun() -> LightDesc:
     return LightDesc("sun", direction=(-0.5, 0.1, -0.9))
 
 
+WALL_TILE = 4.0  # m, side of the square tiles map walls are grouped into
+
+
 def world_from_map(yaml_path: str | Path, wall_height: float = 1.0) -> WorldDesc:
     """A world whose walls are the occupied cells of a map_server map (world frame = map frame).
 
     Occupied cells are merged into few boxes (``mapworld.rectangles_from_occupancy``), all in
-    one static model ``map_walls``; a ground plane covering the map and a sun are added.
+    one static model ``map_walls`` whose links are square tiles of ``WALL_TILE`` metres (many
+    small static bodies let MuJoCo's broad phase skip the walls far from a robot); a ground
+    plane covering the map and a sun are added.
     """
     grid = load_map(yaml_path)
     boxes = wall_boxes(grid, wall_height)
@@ -118,9 +123,14 @@ def world_from_map(yaml_path: str | Path, wall_height: float = 1.0) -> WorldDesc
     extent = float(max(h, w) * grid.resolution) + 20.0
     lo, hi = boxes[:, :2].min(axis=0), boxes[:, :2].max(axis=0)
     centre = (float((lo[0] + hi[0]) / 2), float((lo[1] + hi[1]) / 2)) if len(boxes) else (0, 0)
-    walls = ModelDesc(
-        "map_walls", static=True, links=[LinkDesc("link", geoms=geoms)], source=str(yaml_path)
-    )
+    tiles: dict[tuple[int, int], list[GeomDesc]] = {}
+    for g in geoms:
+        key = (int(g.pose[0] // WALL_TILE), int(g.pose[1] // WALL_TILE))
+        tiles.setdefault(key, []).append(g)
+    links = [
+        LinkDesc(f"tile_{i}_{j}".replace("-", "m"), geoms=v) for (i, j), v in sorted(tiles.items())
+    ]
+    walls = ModelDesc("map_walls", static=True, links=links, source=str(yaml_path))
     return WorldDesc(
         name=Path(yaml_path).stem,
         models=[ground_plane(extent, centre), walls],

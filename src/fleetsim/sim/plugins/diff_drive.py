@@ -78,6 +78,7 @@ class WheeledDrive(DrivePlugin):
         p = self.params
         for j, key in zip(self.left + self.right, self.joint_params):
             require_joint(self.ctx, j, key, self.name)
+        self.frames = (self.ctx.frame(p.odometryFrame), self.ctx.frame(p.robotBaseFrame))
         self.sep = p.wheelSeparation
         self.radius = p.wheelDiameter / 2
         self.cmd = (0.0, 0.0)
@@ -87,10 +88,10 @@ class WheeledDrive(DrivePlugin):
     def reset(self) -> None:
         self.cmd = (0.0, 0.0)
         self.speed = (0.0, 0.0)  # wheel surface speed targets, m/s (left, right)
-        self.pose = np.zeros(3)  # encoder odometry x, y, yaw in the odom frame
+        self.pose = (0.0, 0.0, 0.0)  # encoder odometry x, y, yaw in the odom frame
         self.prev_angles: tuple[float, float] | None = None
         self.prev_t: float | None = None
-        self.twist = np.zeros(2)
+        self.twist = (0.0, 0.0)
 
     def build(self, spec, engine) -> None:
         kv = KV_PER_TORQUE * max(self.torque, 1e-3)
@@ -156,8 +157,8 @@ class WheeledDrive(DrivePlugin):
 
     def _encoder_step(self, engine, t: float) -> None:
         q = engine.data.qpos
-        left = sum(q[i] for i in self.q_left) / len(self.q_left)
-        right = sum(q[i] for i in self.q_right) / len(self.q_right)
+        left = sum(float(q[i]) for i in self.q_left) / len(self.q_left)
+        right = sum(float(q[i]) for i in self.q_right) / len(self.q_right)
         if self.prev_angles is None:
             self.prev_angles = (left, right)
             self.prev_t = t
@@ -167,12 +168,13 @@ class WheeledDrive(DrivePlugin):
         self.prev_angles = (left, right)
         ds = (dl + dr) / 2
         dth = (dr - dl) / self.sep
-        mid = self.pose[2] + dth / 2
-        self.pose += (ds * math.cos(mid), ds * math.sin(mid), dth)
+        x, y, yaw = self.pose
+        mid = yaw + dth / 2
+        self.pose = (x + ds * math.cos(mid), y + ds * math.sin(mid), yaw + dth)
         dt = t - self.prev_t
         self.prev_t = t
         if dt > 0:
-            self.twist = np.array([ds / dt, dth / dt])
+            self.twist = (ds / dt, dth / dt)
 
     def measure(self, engine, t: float) -> OdometryReading:
         p = self.params
@@ -194,8 +196,7 @@ class WheeledDrive(DrivePlugin):
         return OdometryReading(
             t,
             p.odometryTopic,
-            self.ctx.frame(p.odometryFrame),
-            self.ctx.frame(p.robotBaseFrame),
+            *self.frames,
             pos,
             quat,
             lin,

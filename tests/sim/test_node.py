@@ -68,6 +68,13 @@ def test_world_services(sim):
     assert spawn(probe, "bot", (10.0, 10.0)).success
     dup = spawn(probe, "bot", (11.0, 10.0))
     assert not dup.success and "already exists" in dup.status_message
+    client = probe.create_client(gazebo_msgs.SpawnModel, "/gazebo/spawn_urdf_model")
+    broken = client.call(
+        gazebo_msgs.SpawnModel.Request(
+            model_name="broken", model_xml="<robot name='b'>\n<link name='a'>\n</robot>"
+        )
+    )
+    assert not broken.success and ":3" in broken.status_message  # names the line
     get = probe.create_client(gazebo_msgs.GetModelState, "/gazebo/get_model_state")
     setc = probe.create_client(gazebo_msgs.SetModelState, "/gazebo/set_model_state")
     req = gazebo_msgs.SetModelState.Request()

@@ -1,0 +1,63 @@
+"""p3d ground truth: offsets, reference link, seeded noise."""
+
+import numpy as np
+import pytest
+
+from fleetsim.description import parse_urdf
+from fleetsim.errors import SimulationError
+from fleetsim.sim import Engine
+from fleetsim.sim.plugins.p3d import P3dPlugin
+
+from ..conftest import robot_text
+
+
+def p3d_robot(extra: str):
+    """The diffbot with extra p3d parameters."""
+    anchor = "<frameName>/map</frameName>"
+    return parse_urdf(robot_text("diffbot.urdf").replace(anchor, anchor + extra))
+
+
+def reading(engine, entry):
+    plugin = next(p for p in entry.plugins if isinstance(p, P3dPlugin))
+    return plugin.measure(engine, engine.time)
+
+
+def test_offsets_are_applied():
+    e = Engine(None)
+    ent = e.spawn_robot(
+        "r",
+        p3d_robot("<xyzOffsets>1 2 3</xyzOffsets><rpyOffsets>0 0 0.5</rpyOffsets>"),
+        (4.0, 5.0, 0, 0, 0, 0),
+    )
+    r = reading(e, ent)
+    np.testing.assert_allclose(r.position, [5.0, 7.0, 3.0], atol=1e-3)
+    yaw = 2 * np.arctan2(r.orientation[2], r.orientation[3])
+    assert yaw == pytest.approx(0.5, abs=1e-3)
+
+
+def test_noise_is_seeded():
+    def sample(seed):
+        e = Engine(None, rng=np.random.default_rng(seed))
+        ent = e.spawn_robot("r", p3d_robot("<gaussianNoise>0.05</gaussianNoise>"))
+        return reading(e, ent).position
+
+    a, b, c = sample(4), sample(4), sample(5)
+    np.testing.assert_array_equal(a, b)
+    assert not np.array_equal(a, c) and np.abs(a).max() < 0.3
+
+
+def test_reference_link_frame_and_missing_body():
+    e = Engine(None)
+    ent = e.spawn_robot("r", p3d_robot(""), (1.0, 0, 0, 0, 0, 0))
+    text = robot_text("diffbot.urdf").replace(
+        "<frameName>/map</frameName>", "<frameName>base_link</frameName>"
+    )
+    rel = e.spawn_robot("q", parse_urdf(text), (1.0, 0, 0, 0, 0, 0))
+    r = reading(e, rel)
+    np.testing.assert_allclose(r.position, [0, 0, -0.05], atol=1e-3)  # footprint below base
+    assert r.frame_id == "q/base_link" and reading(e, ent).frame_id == "map"
+    bad = robot_text("diffbot.urdf").replace("<bodyName>base_footprint", "<bodyName>chassis")
+    with pytest.raises(
+        SimulationError, match="bodyName names link 'chassis', which the model lacks"
+    ):
+        e.spawn_robot("x", parse_urdf(bad))

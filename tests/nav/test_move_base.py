@@ -4,8 +4,9 @@ import math
 
 import numpy as np
 import pytest
-from nav_world import fill, goal_msg, move_base_params, nav_world, room_grid, room_map
+from nav_world import goal_msg, move_base_params, nav_world, room_map
 
+from fleetsim.errors import ParameterError
 from fleetsim.msgs import geometry_msgs, nav_msgs
 from fleetsim.msgs.actionlib_msgs import GoalStatus
 from fleetsim.nav.map_server import grid_msg_from_map
@@ -58,47 +59,6 @@ def test_simple_goal_topic_in_the_odom_frame_is_transformed_to_the_map():
     assert final_distance(w, 2.0, 2.0) <= 0.15
 
 
-def test_goal_inside_a_wall_aborts_after_recoveries_with_the_reason():
-    w = nav_world(move_base_params(planner_patience=1.0))
-    h = run_goal(w, goal_msg(4.0, 1.0))
-    assert h.status == GoalStatus.ABORTED
-    assert h.text.startswith(
-        "Failed to find a valid plan. Even after executing recovery behaviors."
-    )
-    assert "navfn: the goal (4.000, 1.000) is in an obstacle" in h.text
-    assert w.rt.now() < 40.0  # bounded: 5 x patience + two turns
-    turns = [m.angular.z for _, m in w.watch.cmds if m.angular.z > 0]
-    assert len(turns) > 20  # rotate_recovery turned the robot in place
-    assert w.watch.cmds[-1][1].angular.z == 0.0
-
-
-def test_goal_outside_the_map_aborts_without_recoveries():
-    params = move_base_params(planner_patience=0.5, recovery_behavior_enabled=False)
-    w = nav_world(params)
-    w.rt.run(duration=0.5)
-    h = run_goal(w, goal_msg(20.0, 20.0))
-    assert h.status == GoalStatus.ABORTED
-    assert "navfn: the goal (20.000, 20.000) is off the global costmap" in h.text
-    assert w.rt.now() < 2.0
-
-
-def test_unreachable_goal_in_a_closed_box_aborts():
-    params = move_base_params(planner_patience=0.5, recovery_behavior_enabled=False)
-    h = run_goal(nav_world(params), goal_msg(6.7, 1.1))
-    assert h.status == GoalStatus.ABORTED
-    assert "not connected to the robot through free space" in h.text
-
-
-def test_max_planning_retries_ends_planning_before_the_patience():
-    params = move_base_params(
-        planner_patience=30.0, max_planning_retries=0, recovery_behavior_enabled=False
-    )
-    w = nav_world(params)
-    w.rt.run(duration=0.5)
-    h = run_goal(w, goal_msg(20.0, 20.0))
-    assert h.status == GoalStatus.ABORTED and w.rt.now() < 1.0
-
-
 def test_a_newer_goal_preempts_and_cancel_stops_the_robot():
     w = nav_world()
     first = w.client.send_goal(goal_msg(6.0, 4.5))
@@ -142,34 +102,6 @@ def test_goal_before_the_map_waits_then_is_reached(caplog):
     assert h.status == GoalStatus.SUCCEEDED
 
 
-def test_oscillation_timeout_aborts():
-    params = move_base_params(
-        oscillation_timeout=0.5, oscillation_distance=50.0, recovery_behavior_enabled=False
-    )
-    h = run_goal(nav_world(params), goal_msg(6.0, 4.5), limit=10.0)
-    assert h.status == GoalStatus.ABORTED
-    assert h.text == "Robot is oscillating. Even after executing recovery behaviors."
-
-
-def test_blocked_robot_aborts_on_controller_patience():
-    world = room_grid()
-    fill(world, 0.6, 0.6, 1.4, 0.7)  # a pen around the robot that only its laser sees
-    fill(world, 0.6, 1.3, 1.4, 1.4)
-    fill(world, 0.6, 0.6, 0.7, 1.4)
-    fill(world, 1.3, 0.6, 1.4, 1.4)
-    params = move_base_params(
-        glob={"observation_sources": ""},  # the global planner does not see the pen
-        controller_patience=1.0,
-        recovery_behavior_enabled=False,
-    )
-    w = nav_world(params, world=world)
-    h = run_goal(w, goal_msg(3.0, 3.0), limit=20.0)
-    assert h.status == GoalStatus.ABORTED
-    assert h.text.startswith("Failed to find a valid control.")
-    assert "TrajectoryPlannerROS: no valid trajectory" in h.text
-    assert w.bot.min_clearance > 0.0
-
-
 def test_speed_limit_and_shutdown_costmaps():
     params = move_base_params(planner={"max_vel_x": 0.25}, shutdown_costmaps=True)
     w = nav_world(params)
@@ -180,3 +112,26 @@ def test_speed_limit_and_shutdown_costmaps():
     speeds = [m.linear.x for _, m in w.watch.cmds]
     assert 0.2 < max(speeds) <= 0.25 + 1e-9
     assert w.mb.global_costmap.stopped and w.mb.local_costmap.stopped
+
+
+def test_lesson_parameters_load_without_unknown_warnings(caplog):
+    params = move_base_params(
+        controller_frequency=10.0,
+        max_planning_retries=-1,
+        recovery_behaviors=[{"name": "spin", "type": "rotate_recovery/RotateRecovery"}],
+        spin={"frequency": 10.0},
+        planner_patiance=3.0,
+    )
+    w = nav_world(params)
+    assert w.mb.params.max_planning_retries is None  # ROS's -1: no limit
+    assert w.mb.params.controller_frequency == 10.0
+    assert [r.name for r in w.mb.recoveries] == ["spin"]
+    unknown = [r.getMessage() for r in caplog.records if "unknown parameter" in r.getMessage()]
+    assert (
+        len(unknown) == 1 and "'planner_patiance' (did you mean 'planner_patience'?)" in unknown[0]
+    )
+
+
+def test_unknown_global_planner_is_an_error():
+    with pytest.raises(ParameterError, match=r"'base_global_planner' = 'global_planner/Glob"):
+        nav_world(move_base_params(base_global_planner="global_planner/GlobalPlanner"))

@@ -55,7 +55,7 @@ from fleetsim.nav.move_base_support import (
     pose_stamped,
     quaternion_problem,
 )
-from fleetsim.runtime import Node, param
+from fleetsim.runtime import Node, load_params, param
 from fleetsim.tf.names import normalize_frame
 
 
@@ -192,13 +192,20 @@ class MoveBase(ExecuteCycle, Node):
         return raw if isinstance(raw, dict) else {}
 
     def _load_params(self) -> Any:
+        """As Node's, reading ROS's -1 (no limit) as unset, and not warning about the
+        namespaces of the recovery behaviours listed in ``recovery_behaviors``."""
         raw = self._raw_params()
-        if raw.get("max_planning_retries") == -1:  # ROS's "no limit"
-            self.runtime.params.delete(f"{self.full_name}/max_planning_retries")
-        extra = [str(e.get("name")) for e in raw.get("recovery_behaviors") or []
-                 if isinstance(e, dict)]  # fmt: skip
-        self.PARAM_NAMESPACES = (*type(self).PARAM_NAMESPACES, *extra)
-        return super()._load_params()
+        if raw.get("max_planning_retries") == -1:
+            del raw["max_planning_retries"]
+        listed = raw.get("recovery_behaviors")
+        extra = [str(e.get("name")) for e in listed or [] if isinstance(e, dict)]
+        return load_params(
+            self.Params,
+            raw,
+            where=self.full_name,
+            ignore=frozenset((*self.PARAM_NAMESPACES, *extra)),
+            logger=self.get_logger(),
+        )
 
     # -- small helpers -------------------------------------------------------------------------
     def _warn(self, key: str, text: str, period: float = 5.0) -> None:

@@ -46,7 +46,7 @@ def navfn_costs(costs, allow_unknown):
     return out
 
 
-@njit(cache=True)
+@njit(cache=True, error_model="numpy")  # no zero-division checks: costs are >= 50
 def navfn_potential(costarr, nx, goal, start, at_start, cycles):
     """Potential from ``goal`` by navfn's Dijkstra-like wavefront (propNavFnDijkstra).
 

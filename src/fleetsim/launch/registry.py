@@ -19,6 +19,13 @@ NODES: dict[tuple[str, str], str] = {
     ("robot_state_publisher", "robot_state_publisher"): "fleetsim.description.robot_state_publisher:RobotStatePublisher",
     ("robot_state_publisher", "state_publisher"): "fleetsim.description.robot_state_publisher:RobotStatePublisher",
     ("amcl", "amcl"): "fleetsim.localization.amcl.node:Amcl",
+    ("fake_localization", "fake_localization"): "fleetsim.nav.fake_localization:FakeLocalization",
+    ("map_server", "map_server"): "fleetsim.nav.map_server:MapServer",
+    ("map_server", "map_saver"): "fleetsim.nav.map_server:MapSaver",
+    ("move_base", "move_base"): "fleetsim.nav.move_base:MoveBase",
+    ("fleetsim", "send_goals"): "fleetsim.nav.send_goals:SendGoals",
+    ("navigation_multi", "send_goals"): "fleetsim.nav.send_goals:SendGoals",
+    ("gazebo_ros", "gzserver"): "fleetsim.sim.node:Simulator",
     ("gazebo_ros", "spawn_model"): "fleetsim.sim.spawn_model:SpawnModel",
     ("joint_state_publisher", "joint_state_publisher"): "fleetsim.description.joint_state_publisher:JointStatePublisher",
 }  # fmt: skip

@@ -125,3 +125,31 @@ def test_densified_plan_matches_per_segment_reference():
         n = np.maximum(1, np.ceil(np.hypot(seg[:, 0], seg[:, 1]) / 0.05).astype(int))
         ref = [a + (np.arange(k) / k)[:, None] * d for a, d, k in zip(p[:-1], seg, n)]
         assert np.array_equal(densified_plan(p, 0.05), np.concatenate([*ref, p[-1:]]))
+
+
+@pytest.mark.parametrize("y", [0.62, 0.75, 1.0])
+def test_path_distances_match_the_full_passable_mask(y):
+    """Skipping the footprint mask away from obstacles gives the MapGrid of the full method."""
+    from fleetsim.nav.controllers import TrajectoryPlanner, TrajectoryPlannerParams
+    from fleetsim.nav.controllers.map_grid import distances_from_targets
+    from fleetsim.nav.costmap import Costmap2D
+    from fleetsim.nav.costmap.footprint import footprint_at, polygon_cells
+
+    m = Costmap2D(120, 40, 0.05)
+    m.costs[0:8, :] = 254
+    m.costs[8:12, :] = 253  # inscribed band along the wall
+    m.costs[32:, :] = 254
+    fp = footprint_from_radius(0.2)
+    tp = TrajectoryPlanner(m, fp, TrajectoryPlannerParams(holonomic_robot=False))
+    xs = np.linspace(0.5, 5.0, 50)
+    plan = np.stack([xs, np.full(50, 1.0), np.zeros(50)], axis=1)
+    tp.set_plan(plan)
+    pose = (1.0, y, 0.3)
+    tp.compute_velocity_commands(pose, (0.0, 0.0, 0.0))
+    passable = np.zeros(m.costs.shape, bool)
+    rows, cols = polygon_cells(m, footprint_at(fp, *pose))
+    passable[rows, cols] = True
+    assert np.array_equal(tp.path_dist, distances_from_targets(m.costs, tp.plan_cells, passable))
+    assert tp._obstacle_near(footprint_at(fp, *pose)) == (y < 0.8)
+    without = distances_from_targets(m.costs, tp.plan_cells, np.zeros_like(passable))
+    assert np.array_equal(tp.path_dist, without) == (y > 0.7)  # the mask matters near walls

@@ -111,7 +111,8 @@ def _add_joint(body, joint: Any, prefix: str, robot: Any) -> None:
             j.limited = mujoco.mjtLimited.mjLIMITED_TRUE
             j.range = [lim.lower, lim.upper]
         if joint.dynamics is not None:
-            j.damping = joint.dynamics.damping
+            # MuJoCo 4 damping is (linear, quadratic, cubic); URDF gives the linear term
+            j.damping = [joint.dynamics.damping, 0.0, 0.0]
             j.frictionloss = joint.dynamics.friction
     elif joint.type == "planar":
         for k, ax in enumerate(([1, 0, 0], [0, 1, 0])):

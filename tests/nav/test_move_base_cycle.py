@@ -112,3 +112,16 @@ def test_a_clearing_recovery_forgets_far_obstacles_at_the_next_update():
     cm.update()
     assert cm.costmap.costs[far[1], far[0]] < 253  # outside the 3 m square: forgotten
     assert cm.costmap.costs[near[1], near[0]] == 254  # inside it: kept
+
+
+def test_a_new_goal_during_a_rotate_recovery_starts_afresh():
+    w = nav_world(move_base_params(planner_patience=0.5))
+    first = w.client.send_goal(goal_msg(4.0, 1.0))  # inside the wall
+    spinning = w.mb.recoveries[1].rotate
+    w.rt.run(duration=10.0, until=lambda: spinning.start_angle is not None)
+    assert w.mb.state == "CLEARING" and w.mb.recovery_index == 1
+    w.rt.run(duration=1.0)  # part of the turn
+    second = run_goal(w, goal_msg(2.0, 2.0), limit=30.0)
+    assert first.status == GoalStatus.PREEMPTED
+    assert second.status == GoalStatus.SUCCEEDED
+    assert spinning.start_angle is None

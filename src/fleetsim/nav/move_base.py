@@ -230,14 +230,17 @@ class MoveBase(ExecuteCycle, Node):
         self.recovery_index = 0
         self.recovery_trigger = PLANNING_R
         self.next_plan_time = self.now()
-        for rec in self.recoveries:
-            if rec.rotate is not None:
-                rec.rotate.start_angle = None
+        self._reset_rotations()
         if publish:
             self.publish_zero_velocity()
         if self.params.shutdown_costmaps:
             self.global_costmap.stop()
             self.local_costmap.stop()
+
+    def _reset_rotations(self) -> None:
+        for rec in self.recoveries:
+            if rec.rotate is not None:
+                rec.rotate.start_angle = None
 
     def _wake_planner(self) -> None:
         self.run_planner = True
@@ -300,6 +303,8 @@ class MoveBase(ExecuteCycle, Node):
         self.goal_msg = goal.target_pose
         self.goal = self.to_global(self.goal_msg)
         self.recovery_index = 0
+        self.recovery_trigger = PLANNING_R
+        self._reset_rotations()
         self.state = PLANNING
         self._wake_planner()
         self.plan = self.new_plan = None

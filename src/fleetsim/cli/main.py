@@ -31,6 +31,7 @@ SUBAPPS = [
     ("fleetsim.cli.urdf", "app", "urdf", "Robot descriptions: check, graph, export."),
     ("fleetsim.cli.sim", "app", "sim", "The simulator: world snapshots."),
     ("fleetsim.cli.bag", "app", "bag", "MCAP recordings: info, play, record."),
+    ("fleetsim.cli.map", "app", "map", "Maps: save (map_saver), show."),
     ("fleetsim.cli.tools", "topic_app", "topic", "Topics of a running simulation."),
     ("fleetsim.cli.tools", "service_app", "service", "Services of a running simulation."),
     ("fleetsim.cli.tools", "param_app", "param", "Parameters of a running simulation."),

@@ -27,7 +27,8 @@ from fleetsim.sim.plugins.base import (
 )
 
 _log = logging.getLogger("fleetsim.sim.drive")
-KV_PER_TORQUE = 20.0  # velocity-actuator gain per N m of torque limit (N m s/rad)
+SERVO_TIME = 0.05  # s, time constant of the wheel speed servo (a motor controller's lag)
+INTEGRAL_TIME = 0.1  # s, integral time of the servo (holds speed against scrub and slopes)
 
 
 @dataclass(frozen=True)
@@ -79,6 +80,7 @@ class WheeledDrive(DrivePlugin):
         for j, key in zip(self.left + self.right, self.joint_params):
             require_joint(self.ctx, j, key, self.name)
         self.frames = (self.ctx.frame(p.odometryFrame), self.ctx.frame(p.robotBaseFrame))
+        self.kv = 1.0  # N m s/rad, set from the robot's mass in bind()
         self.sep = p.wheelSeparation
         self.radius = p.wheelDiameter / 2
         self.cmd = (0.0, 0.0)
@@ -88,22 +90,22 @@ class WheeledDrive(DrivePlugin):
     def reset(self) -> None:
         self.cmd = (0.0, 0.0)
         self.speed = (0.0, 0.0)  # wheel surface speed targets, m/s (left, right)
+        self.integral = [0.0] * (len(self.left) + len(self.right))
         self.pose = (0.0, 0.0, 0.0)  # encoder odometry x, y, yaw in the odom frame
         self.prev_angles: tuple[float, float] | None = None
         self.prev_t: float | None = None
         self.twist = (0.0, 0.0)
 
     def build(self, spec, engine) -> None:
-        kv = KV_PER_TORQUE * max(self.torque, 1e-3)
         for j in self.left + self.right:
             a = spec.add_actuator(
                 name=f"{self.ctx.model}/{self.name}/{j}",
                 target=f"{self.ctx.model}/{j}",
                 trntype=mujoco.mjtTrn.mjTRN_JOINT,
             )
-            a.set_to_velocity(kv=kv)
-            a.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
-            a.forcerange = [-self.torque, self.torque]
+            a.set_to_velocity(kv=1.0)  # gain set in bind()
+            # no forcerange: a force-limited actuator loses its implicit damping term and goes
+            # unstable on light wheels; the torque limit is applied on the target instead
 
     def bind(self, engine) -> None:
         m = engine.model
@@ -116,11 +118,20 @@ class WheeledDrive(DrivePlugin):
             ],
             np.int64,
         )
-        self.qadr, _ = joint_addresses(engine, self.ctx.model, self.left + self.right)
+        self.qadr, dadr = joint_addresses(engine, self.ctx.model, self.left + self.right)
         self.root = engine.root_body(self.ctx.model)
+        # wheel speed servo gain: the inertia each wheel drives (its share of the robot's mass
+        # at the wheel radius) over the servo time constant; stiffer gains rock light robots
+        m = engine.model
+        mass = float(m.body_subtreemass[self.root])
+        n = len(self.left) + len(self.right)
+        inertia = mass * self.radius**2 / n + float(m.dof_armature[dadr].mean())
+        self.kv = max(inertia / SERVO_TIME, 1e-6)
+        for a in self.act:
+            m.actuator_gainprm[a, 0] = self.kv
+            m.actuator_biasprm[a, 2] = -self.kv
         self.nl = len(self.left)
-        self.act_left = [int(a) for a in self.act[: self.nl]]
-        self.act_right = [int(a) for a in self.act[self.nl :]]
+        self.wheels = [(int(a), int(v)) for a, v in zip(self.act, dadr)]
         self.q_left = [int(a) for a in self.qadr[: self.nl]]
         self.q_right = [int(a) for a in self.qadr[self.nl :]]
 
@@ -145,11 +156,17 @@ class WheeledDrive(DrivePlugin):
             left = self.speed[0] + min(max(left - self.speed[0], -dv), dv)
             right = self.speed[1] + min(max(right - self.speed[1], -dv), dv)
         self.speed = (left, right)
-        ctrl = engine.data.ctrl
-        for a in self.act_left:
-            ctrl[a] = left / self.radius
-        for a in self.act_right:
-            ctrl[a] = right / self.radius
+        ctrl, qvel = engine.data.ctrl, engine.data.qvel
+        limit = self.torque / self.kv  # speed error (rad/s) at which the torque saturates
+        gain = engine.model.opt.timestep / INTEGRAL_TIME
+        integ = self.integral
+        for i, (a, v) in enumerate(self.wheels):
+            w = float(qvel[v])
+            err = (left if i < self.nl else right) / self.radius - w
+            # PI speed servo: P through the (implicit) velocity actuator, I added to its target,
+            # clamped to the torque limit with anti-windup
+            integ[i] = min(max(integ[i] + err * gain, -limit - err), limit - err)
+            ctrl[a] = w + min(max(err + integ[i], -limit), limit)
 
     @property
     def update_rate(self) -> float:

@@ -194,3 +194,15 @@ def test_xml_syntax_error_has_line(tmp_path):
     q.write_text("<robot/>")
     with pytest.raises(LaunchError, match="root element must be <launch>"):
         load_xml(q)
+
+
+def test_eval_reads_bare_args_as_roslaunch_does(tmp_path):
+    p = write(
+        tmp_path,
+        '<arg name="nav" default="false"/><arg name="amcl" default="true"/>'
+        '<param name="x" value="1" if="$(eval nav or amcl)"/>'
+        '<param name="y" value="1" if="$(eval nav and amcl)"/>'
+        "<param name=\"z\" value=\"$(eval arg('nav') + '!')\"/>",
+    )
+    t = load_xml(p).param_tree()
+    assert t.has("/x") and not t.has("/y") and t.get("/z") == "false!"

@@ -102,8 +102,10 @@ def _eval(expr: str, ctx: Context, where: str) -> str:
     # optenv(), anon(), dirname() and math. Only names, no builtins beyond a few safe ones.
     class _Args(dict):
         def __missing__(self, key):
+            # like roslaunch, a bare arg name reads as its converted value ("false" -> False,
+            # "3" -> 3); arg('name') gives the string
             if key in ctx.args:
-                return ctx.arg(key, where)
+                return auto_value(ctx.arg(key, where))
             raise LaunchError(f"{where}: $(eval {expr}): unknown name '{key}'")
 
     scope = _Args(
@@ -153,6 +155,19 @@ def substitute(text: str | None, ctx: Context, where: str) -> str | None:
     if "$(" in out:
         raise LaunchError(f"{where}: substitution does not parse: {text!r}")
     return out
+
+
+def auto_value(text: str):
+    """roslaunch's automatic conversion: int, then float, then true/false, else the string."""
+    v = text.strip()
+    for conv in (int, float):
+        try:
+            return conv(v)
+        except ValueError:
+            pass
+    if v.lower() in ("true", "false"):
+        return v.lower() == "true"
+    return text
 
 
 def to_bool(value: str, where: str) -> bool:

@@ -22,7 +22,7 @@ from lxml import etree
 
 from fleetsim.errors import FleetsimError, LaunchError, did_you_mean
 from fleetsim.launch.model import LaunchPlan, NodeSpec, ParamOp
-from fleetsim.launch.substitutions import Context, substitute, to_bool
+from fleetsim.launch.substitutions import Context, auto_value, substitute, to_bool
 from fleetsim.runtime import names
 
 _ATTRS = {
@@ -101,15 +101,7 @@ def convert_value(value: str, type_: str | None, where: str) -> Any:
         raise LaunchError(
             f"{where}: unknown param type {type_!r}; use str, int, double, bool or yaml"
         )
-    v = value.strip()
-    for conv in (int, float):
-        try:
-            return conv(v)
-        except ValueError:
-            pass
-    if v.lower() in ("true", "false"):
-        return v.lower() == "true"
-    return value
+    return auto_value(value)
 
 
 class XmlLoader:

@@ -17,8 +17,10 @@ import numpy as np
 from fleetsim.errors import SimulationError
 from fleetsim.sim import sdf
 from fleetsim.sim.build import add_sdf_model, spec_from_world
+from fleetsim.sim.drives import DriveBatch
 from fleetsim.sim.lasers import LaserBatch
 from fleetsim.sim.plugins import base
+from fleetsim.sim.plugins.diff_drive import WheeledDrive
 from fleetsim.sim.plugins.link_attacher import LinkAttacher
 from fleetsim.sim.queries import StateQueries
 from fleetsim.sim.robot_build import add_robot
@@ -87,6 +89,7 @@ class Engine(StateQueries):
         self.data: mujoco.MjData | None = None
         self.attacher = LinkAttacher()
         self.lasers = LaserBatch()
+        self.drives = DriveBatch()
         self.paused = False
         self._next_due: dict[int, float] = {}
         self._renderers: dict[tuple[int, int], mujoco.Renderer] = {}
@@ -103,6 +106,7 @@ class Engine(StateQueries):
                 self.model, self.data = self.spec.recompile(self.model, self.data)
         except ValueError as exc:
             raise SimulationError(f"MuJoCo cannot compile the world: {exc}") from exc
+        self.drives.sync_back()
         mujoco.mj_forward(self.model, self.data)
         self._index()
         for r in self._renderers.values():
@@ -268,11 +272,13 @@ class Engine(StateQueries):
         """Refresh the plugin lists after the set of models changed."""
         self._plugins = self.plugins()
         self._controllers = [p for p in self._plugins if type(p).control is not base.Plugin.control]
+        self.drives.bind([p for p in self._plugins if isinstance(p, WheeledDrive)])
         self._min_due = 0.0
 
     def step(self) -> None:
         """One physics step: plugin controls, link attacher, ``mj_step``."""
         t = self.time
+        self.drives.control(self, t)
         for p in self._controllers:
             p.control(self, t)
         if self.attacher.pending:

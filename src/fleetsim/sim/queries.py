@@ -154,6 +154,7 @@ class StateQueries:
         self._reset_joints()
         for p in self.plugins():
             p.reset()
+        self.drives.reload()
         mujoco.mj_forward(self.model, self.data)
 
     def _reset_joints(self) -> None:

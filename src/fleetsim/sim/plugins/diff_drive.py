@@ -1,7 +1,8 @@
 """Differential drive (``libgazebo_ros_diff_drive.so``) and the shared wheeled-drive logic.
 
 The wheels are real MuJoCo hinge joints rolling on friction contacts, each driven by a velocity
-actuator whose force is limited to the plugin's torque, as Gazebo's joint motors are. Encoder
+actuator in a PI speed servo limited to the plugin's torque (``sim.drives.DriveBatch`` runs the
+servos of all drives at once, before every physics step). Encoder
 odometry integrates the wheel angle increments, so it drifts and slips as a real base does;
 ``odometrySource world`` reports the model's true world pose instead (Gazebo's default).
 A ``Twist`` with NaN or infinite components is ignored with a warning and the robot stops; a
@@ -28,7 +29,6 @@ from fleetsim.sim.plugins.base import (
 
 _log = logging.getLogger("fleetsim.sim.drive")
 SERVO_TIME = 0.05  # s, time constant of the wheel speed servo (a motor controller's lag)
-INTEGRAL_TIME = 0.1  # s, integral time of the servo (holds speed against scrub and slopes)
 
 
 @dataclass(frozen=True)
@@ -143,30 +143,6 @@ class WheeledDrive(DrivePlugin):
             return
         self.cmd = (float(vx), float(wz))
         self.last_cmd_t = t
-
-    def control(self, engine, t: float) -> None:
-        vx, wz = self.cmd
-        timeout = self.params.commandTimeout
-        if timeout > 0 and t - self.last_cmd_t > timeout:
-            vx, wz = 0.0, 0.0
-        left = vx - wz * self.sep / 2
-        right = vx + wz * self.sep / 2
-        if self.accel > 0:
-            dv = self.accel * engine.model.opt.timestep
-            left = self.speed[0] + min(max(left - self.speed[0], -dv), dv)
-            right = self.speed[1] + min(max(right - self.speed[1], -dv), dv)
-        self.speed = (left, right)
-        ctrl, qvel = engine.data.ctrl, engine.data.qvel
-        limit = self.torque / self.kv  # speed error (rad/s) at which the torque saturates
-        gain = engine.model.opt.timestep / INTEGRAL_TIME
-        integ = self.integral
-        for i, (a, v) in enumerate(self.wheels):
-            w = float(qvel[v])
-            err = (left if i < self.nl else right) / self.radius - w
-            # PI speed servo: P through the (implicit) velocity actuator, I added to its target,
-            # clamped to the torque limit with anti-windup
-            integ[i] = min(max(integ[i] + err * gain, -limit - err), limit - err)
-            ctrl[a] = w + min(max(err + integ[i], -limit), limit)
 
     @property
     def update_rate(self) -> float:

@@ -24,7 +24,7 @@ from fleetsim.sim.plugins.diff_drive import WheeledDrive
 from fleetsim.sim.plugins.link_attacher import LinkAttacher
 from fleetsim.sim.queries import StateQueries
 from fleetsim.sim.robot_build import add_robot
-from fleetsim.sim.world import ModelDesc, Pose, WorldDesc, world_from_map
+from fleetsim.sim.world import WALL_HEIGHT, ModelDesc, Pose, WorldDesc, world_from_map
 
 
 @dataclass
@@ -44,7 +44,9 @@ class ModelEntry:
     actuators: list[str] = field(default_factory=list)
 
 
-def load_world(source: str | Path | WorldDesc | None, wall_height: float = 1.0) -> WorldDesc:
+def load_world(
+    source: str | Path | WorldDesc | None, wall_height: float = WALL_HEIGHT
+) -> WorldDesc:
     """A ``WorldDesc`` from an SDF ``.world`` file, a map ``.yaml`` file, or None (empty)."""
     if source is None:
         from fleetsim.sim.world import ground_plane, sun
@@ -75,7 +77,7 @@ class Engine(StateQueries):
         world=None,
         timestep: float = 0.004,
         rng: np.random.Generator | None = None,
-        wall_height: float = 1.0,
+        wall_height: float = WALL_HEIGHT,
     ) -> None:
         self.world = load_world(world, wall_height)
         self.wall_height = wall_height

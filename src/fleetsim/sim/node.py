@@ -27,6 +27,7 @@ from fleetsim.sim.plugins.base import (
     ScanReading,
 )
 from fleetsim.sim.services import WorldServices
+from fleetsim.sim.world import WALL_HEIGHT
 
 EMPTY_WORLDS = ("", "worlds/empty.world", "empty", "empty.world")
 
@@ -45,7 +46,9 @@ class SimulatorParams:
     pub_clock_frequency: float = param(
         100.0, unit="Hz", range=(0.0, None), help="/clock rate (0: every update)"
     )
-    wall_height: float = param(1.0, unit="m", range=(0.01, None), help="map-world wall height")
+    wall_height: float = param(
+        WALL_HEIGHT, unit="m", range=(0.01, None), help="map-world wall height"
+    )
     publish_contacts: bool = param(True, help="publish robot contacts on ~robot_contacts")
 
 

@@ -14,6 +14,9 @@ from fleetsim.sim.mapworld import OccupancyMap, load_map, wall_boxes
 
 Pose = tuple[float, float, float, float, float, float]
 ZERO_POSE: Pose = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
+#: walls extruded from a map are building walls: taller than any robot's sensors (the lesson
+#: mounts lizi's laser 1 m up)
+WALL_HEIGHT = 2.0
 
 
 @dataclass
@@ -99,7 +102,7 @@ def sun() -> LightDesc:
 WALL_TILE = 4.0  # m, side of the square tiles map walls are grouped into
 
 
-def world_from_map(yaml_path: str | Path, wall_height: float = 1.0) -> WorldDesc:
+def world_from_map(yaml_path: str | Path, wall_height: float = WALL_HEIGHT) -> WorldDesc:
     """A world whose walls are the occupied cells of a map_server map (world frame = map frame).
 
     Occupied cells are merged into few boxes (``mapworld.rectangles_from_occupancy``), all in

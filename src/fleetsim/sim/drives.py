@@ -9,6 +9,7 @@ batch keeps the servo state while bound and writes it back before the world is r
 
 from __future__ import annotations
 
+import numba
 import numpy as np
 
 INTEGRAL_TIME = 0.1  # s, integral time of the servo (holds speed against scrub and slopes)
@@ -62,20 +63,76 @@ class DriveBatch:
         n = len(self.drives)
         cmd = np.array([d.cmd for d in self.drives], float).reshape(n, 2)
         last = np.fromiter((d.last_cmd_t for d in self.drives), float, n)
-        cmd[(self.timeout > 0) & (t - last > self.timeout)] = 0.0
-        target = np.empty((n, 2))
-        target[:, 0] = cmd[:, 0] - cmd[:, 1] * self.half_sep
-        target[:, 1] = cmd[:, 0] + cmd[:, 1] * self.half_sep
-        dt = engine.model.opt.timestep
-        ramp = self.accel > 0
-        if ramp.any():
-            dv = (self.accel * dt)[:, None]
-            ramped = self.speed + np.clip(target - self.speed, -dv, dv)
-            target = np.where(ramp[:, None], ramped, target)
-        self.speed = target
-        qvel, ctrl = engine.data.qvel, engine.data.ctrl
-        w = qvel[self.dofs]
-        err = target[self.owner, self.side] / self.radius - w
-        lim = self.limit
-        self.integral = np.clip(self.integral + err * (dt / INTEGRAL_TIME), -lim - err, lim - err)
-        ctrl[self.acts] = w + np.clip(err + self.integral, -lim, lim)
+        servo_targets(
+            cmd,
+            last,
+            t,
+            self.timeout,
+            self.half_sep,
+            self.accel,
+            engine.model.opt.timestep,
+            self.speed,
+            self.owner,
+            self.side,
+            self.radius,
+            self.limit,
+            self.integral,
+            engine.data.qvel,
+            engine.data.ctrl,
+            self.acts,
+            self.dofs,
+        )
+
+
+@numba.njit(cache=True)
+def servo_targets(
+    cmd,
+    last,
+    t,
+    timeout,
+    half_sep,
+    accel,
+    dt,
+    speed,
+    owner,
+    side,
+    radius,
+    limit,
+    integral,
+    qvel,
+    ctrl,
+    acts,
+    dofs,
+):
+    """Wheel actuator targets of all drives (updates ``speed``, ``integral``, ``ctrl``).
+
+    Parameters
+    ----------
+    cmd : (P, 2) commanded linear (m/s) and angular (rad/s) speed per drive.
+    last : (P,) sim time of each drive's last command, s; ``timeout`` (P,) s (0: none).
+    half_sep : (P,) half wheel separation, m; accel : (P,) wheel ramp, m/s^2 (0: none).
+    speed : (P, 2) wheel surface speed targets (left, right), m/s, ramp state.
+    owner, side : (W,) drive index and side (0 left, 1 right) of each wheel.
+    radius, limit : (W,) wheel radius (m) and the speed error at the torque limit (rad/s).
+    integral : (W,) integral state of the servo, rad/s.
+    qvel, ctrl : the MuJoCo data arrays; acts, dofs : (W,) actuator and dof of each wheel.
+    """
+    for i in range(cmd.shape[0]):
+        vx = cmd[i, 0]
+        wz = cmd[i, 1]
+        if timeout[i] > 0 and t - last[i] > timeout[i]:
+            vx = 0.0
+            wz = 0.0
+        for k in range(2):
+            target = vx - wz * half_sep[i] if k == 0 else vx + wz * half_sep[i]
+            if accel[i] > 0:
+                dv = accel[i] * dt
+                target = speed[i, k] + min(max(target - speed[i, k], -dv), dv)
+            speed[i, k] = target
+    gain = dt / INTEGRAL_TIME
+    for j in range(acts.shape[0]):
+        w = qvel[dofs[j]]
+        err = speed[owner[j], side[j]] / radius[j] - w
+        lim = limit[j]
+        integral[j] = min(max(integral[j] + err * gain, -lim - err), lim - err)
+        ctrl[acts[j]] = w + min(max(err + integral[j], -lim), lim)

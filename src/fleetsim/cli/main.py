@@ -69,10 +69,12 @@ def _root(
 def demo(
     out: str = typer.Option("out", "--out", "-o", help="Folder for the demo's outputs."),
 ) -> None:
-    """Run the main demo headless and write its outputs to OUT."""
+    """Run the main demo headless: three lizis with amcl across the office (navigation_multi),
+    recorded to OUT/demo.mcap and rendered to OUT/demo.mp4 and OUT/demo.png."""
     from fleetsim.demo import run_demo
 
-    run_demo(out)
+    if not run_demo(out):
+        raise typer.Exit(1)
 
 
 def _add_subapps() -> None:

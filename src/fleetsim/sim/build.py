@@ -96,11 +96,25 @@ def _material_for(spec: mujoco.MjSpec, g: GeomDesc, prefix: str) -> str:
 
 
 def add_geom(
-    spec, body, g: GeomDesc, static: bool, prefix: str, index: int, shown: bool = False
+    spec,
+    body,
+    g: GeomDesc,
+    static: bool,
+    prefix: str,
+    index: int,
+    shown: bool = False,
+    frame: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> None:
     """Add one ``GeomDesc`` to ``body`` (collision or visual, per ``g.collide``); ``shown``
     puts a collision geom in the visual group (for links without visuals)."""
-    kw = {"pos": g.pose[:3], "quat": quat_from_rpy(*g.pose[3:])}
+    pos, quat = np.array(g.pose[:3], float), quat_from_rpy(*g.pose[3:])
+    if frame is not None:  # express the geom in ``body`` when it sits in another frame
+        fpos, fquat = frame
+        p, q = np.zeros(3), np.zeros(4)
+        mujoco.mju_rotVecQuat(p, pos, fquat)
+        mujoco.mju_mulQuat(q, fquat, quat)
+        pos, quat = p + fpos, q
+    kw = {"pos": pos, "quat": quat}
     if g.kind == "box":
         kw.update(type=G.mjGEOM_BOX, size=[s / 2 for s in g.size])
     elif g.kind == "cylinder":
@@ -162,7 +176,12 @@ def _floor_material(spec) -> str:
 
 
 def add_sdf_model(spec: mujoco.MjSpec, m: ModelDesc, pose: Pose | None = None) -> list[str]:
-    """Add an SDF model; returns its top-level body names (one per link, ``<model>/<link>``)."""
+    """Add an SDF model; returns its top-level body names (one per link, ``<model>/<link>``).
+
+    A static model adds no bodies: its geoms go straight into the world body (named
+    ``<model>/<link>/...``), which MuJoCo's broad phase handles far faster than many static
+    bodies (a map world has thousands of wall boxes).
+    """
     pose = pose if pose is not None else m.pose
     mq = quat_from_rpy(*pose[3:])
     roots = []
@@ -172,17 +191,21 @@ def add_sdf_model(spec: mujoco.MjSpec, m: ModelDesc, pose: Pose | None = None) -
         lq = np.zeros(4)
         mujoco.mju_rotVecQuat(lp, np.array(link.pose[:3], float), mq)
         mujoco.mju_mulQuat(lq, mq, quat_from_rpy(*link.pose[3:]))
+        lp = lp + np.array(pose[:3], float)
         name = f"{m.name}/{link.name}"
-        body = spec.worldbody.add_body(name=name, pos=lp + np.array(pose[:3]), quat=lq)
-        if not m.static:
-            body.add_freejoint(name=f"{name}/free")
-            body.mass = max(link.mass, MIN_MASS)
-            inertia = link.inertia or (link.mass * 0.01,) * 3
-            body.inertia = [max(i, MIN_INERTIA) for i in inertia]
-            body.explicitinertial = True
         has_visual = any(not g.collide for g in link.geoms)
+        if m.static:
+            for i, g in enumerate(link.geoms):
+                add_geom(spec, spec.worldbody, g, True, f"{name}/", i, not has_visual, (lp, lq))
+            continue
+        body = spec.worldbody.add_body(name=name, pos=lp, quat=lq)
+        body.add_freejoint(name=f"{name}/free")
+        body.mass = max(link.mass, MIN_MASS)
+        inertia = link.inertia or (link.mass * 0.01,) * 3
+        body.inertia = [max(i, MIN_INERTIA) for i in inertia]
+        body.explicitinertial = True
         for i, g in enumerate(link.geoms):
-            add_geom(spec, body, g, m.static, f"{m.name}/{link.name}/", i, not has_visual)
+            add_geom(spec, body, g, False, f"{name}/", i, not has_visual)
         roots.append(name)
     return roots
 

@@ -132,6 +132,10 @@ class Engine(StateQueries):
         for b in range(1, m.nbody):
             self._body_model[b] = top.get(int(m.body_rootid[b]), -1)
         self.geom_model = self._body_model[m.geom_bodyid]
+        # geoms of static models sit in the world body, named "<model>/<link>/..."
+        index = {name: i for i, name in enumerate(self._model_names)}
+        for g in np.flatnonzero(m.geom_bodyid == 0):
+            self.geom_model[g] = index.get(m.geom(int(g)).name.split("/", 1)[0], -1)
 
     def _check_new_name(self, name: str) -> None:
         if not name or "/" in name:
@@ -242,6 +246,9 @@ class Engine(StateQueries):
         return entry
 
     def _remove_from_spec(self, entry: ModelEntry, n_act: int | None = None) -> None:
+        prefix = f"{entry.name}/"
+        for g in [g for g in self.spec.worldbody.geoms if g.name.startswith(prefix)]:
+            self.spec.delete(g)
         for b in entry.bodies:
             body = self.spec.body(b)
             if body is not None:

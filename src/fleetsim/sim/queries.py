@@ -49,6 +49,11 @@ class StateQueries:
     def link_id(self, model: str, link: str) -> int:
         """Body id of ``model``'s link; error naming the model's links when missing."""
         bid = self.body_id(model, link)
+        if bid < 0 and self.entry(model).static:
+            raise SimulationError(
+                f"model '{model}' is static: its links are part of the world and cannot be "
+                "moved, attached or measured"
+            )
         if bid < 0:
             links = [
                 self.model.body(b).name.split("/", 1)[1]
@@ -61,10 +66,15 @@ class StateQueries:
         return bid
 
     def root_body(self, name: str) -> int:
-        return self.model.body(self.entry(name).bodies[0]).id
+        """Body id of the model's root link (0, the world body, for static models)."""
+        entry = self.entry(name)
+        return self.model.body(entry.bodies[0]).id if entry.bodies else 0
 
     def model_pose(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """World position (3,) m and orientation quaternion (w, x, y, z) of the model root."""
+        entry = self.entry(name)
+        if not entry.bodies:  # static: where it was placed
+            return np.array(entry.pose0[:3], float), quat_from_rpy(*entry.pose0[3:])
         b = self.root_body(name)
         return self.data.xpos[b].copy(), self.data.xquat[b].copy()
 
@@ -84,7 +94,7 @@ class StateQueries:
 
     def _free_joint(self, name: str) -> int:
         b = self.root_body(name)
-        if self.model.body_jntnum[b] == 0:
+        if b == 0 or self.model.body_jntnum[b] == 0:
             return -1
         j = int(self.model.body_jntadr[b])
         return j if self.model.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE else -1
@@ -130,18 +140,25 @@ class StateQueries:
             e2 = self.models[names[i2]] if i2 >= 0 else None
             if not ((e1 and e1.kind == "robot") or (e2 and e2.kind == "robot")):
                 continue
-            b1, b2 = m.body(int(m.geom_bodyid[g1])).name, m.body(int(m.geom_bodyid[g2])).name
             out.append(
                 Contact(
                     names[i1] if i1 >= 0 else "world",
-                    b1.split("/", 1)[-1],
+                    self._link_of(g1),
                     names[i2] if i2 >= 0 else "world",
-                    b2.split("/", 1)[-1],
+                    self._link_of(g2),
                     tuple(float(v) for v in c.pos),
                     float(-c.dist),
                 )
             )
         return out
+
+    def _link_of(self, geom: int) -> str:
+        """Link name of a geom (``<model>/<link>/...`` for static geoms in the world body)."""
+        m = self.model
+        body = int(m.geom_bodyid[geom])
+        name = m.geom(geom).name if body == 0 else m.body(body).name
+        parts = name.split("/")
+        return parts[1] if len(parts) > 1 else name
 
     # -------------------------------------------------------------------- resets
     def reset_world(self) -> None:

@@ -187,3 +187,32 @@ def test_idle_robot_stays_put(diffbot):
         heights.append(e.model_pose("r")[0][2])
     assert np.hypot(*(e.model_pose("r")[0][:2] - [2.0, 1.0])) < 1e-3
     assert max(heights) < 1e-3  # no hopping on its contacts
+
+
+def test_static_models_spawn_and_delete_in_the_world_body(diffbot):
+    from fleetsim.sim.plugins.laser import LaserPlugin
+
+    e = Engine(None)
+    r = e.spawn_robot("r", diffbot, (0, 0, 0, 0, 0, 0))
+    laser = next(p for p in r.plugins if isinstance(p, LaserPlugin))
+
+    def ahead():
+        return e.lasers.measure(e, [laser], e.time)[0].ranges[180]
+
+    assert np.isinf(ahead())
+    e.spawn_sdf(
+        "post",
+        "<sdf><model name='p'><static>1</static><link name='l'><collision "
+        "name='c'><geometry><box><size>.2 .2 1</size></box></geometry></collision>"
+        "</link></model></sdf>",
+        (2.0, 0, 0.5, 0, 0, 0),
+    )
+    post = e.geom_model == e._model_names.index("post")
+    assert post.any() and (e.model.geom_bodyid[post] == 0).all()
+    assert ahead() == pytest.approx(2.0 - 0.1 - 0.1, abs=1e-3)  # laser 0.1 ahead of centre
+    np.testing.assert_allclose(e.model_pose("post")[0], [2.0, 0, 0.5])
+    with pytest.raises(SimulationError, match="model 'post' is static"):
+        e.attacher.attach(e, "r", "base_link", "post", "l")
+    e.delete_model("post")
+    assert np.isinf(ahead())
+    assert not any(e.model.geom(g).name.startswith("post/") for g in range(e.model.ngeom))

@@ -21,12 +21,13 @@ yet, a map that cannot be used) is logged and skipped; it never stops the run.
 from __future__ import annotations
 
 import math
+from collections import deque
 from typing import Any
 
 import numpy as np
 
-from fleetsim.errors import FleetsimError
-from fleetsim.msgs import geometry_msgs, nav_msgs, sensor_msgs, std_msgs, std_srvs
+from fleetsim.errors import ExtrapolationError, FleetsimError, TransformError
+from fleetsim.msgs import geometry_msgs, nav_msgs, sensor_msgs, std_msgs, std_srvs, tf2_msgs
 from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.runtime import Node
 from fleetsim.tf import TransformBroadcaster, make_transform_stamped, resolve_frame_once
@@ -39,6 +40,7 @@ from .params import AmclParams
 from .scan import beams_from_scan
 
 MAP_RETRY_PERIOD = 1.0  # s of sim time between static_map attempts
+SCAN_QUEUE_SIZE = 100  # scans waiting for their odometry in tf (amcl's laser_scan_filter_)
 
 
 def _yaw_of(q: Any) -> float:
@@ -86,6 +88,8 @@ class Amcl(Node):
         )
         self.tf_pub = TransformBroadcaster(self) if p.tf_broadcast else None
         _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now, not at the first scan
+        self._pending_scans: deque[sensor_msgs.LaserScan] = deque(maxlen=SCAN_QUEUE_SIZE)
+        self.create_subscription(tf2_msgs.TFMessage, "/tf", self._on_tf, queue_size=100)
         self.create_subscription(sensor_msgs.LaserScan, "scan", self.on_scan, queue_size=1)
         self.create_subscription(
             geometry_msgs.PoseWithCovarianceStamped, "initialpose", self.on_initial_pose, 2
@@ -250,9 +254,30 @@ class Amcl(Node):
 
     # ----- the scan callback -----
     def on_scan(self, scan: sensor_msgs.LaserScan) -> None:
+        """Queue the scan and process every queued one whose odometry is in tf.
+
+        As ROS amcl's tf ``MessageFilter``: a scan whose ``odom -> base`` transform at its stamp
+        has not arrived yet (the simulator publishes a scan before the tf of the same step) waits
+        for it; a new tf message retries the queue.
+        """
         if self.filter.grid is None:
             self._warn_once("no_map", "received a scan but no map yet; waiting for the map")
             return
+        self._pending_scans.append(scan)
+        self._drain_scans()
+
+    def _on_tf(self, msg: Any) -> None:
+        if self._pending_scans:
+            self._drain_scans()
+
+    def _drain_scans(self) -> None:
+        while self._pending_scans:
+            if not self._process_scan(self._pending_scans[0]):
+                return
+            self._pending_scans.popleft()
+
+    def _process_scan(self, scan: sensor_msgs.LaserScan) -> bool:
+        """Run the filter on one scan; False when tf cannot answer for its stamp yet."""
         stamp = scan.header.stamp.to_sec()
         laser_frame = normalize_frame(scan.header.frame_id) or self.base_frame
         buf = self.tf_buffer
@@ -262,9 +287,20 @@ class Amcl(Node):
                     buf.lookup_pose2d(self.base_frame, laser_frame, 0.0)
                 )
             odom_pose = np.array(buf.lookup_pose2d(self.odom_frame, self.base_frame, stamp))
+        except ExtrapolationError as err:
+            try:
+                newest = buf.latest_common_time(self.odom_frame, self.base_frame)
+            except TransformError:
+                newest = None
+            if newest is not None and newest < stamp:
+                return False  # tf has not caught up with this scan yet: wait for it
+            self._warn_once("tf_old", f"dropping a scan older than tf's history: {err}")
+            return True
         except FleetsimError as err:
             self._warn_once(f"tf:{laser_frame}", f"skipping scans until tf is available: {err}")
-            return
+            return True
+        if self.filter.grid is None:
+            return True
         p = self.params
         try:
             beams = beams_from_scan(
@@ -280,7 +316,7 @@ class Amcl(Node):
             )
         except LocalizationError as err:
             self._warn_once("scan", f"skipping scan: {err}")
-            return
+            return True
         self.filter.laser_pose = self._laser_poses[laser_frame]
         result = self.filter.update(odom_pose, beams)
         if result.updated:
@@ -289,6 +325,7 @@ class Amcl(Node):
             self._publish_pose(scan.header.stamp, odom_pose)
         if self._map_to_odom is not None and self.tf_pub is not None:
             self._send_map_to_odom(stamp)
+        return True
 
     # ----- outputs -----
     def _publish_cloud(self, stamp: Time) -> None:

@@ -43,10 +43,11 @@ def main() -> None:
         t0 = time.perf_counter()
         engine.lasers.measure(engine, lasers, engine.time)
         times.append(time.perf_counter() - t0)
-    grid = engine.lasers.static_grid
+    occ = engine.lasers.occupancy.occupied
+    walls = int(np.sum(engine.geom_model == engine._model_names.index("map_walls")))
     print(
-        f"world: Willow map, {len(grid.prims)} wall segments, grid {grid.nx} x {grid.ny} "
-        f"cells of {grid.cell} m; {engine.model.ngeom} geoms in MuJoCo"
+        f"world: Willow map, occupancy grid {occ.shape[1]} x {occ.shape[0]} cells "
+        f"({int(occ.sum())} occupied) = {walls} wall boxes in MuJoCo, {args.robots} robots"
     )
     print(
         f"batched sweep: {len(lasers)} lasers x {lasers[0].samples} beams = {beams} rays: "

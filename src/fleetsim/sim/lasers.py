@@ -71,13 +71,14 @@ class LaserBatch:
     def measure(self, engine, lasers: list, t: float) -> list:
         """Readings of ``lasers`` (``LaserPlugin``) from one batched cast."""
         n = len(lasers)
-        origins = np.empty((n, 3))
-        angle0 = np.empty(n)
         inc = np.array([lz.increment for lz in lasers])
         nb = np.array([lz.samples for lz in lasers], np.int64)
-        owner = np.empty(n, np.int64)
-        for i, lz in enumerate(lasers):
-            origins[i], angle0[i], owner[i] = lz.pose(engine)
+        owner = np.array([lz.owner for lz in lasers], np.int64)
+        body = np.array([lz.body for lz in lasers], np.int64)
+        R = engine.data.xmat[body].reshape(n, 3, 3)
+        origins = engine.data.xpos[body] + np.einsum("nij,nj->ni", R, [lz.pos for lz in lasers])
+        xaxis = np.einsum("nij,nj->ni", R, [lz.xaxis for lz in lasers])  # sensor x, world
+        angle0 = np.arctan2(xaxis[:, 1], xaxis[:, 0]) + [lz.angle_min for lz in lasers]
         offsets = np.concatenate([[0], np.cumsum(nb)[:-1]]).astype(np.int64)
         rmin = np.array([lz.range_min for lz in lasers])
         rmax = np.array([lz.range_max for lz in lasers])

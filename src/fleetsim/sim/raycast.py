@@ -341,7 +341,7 @@ def ranges_from_occupancy(
                     out[r] = t
                     break
                 safe = clearance[iy, ix] - 1.5  # cells free around any point of this cell
-                if safe > 2.0:
+                if safe > 4.0:
                     t += safe * res
                     ix, iy, tmx, tmy = _dda_start(ox, oy, dx, dy, t, x0, y0, res)
                     continue

@@ -71,6 +71,9 @@ class LaserPlugin(SensorPlugin):
         self.rate = float(sensor.update_rate)
         self.pos = np.array(sensor.pose.xyz, float)
         self.quat = quat_from_rpy(*sensor.pose.rpy)
+        rot = np.zeros(9)
+        mujoco.mju_quat2Mat(rot, self.quat)
+        self.xaxis = rot.reshape(3, 3)[:, 0].copy()  # the sensor's x axis in its link frame
         self.frame_id = ctx.frame(self.params.frameName)
 
     @property

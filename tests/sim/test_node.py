@@ -63,6 +63,41 @@ def test_two_namespaces_do_not_share_commands(sim):
     assert clock and clock[-1].clock.to_sec() == pytest.approx(rt.now(), abs=0.011)
 
 
+def test_odometry_tf_arrives_before_the_scan_of_the_same_time(sim):
+    from fleetsim.msgs import sensor_msgs, tf2_msgs
+
+    rt, s, probe = sim
+    assert spawn(probe, "lizi2", (24.0, 15.0)).success
+    log = []
+    probe.create_subscription(
+        tf2_msgs.TFMessage,
+        "/tf",
+        lambda m: log.append(
+            (
+                "tf",
+                {
+                    t.header.stamp.to_nsec()
+                    for t in m.transforms
+                    if t.child_frame_id == "lizi2/base_footprint"
+                },
+            )
+        ),
+        queue_size=100,
+    )
+    probe.create_subscription(
+        sensor_msgs.LaserScan,
+        "/lizi2/scan",
+        lambda m: log.append(("scan", m.header.stamp.to_nsec())),
+        queue_size=100,
+    )
+    rt.run(duration=0.5)
+    scans = [i for i, (kind, _) in enumerate(log) if kind == "scan"]
+    assert len(scans) >= 4
+    for i in scans:
+        seen = set().union(*(v for kind, v in log[:i] if kind == "tf"))
+        assert log[i][1] in seen
+
+
 def test_world_services(sim):
     rt, s, probe = sim
     assert spawn(probe, "bot", (10.0, 10.0)).success

@@ -148,33 +148,35 @@ class Simulator(Node):
                 self.contacts_pub.publish(conv.contacts_msg(self.now(), contacts))
 
     def publish(self, readings: list) -> None:
-        """Turn plugin readings into messages on their robots' topics."""
-        tfs = []
+        """Turn plugin readings into messages on their robots' topics.
+
+        Odometry transforms go out first (one ``/tf`` message), so that a scan or image of the
+        same update finds its robot's ``odom -> base`` transform already in the tf buffer.
+        """
+        off = self.offset
+        for r in readings:
+            r.stamp += off
+        tfs = [
+            conv.odometry_tf(r) for r in readings if isinstance(r, OdometryReading) and r.publish_tf
+        ]
+        if tfs:
+            self.tf.send_transform(tfs)
         for r in readings:
             ns = r.namespace
-            off = self.offset
             if isinstance(r, OdometryReading):
-                r.stamp += off
                 self._publisher(rnames.resolve(r.topic, ns), nav_msgs.Odometry).publish(
                     conv.odometry_msg(r)
                 )
-                if r.publish_tf:
-                    tfs.append(conv.odometry_tf(r))
             elif isinstance(r, ScanReading):
-                r.stamp += off
                 self._publisher(rnames.resolve(r.topic, ns), sensor_msgs.LaserScan).publish(
                     conv.scan_msg(r)
                 )
             elif isinstance(r, JointStateReading):
-                r.stamp += off
                 self._publisher(rnames.resolve(r.topic, ns), sensor_msgs.JointState).publish(
                     conv.joint_state_msg(r)
                 )
             elif isinstance(r, ImageReading):
-                r.stamp += off
                 self._publish_image(r, ns)
-        if tfs:
-            self.tf.send_transform(tfs)
 
     def _publish_image(self, r: ImageReading, ns: str) -> None:
         img = conv.image_msg(r.stamp, r.frame_id, r.image, r.encoding)

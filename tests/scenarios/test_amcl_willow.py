@@ -64,7 +64,15 @@ def test_tracking_along_the_willow_route():
 
 
 def test_global_localization_converges_within_30_m():
-    params = dict(TRACKING, max_particles=20000, min_particles=500)
+    params = dict(
+        TRACKING,
+        max_particles=20000,
+        min_particles=500,
+        laser_z_hit=0.8,
+        laser_z_rand=0.2,
+        recovery_alpha_slow=0.001,
+        recovery_alpha_fast=0.1,
+    )
     run = willow_amcl_run(seed=2, amcl_params=params, initial_guess=(20.0, 40.0, 0.0))
     run.rt.run(duration=0.5)
     run.global_localization()
@@ -89,7 +97,7 @@ def test_kidnapped_robot_recovers():
     assert run.teleport(float(x), float(y), float(heading))
     run.rt.run(duration=1.0)
     moved = run.truth()
-    assert np.hypot(moved[0] - x, moved[1] - y) < 0.1
+    assert np.hypot(moved[0] - x, moved[1] - y) < 1.0  # teleported (and driving on)
     assert np.hypot(*(moved[:2] - run.estimate()[:2])) > 5.0  # amcl still believes the old pose
     kidnapped_at = run.follower.travelled
     run.drive(max_sim_time=120.0, until=lambda: run.follower.travelled >= kidnapped_at + 15.0)

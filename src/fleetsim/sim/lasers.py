@@ -1,10 +1,11 @@
 """All planar lasers of the world in one batched ray cast.
 
-Static world: in a map world the extruded walls are the occupied cells themselves, so rays walk
-the occupancy grid (``raycast.ranges_from_occupancy``); every other static geom is sliced into
-primitives binned once per compile (``raycast.ranges_from_primitives``). Movable models (robots,
-loose objects) are sliced at every sweep and tested only by the beams that fall inside their
-bounding circle (``raycast.ranges_with_bodies``), skipping the robot that carries the laser.
+Static world: in a map world the extruded walls are the occupied cells themselves, so rays
+walk the occupancy grid (``occupancy_cast.ranges_from_occupancy``); every other static geom is
+sliced into primitives binned once per compile (``raycast.ranges_from_primitives``). Movable
+models (robots, loose objects) are sliced at every sweep and tested only by the beams that fall
+inside their bounding circle (``raycast.ranges_with_bodies``), skipping the robot that carries
+the laser.
 """
 
 from __future__ import annotations
@@ -12,7 +13,7 @@ from __future__ import annotations
 import mujoco
 import numpy as np
 
-from fleetsim.sim import raycast
+from fleetsim.sim import occupancy_cast, raycast
 from fleetsim.sim.slices import primitives_of
 
 STATIC_CELL = 0.5  # m
@@ -38,7 +39,7 @@ class LaserBatch:
             walls = engine._model_names.index("map_walls")
             static = static & (engine.geom_model != walls)
             if self.occupancy is not grid:
-                self.clearance = raycast.clearance_from_occupancy(grid.occupied)
+                self.clearance = occupancy_cast.clearance_from_occupancy(grid.occupied)
             self.occupancy = grid
             self.wall_height = engine.wall_height
         sid = np.flatnonzero(collide & real & static)
@@ -93,7 +94,7 @@ class LaserBatch:
             ranges = np.full(len(ray_a), np.inf)
         if self.occupancy is not None:
             g = self.occupancy
-            walls = raycast.ranges_from_occupancy(
+            walls = occupancy_cast.ranges_from_occupancy(
                 ray_o,
                 ray_a,
                 ray_min,

@@ -121,6 +121,13 @@ def test_world_services(sim):
     assert st.success and st.pose.position.x == pytest.approx(11.0)
     missing = get.call(gazebo_msgs.GetModelState.Request(model_name="nobody"))
     assert not missing.success and "no model named 'nobody'" in missing.status_message
+    states = []
+    probe.create_subscription(
+        gazebo_msgs.ModelStates, "/gazebo/model_states", states.append, queue_size=5
+    )
+    rt.run(duration=0.2)
+    assert states and states[-1].name == ["ground_plane", "map_walls", "bot"]
+    assert states[-1].pose[2].position.x == pytest.approx(11.0, abs=0.02)
     props = probe.create_client(
         gazebo_msgs.GetWorldProperties, "/gazebo/get_world_properties"
     ).call()

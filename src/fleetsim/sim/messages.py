@@ -112,3 +112,22 @@ def contacts_msg(t: float, contacts: list[Contact]) -> gazebo_msgs.ContactsState
         s.depths = np.array([c.depth])
         msg.states.append(s)
     return msg
+
+
+def model_states_msg(engine) -> gazebo_msgs.ModelStates:
+    """Pose and twist (world frame) of every model, as gazebo publishes ``model_states``."""
+    msg = gazebo_msgs.ModelStates()
+    for name in engine.models:
+        pos, quat = engine.model_pose(name)
+        lin, ang = engine.model_twist(name)
+        pose = geometry_msgs.Pose()
+        pose.position.x, pose.position.y, pose.position.z = (float(v) for v in pos)
+        o = pose.orientation
+        o.w, o.x, o.y, o.z = (float(v) for v in quat)
+        twist = geometry_msgs.Twist()
+        twist.linear.x, twist.linear.y, twist.linear.z = (float(v) for v in lin)
+        twist.angular.x, twist.angular.y, twist.angular.z = (float(v) for v in ang)
+        msg.name.append(name)
+        msg.pose.append(pose)
+        msg.twist.append(twist)
+    return msg

@@ -50,6 +50,9 @@ class SimulatorParams:
         WALL_HEIGHT, unit="m", range=(0.01, None), help="map-world wall height"
     )
     publish_contacts: bool = param(True, help="publish robot contacts on ~robot_contacts")
+    model_states_rate: float = param(
+        10.0, unit="Hz", range=(0.0, None), help="~model_states rate (0: off; fleetsim addition)"
+    )
 
 
 class Simulator(Node):
@@ -77,6 +80,10 @@ class Simulator(Node):
             conv.gazebo_msgs.ContactsState, "~robot_contacts", queue_size=10
         )
         self._last_clock = -1.0
+        self._last_states = -1.0
+        self.states_pub = self.create_publisher(
+            conv.gazebo_msgs.ModelStates, "~model_states", queue_size=1
+        )
         self.services = WorldServices(self)
         self.create_timer(p.update_period, self.on_update, priority=-100)
 
@@ -142,6 +149,12 @@ class Simulator(Node):
         if self.now() - self._last_clock >= period - 1e-9:
             self._last_clock = self.now()
             self.clock_pub.publish(rosgraph_msgs.Clock(clock=self.now_msg()))
+        if (
+            p.model_states_rate > 0
+            and self.now() - self._last_states >= 1 / p.model_states_rate - 1e-9
+        ):
+            self._last_states = self.now()
+            self.states_pub.publish(conv.model_states_msg(self.engine))
         if p.publish_contacts and not self.engine.paused:
             contacts = self.engine.contacts()
             if contacts:

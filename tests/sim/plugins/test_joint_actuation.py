@@ -42,3 +42,18 @@ def test_bad_commands(arm):
         ctl.command("elbow", 1.0)
     with pytest.raises(SimulationError, match="command for 'wrist' must be finite"):
         ctl.command("wrist", float("nan"))
+
+
+def test_update_hook_runs_a_pd_loop_at_the_physics_rate(arm):
+    e, ctl = arm
+    calls = []
+
+    def pd(plugin, engine, t):
+        pos, vel = plugin.states(engine)["slider"]
+        plugin.command("slider", 200.0 * (0.1 - pos) - 20.0 * vel)
+        calls.append(t)
+
+    ctl.add_update_hook(pd)
+    e.advance(1.0)
+    assert len(calls) == round(1.0 / e.model.opt.timestep)
+    assert ctl.states(e)["slider"][0] == pytest.approx(0.1, abs=0.005)

@@ -3,7 +3,9 @@
 Every ``<transmission>`` joint gets a MuJoCo actuator by its hardware interface:
 ``EffortJointInterface`` a torque motor limited to the URDF effort limit, ``VelocityJointInterface``
 a velocity servo, ``PositionJointInterface`` a position servo (stiffness from the effort limit).
-Controllers (the arm issue's ros_control layer) call ``command(joint, value)``.
+Controllers (the arm issue's ros_control layer) call ``command(joint, value)``, either from
+their own timers or, for loops that must run at the physics rate, from an update hook
+(``add_update_hook``).
 """
 
 from __future__ import annotations
@@ -53,6 +55,7 @@ class JointActuationPlugin(ActuatorPlugin):
                     )
                 self.modes[require_joint(ctx, joint, f"transmission '{tr.name}'", spec.name)] = mode
         self.targets = dict.fromkeys(self.modes, 0.0)
+        self.hooks: list = []
 
     def _effort(self, joint: str) -> float:
         lim = self.ctx.robot.joints[joint].limit
@@ -98,7 +101,15 @@ class JointActuationPlugin(ActuatorPlugin):
             raise SimulationError(f"{self.where}: command for '{joint}' must be finite")
         self.targets[joint] = float(value)
 
+    def add_update_hook(self, hook) -> None:
+        """Call ``hook(plugin, engine, t)`` before every physics step, before the targets are
+        applied: where ros_control-style controllers run, at the control period of
+        gazebo_ros_control (PID loops over effort joints need the physics rate to be stable)."""
+        self.hooks.append(hook)
+
     def control(self, engine, t: float) -> None:
+        for hook in self.hooks:
+            hook(self, engine, t)
         ctrl = engine.data.ctrl
         for j, v in self.targets.items():
             ctrl[self.act[j]] = v

@@ -319,6 +319,7 @@ class Engine(StateQueries):
         t = self.time
         out: list[Any] = []
         lasers = []
+        batches: dict[type, list] = {}
         min_due = np.inf
         for p in self._plugins:
             key = id(p)
@@ -335,12 +336,18 @@ class Engine(StateQueries):
             min_due = min(min_due, nxt)
             if getattr(p, "is_laser", False):
                 lasers.append(p)
+            elif hasattr(p, "measure_batch"):
+                batches.setdefault(type(p), []).append(p)
             else:
                 r = p.measure(self, t)
                 if r is not None:
                     r.namespace = p.ctx.namespace
                     out.append(r)
         self._min_due = min_due
+        for cls, group in batches.items():
+            for r, p in zip(cls.measure_batch(self, group, t), group):
+                r.namespace = p.ctx.namespace
+                out.append(r)
         if lasers:
             for r, p in zip(self.lasers.measure(self, lasers, t), lasers):
                 r.namespace = p.ctx.namespace

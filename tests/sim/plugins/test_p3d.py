@@ -61,3 +61,28 @@ def test_reference_link_frame_and_missing_body():
         SimulationError, match="bodyName names link 'chassis', which the model lacks"
     ):
         e.spawn_robot("x", parse_urdf(bad))
+
+
+def test_batched_readings_equal_single_ones(diffbot):
+    from fleetsim.sim.plugins.p3d import P3dPlugin
+
+    e = Engine(None)
+    entries = [
+        e.spawn_robot(
+            f"r{i}",
+            p3d_robot("<xyzOffsets>0 0 1</xyzOffsets><rpyOffsets>0.1 0 0.3</rpyOffsets>"),
+            (i, 0, 0, 0, 0, i),
+        )
+        for i in range(3)
+    ]
+    for ent in entries:
+        ent.plugins[0].command(0.4, 0.5, e.time)
+    e.advance(0.3)
+    e.step()  # cvel and xpos of the same (pre-integration) state, as readings see them
+    plugins = [next(p for p in ent.plugins if isinstance(p, P3dPlugin)) for ent in entries]
+    batch = P3dPlugin.measure_batch(e, plugins, e.time)
+    for p, b in zip(plugins, batch):
+        one = p.measure(e, e.time)
+        for field in ("position", "orientation", "linear", "angular"):
+            np.testing.assert_allclose(getattr(b, field), getattr(one, field), atol=1e-9)
+        assert (b.frame_id, b.child_frame_id) == (one.frame_id, one.child_frame_id)

@@ -184,7 +184,7 @@ class WheeledDrive(DrivePlugin):
             w, qx, qy, qz = d.xquat[self.root]
             quat = np.array([qx, qy, qz, w])
             vel = np.zeros(6)
-            mujoco.mj_objectVelocity(engine.model, d, mujoco.mjtObj.mjOBJ_BODY, self.root, vel, 1)
+            mujoco.mj_objectVelocity(engine.model, d, mujoco.mjtObj.mjOBJ_XBODY, self.root, vel, 1)
             lin, ang = vel[3:].copy(), vel[:3].copy()
         return OdometryReading(
             t,

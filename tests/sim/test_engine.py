@@ -121,7 +121,9 @@ def test_bad_plugins(diffbot):
     text = robot_text("diffbot.urdf")
     e = Engine(None)
     unknown = text.replace("libgazebo_ros_joint_state_publisher.so", "libmy_fancy_plugin.so")
-    with pytest.warns(UserWarning, match="unknown plugin filename 'libmy_fancy_plugin.so'"):
+    with pytest.warns(
+        UserWarning, match="model 'u': unknown plugin filename 'libmy_fancy_plugin.so'"
+    ):
         e.spawn_robot("u", parse_urdf(unknown))
     assert "u" in e.models
     wrong = text.replace("<wheelTorque>1</wheelTorque>", "<wheelTorque>strong</wheelTorque>")

@@ -209,7 +209,7 @@ class Engine(StateQueries):
         robot = entry.robot
         for block in robot.gazebo:
             for spec in block.plugins:
-                cls = base.plugin_class(spec.filename)
+                cls = base.plugin_class(spec.filename, f"model '{entry.name}'")
                 if cls is not None:
                     ctx = base.PluginContext(
                         entry.name,
@@ -221,7 +221,7 @@ class Engine(StateQueries):
                     out.append(cls(ctx, spec))
             for sensor in block.sensors:
                 for spec in sensor.plugins:
-                    cls = base.plugin_class(spec.filename)
+                    cls = base.plugin_class(spec.filename, f"model '{entry.name}'")
                     if cls is not None:
                         ctx = base.PluginContext(
                             entry.name,

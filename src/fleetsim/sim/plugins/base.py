@@ -252,14 +252,16 @@ class JointStateReading:
     namespace: str = "/"  # ROS namespace the topic resolves in (set by the engine)
 
 
-def plugin_class(filename: str) -> type[Plugin] | None:
+def plugin_class(filename: str, where: str = "") -> type[Plugin] | None:
     """The class registered for a Gazebo filename; None (with a warning) when unknown."""
     cls = REGISTRY.get(filename)
     if cls is None:
-        warnings.warn(
-            f"unknown plugin filename '{filename}'{did_you_mean(filename, REGISTRY)}; ignored",
-            stacklevel=3,
+        msg = (
+            f"{where + ': ' if where else ''}unknown plugin filename '{filename}'"
+            f"{did_you_mean(filename, REGISTRY)}; ignored, the model spawns without it"
         )
+        _log.warning("%s", msg)
+        warnings.warn(msg, stacklevel=3)
     return cls
 
 

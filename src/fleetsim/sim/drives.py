@@ -13,6 +13,38 @@ import numba
 import numpy as np
 
 INTEGRAL_TIME = 0.1  # s, integral time of the servo (holds speed against scrub and slopes)
+# m/s: the most that full ground friction may change a drive wheel's surface speed in one physics
+# step (sets the rotor armature, see ``rotor_armature``)
+SLIP_RESOLUTION = 0.005
+
+
+def rotor_armature(
+    mass: float, radius: float, n_wheels: int, mu: float, gravity: float, timestep: float
+) -> float:
+    """Reflected rotor inertia of a drive wheel that lets the contact solver see a held wheel.
+
+    Gazebo's wheel motor is a velocity constraint solved together with the contacts, so the
+    ground cannot change a driven wheel's speed below the torque limit. The servo here is a
+    force element that MuJoCo's constraint solver does not see: it treats the bare wheel
+    inertia as free, finds that a small part of the friction cone stops the wheel's slip within
+    one step, and spends the rest on the sideways direction. A skid-steer robot then scrubs
+    sideways at full friction and barely turns (0.1 of the commanded rate instead of the
+    Coulomb ``b^2 / (a^2 + b^2)``). A geared motor's rotor inertia, reflected to the wheel,
+    is what holds a real wheel's speed over short times; this is the smallest such inertia
+    with which full friction on the wheel (``mu * mass * gravity / n_wheels``) changes the
+    wheel's surface speed by at most ``SLIP_RESOLUTION`` over one ``timestep``.
+
+    Parameters
+    ----------
+    mass : whole robot mass, kg. radius : wheel radius, m. n_wheels : drive wheels sharing
+    the load. mu : wheel friction coefficient. gravity : m/s^2. timestep : physics step, s.
+
+    Returns
+    -------
+    float : armature of the wheel joint, kg m^2 (0 for a massless robot or no gravity).
+    """
+    load = mu * mass * abs(gravity) / max(n_wheels, 1)  # N, friction on one wheel
+    return load * radius**2 * timestep / SLIP_RESOLUTION
 
 
 class DriveBatch:

@@ -19,6 +19,7 @@ import mujoco
 import numpy as np
 
 from fleetsim.runtime.params import param
+from fleetsim.sim.drives import rotor_armature
 from fleetsim.sim.plugins.base import (
     DrivePlugin,
     OdometryReading,
@@ -74,6 +75,10 @@ class WheeledDrive(DrivePlugin):
     accel: float
     encoder: bool
     publish_tf: bool
+    # give the drive wheels a held rotor (``drives.rotor_armature``): skid steer needs it to
+    # scrub as Coulomb friction does; a diff drive's wheels roll without scrubbing and keep
+    # their bare inertia, so its torque limit bounds the acceleration of the robot alone
+    held_rotor: bool = False
 
     def _setup(self) -> None:
         p = self.params
@@ -97,6 +102,8 @@ class WheeledDrive(DrivePlugin):
         self.twist = (0.0, 0.0)
 
     def build(self, spec, engine) -> None:
+        if self.held_rotor:
+            self._set_rotor_armature(spec)
         for j in self.left + self.right:
             a = spec.add_actuator(
                 name=f"{self.ctx.model}/{self.name}/{j}",
@@ -106,6 +113,35 @@ class WheeledDrive(DrivePlugin):
             a.set_to_velocity(kv=1.0)  # gain set in bind()
             # no forcerange: a force-limited actuator loses its implicit damping term and goes
             # unstable on light wheels; the torque limit is applied on the target instead
+
+    def _set_rotor_armature(self, spec) -> None:
+        """Give the drive wheels their motors' reflected inertia (``drives.rotor_armature``)."""
+        robot = self.ctx.robot
+        mass = sum(
+            link.inertial.mass
+            for link in robot.links.values()
+            if link.inertial is not None and link.inertial.mass > 0
+        )
+        joints = [spec.joint(f"{self.ctx.model}/{j}") for j in self.left + self.right]
+        mu = max(
+            (
+                float(g.friction[0])
+                for j in joints
+                for g in j.parent.geoms
+                if g.contype or g.conaffinity
+            ),
+            default=1.0,
+        )
+        arm = rotor_armature(
+            mass,
+            self.radius,
+            len(joints),
+            mu,
+            float(np.linalg.norm(spec.option.gravity)),
+            spec.option.timestep,
+        )
+        for j in joints:
+            j.armature = max(float(j.armature), arm)
 
     def bind(self, engine) -> None:
         m = engine.model

@@ -1,8 +1,20 @@
 """Skid-steer drive (``libgazebo_ros_skid_steer_drive.so``): four wheels, two per side.
 
-Same wheel actuation as the diff drive (velocity actuators under a torque limit on real wheel
-joints). Turning makes the wheels scrub sideways, so encoder odometry (the mean angle of each
-side's wheels) over-estimates rotation and drifts: compare it with p3d ground truth.
+Same wheel actuation as the diff drive (velocity servos under a torque limit on real wheel
+joints), plus a held rotor on every drive wheel (``sim.drives.rotor_armature``): Gazebo's wheel
+motor is a velocity constraint solved with the contacts, and without that inertia MuJoCo's
+contact solver spent most of the friction cone sideways, so the robots turned at 0.1-0.2 of the
+commanded rate. Turning makes the wheels scrub: with isotropic Coulomb friction and four equally
+loaded wheels the true yaw rate is ``b^2 / (a^2 + b^2)`` of the commanded one (``a`` half
+wheelbase, ``b`` half track). Measured on flat ground (true / commanded yaw rate, steady
+state): lizi 0.57 in place (1.0 and 0.4 rad/s) and 0.52 on a 0.3 m/s, 0.5 rad/s arc (Coulomb
+0.60); pioneer3at 0.65-0.68 (Coulomb 0.68); jackal 0.65-0.69 (Coulomb 0.67). Straight runs
+keep the commanded speed.
+
+Encoder odometry (the mean angle of each side's wheels, as the Gazebo plugin's wheel
+odometry) assumes rolling wheels, so it reports the commanded rotation: about 1/0.57 = 1.75x
+lizi's true rotation, 1.5x pioneer3at's and jackal's, and it drifts. Compare it with p3d ground
+truth; the torque also spins the held rotor, so a low ``torque`` slows starts.
 """
 
 from __future__ import annotations
@@ -44,6 +56,7 @@ class SkidSteerParams:
 class SkidSteerPlugin(WheeledDrive):
     Params = SkidSteerParams
     joint_params = ("leftFrontJoint", "leftRearJoint", "rightFrontJoint", "rightRearJoint")
+    held_rotor = True
 
     def __init__(self, ctx, spec, sensor=None) -> None:
         super().__init__(ctx, spec, sensor)

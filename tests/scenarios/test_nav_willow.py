@@ -20,29 +20,24 @@ import numpy as np
 import pytest
 from nav_harness import (
     CONFIG,
+    GOALS,
     LESSON_STARTS,
     LIZI_FOOTPRINT,
+    SIM_LIMIT,
     WILLOW,
+    XY_GOAL_TOLERANCE,
     TruthLog,
     bottleneck_width,
     clearances_from_map,
+    lesson_starts,
     nearest_free_start,
     willow_session,
-    yaw_towards,
 )
 
 from fleetsim.msgs import actionlib_msgs, move_base_msgs
 from fleetsim.nav.map_io import OccupancyMap, load_map
 from fleetsim.nav.navigator import Navigator, TaskResult
 from fleetsim.runtime import Node
-
-GOALS = {
-    "lizi1": (5.0, 12.0, math.pi),
-    "lizi2": (22.0, 33.0, math.pi / 2),
-    "lizi3": (40.0, 12.0, 0.0),
-}
-XY_GOAL_TOLERANCE = 0.2  # m, base_local_planner_params.yaml of willow_nav
-SIM_LIMIT = 150.0  # s of sim time for the three-robot run
 
 LIZI_SKID_XFAIL = pytest.mark.xfail(
     strict=True,
@@ -54,15 +49,6 @@ LIZI_SKID_XFAIL = pytest.mark.xfail(
 @pytest.fixture(scope="module")
 def willow() -> OccupancyMap:
     return load_map(WILLOW)
-
-
-def lesson_starts(grid: OccupancyMap) -> list[tuple[float, float, float]]:
-    """The lesson's starts moved to free cells, each facing its robot's goal."""
-    out = []
-    for (sx, sy), goal in zip(LESSON_STARTS, GOALS.values(), strict=True):
-        x, y = nearest_free_start(grid, (sx, sy), LIZI_FOOTPRINT)
-        out.append((x, y, round(yaw_towards((x, y), goal[:2]), 3)))
-    return out
 
 
 # -- the map helpers ------------------------------------------------------------------------

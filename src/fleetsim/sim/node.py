@@ -26,6 +26,7 @@ from fleetsim.sim.plugins.base import (
     OdometryReading,
     ScanReading,
 )
+from fleetsim.sim.plugins.camera import CameraPlugin
 from fleetsim.sim.services import WorldServices
 from fleetsim.sim.world import WALL_HEIGHT
 
@@ -118,7 +119,19 @@ class Simulator(Node):
                 subs.append(
                     self.create_subscription(geometry_msgs.Twist, topic, on_cmd, queue_size=1)
                 )
+            elif isinstance(p, CameraPlugin):
+                # as gazebo_ros_camera: render only while someone subscribes to the images
+                pp = p.params
+                names = [pp.imageTopicName, pp.cameraInfoTopicName]
+                if p.depth_enabled:
+                    names += [pp.depthImageTopicName, pp.depthImageCameraInfoTopicName]
+                topics = [self.topic(entry, p.topic(n)) for n in names]
+                p.wanted = lambda topics=topics: self._has_subscribers(topics)
         self._subs[entry.name] = subs
+
+    def _has_subscribers(self, topics: list[str]) -> bool:
+        graph = self.runtime.graph
+        return any(t in graph.topics and graph.topics[t].subscriptions for t in topics)
 
     def delete_model(self, name: str) -> None:
         self.engine.delete_model(name)

@@ -68,6 +68,8 @@ def _get(d: dict | None, path: str, default):
 class CameraPlugin(SensorPlugin):
     Params = CameraParams
     depth_enabled = False
+    #: set by the simulator node: True while the images have subscribers (None: always render)
+    wanted = None
 
     def __init__(self, ctx, spec, sensor=None) -> None:
         super().__init__(ctx, spec, sensor)
@@ -135,7 +137,9 @@ class CameraPlugin(SensorPlugin):
             return img
         return r.render().copy()
 
-    def measure(self, engine, t: float) -> ImageReading:
+    def measure(self, engine, t: float) -> ImageReading | None:
+        if self.wanted is not None and not self.wanted():
+            return None  # nobody looks: skip the (software) rendering
         p = self.params
         reading = ImageReading(
             t,

@@ -1,0 +1,217 @@
+"""BARN benchmark: the jackal with move_base on the BARN worlds, under the data's protocol.
+
+Each run is the shipped scenario ``fleetsim_launch/barn.launch`` (args ``world:=N``,
+``barn_dir:=...``) in process, headless, no bridge: the jackal spawned at the start pose
+(-2.25, 3.0, yaw 1.57), move_base on laser-only costmaps, send_goals sending the goal
+(-2.25, 13.0). The protocol of /work/shared/data/barn/README.md:
+
+- success: the ground-truth position (``/jackal/ground_truth/state``, the simulator's p3d) within
+  1.0 m of the goal;
+- collision: any contact of the jackal with an obstacle (the run's `RunMonitor`, which counts
+  the simulator's contacts) ends the run as a failure;
+- timeout: 100 s of simulated time pass. A goal that move_base aborts ends the run early and is
+  counted as a timeout (the robot would stand still until the 100 s pass), reported as
+  ``aborted``;
+- metric: success * optimal_time / clip(actual_time, 2 * optimal_time, 8 * optimal_time), with
+  optimal_time = length of the reference path (``path_N.npy`` in metres, start and goal
+  added) / 2 m/s.
+
+The clock starts when the robot has moved 0.1 m from its start, as the BARN challenge's run
+script does (the startup of the stack is not navigation time).
+
+    PYTHONPATH=src .venv/bin/python benchmarks/barn.py               # a handful of worlds
+    PYTHONPATH=src .venv/bin/python benchmarks/barn.py --worlds 3,9,15
+    PYTHONPATH=src .venv/bin/python benchmarks/barn.py --all
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import math
+import os
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from fleetsim.launch.packages import ASSETS
+from fleetsim.launch.runner import LaunchSession, load_plan
+from fleetsim.msgs import nav_msgs
+from fleetsim.runtime import Node
+
+BARN_DIR = Path("/work/shared/data/barn")
+LAUNCH = ASSETS / "launch" / "barn.launch"
+START = (-2.25, 3.0)
+GOAL = (-2.25, 13.0)
+GOAL_RADIUS = 1.0  # m
+TIME_LIMIT = 100.0  # s of sim time
+MOVED = 0.1  # m from the start: the clock starts
+CHECK_PERIOD = 0.1  # s of sim time between checks of the run's state
+DEFAULT_WORLDS = (3, 51, 99, 153, 201, 249)
+
+
+def path_from_grid(grid_path: np.ndarray) -> np.ndarray:
+    """(K + 2, 2) reference path in the world frame (m): start, the (K, 2) grid path
+    converted as the README gives it (x = 0.15 a - 4.575, y = 0.15 b + 5.075), goal."""
+    g = np.asarray(grid_path, dtype=float)
+    xy = np.column_stack([0.15 * g[:, 0] - 4.575, 0.15 * g[:, 1] + 5.075])
+    return np.vstack([START, xy, GOAL])
+
+
+def optimal_time_of(path: np.ndarray, speed: float = 2.0) -> float:
+    """Optimal time (s): length (m) of the (K, 2) path over ``speed`` (m/s)."""
+    return float(np.sum(np.hypot(*np.diff(path, axis=0).T))) / speed
+
+
+def metric_of(success: bool, actual_time: float, optimal_time: float) -> float:
+    """BARN's score of one run (0 on failure, at most 0.5)."""
+    clipped = float(np.clip(actual_time, 2.0 * optimal_time, 8.0 * optimal_time))
+    return float(success) * optimal_time / clipped
+
+
+class GroundTruth(Node):
+    """The jackal's latest ground-truth (x, y) from its p3d, and where it first was."""
+
+    def __init__(self, runtime) -> None:
+        super().__init__(runtime, "barn_ground_truth", "/")
+        self.xy: tuple[float, float] | None = None
+        self.first: tuple[float, float] | None = None
+        self.create_subscription(
+            nav_msgs.Odometry, "/jackal/ground_truth/state", self._on_state, queue_size=1
+        )
+
+    def _on_state(self, msg) -> None:
+        p = msg.pose.pose.position
+        self.xy = (p.x, p.y)
+        if self.first is None:
+            self.first = self.xy
+
+
+@dataclass
+class RunResult:
+    world: int
+    outcome: str  # success | collision | timeout | aborted
+    time: float  # s of sim time from the first 0.1 m of motion to the end of the run
+    optimal_time: float
+    metric: float
+    final_gap: float  # m from the goal at the end
+    wall: float  # s of wall time for the run
+
+    @property
+    def success(self) -> bool:
+        return self.outcome == "success"
+
+
+def run_world(
+    world: int, barn_dir: Path = BARN_DIR, seed: int = 0, time_limit: float = TIME_LIMIT
+) -> RunResult:
+    """One run of the protocol on world ``world``."""
+    t_wall = time.perf_counter()
+    optimal = optimal_time_of(path_from_grid(np.load(barn_dir / f"path_{world}.npy")))
+    args = {"world": str(world), "barn_dir": str(barn_dir), "gui": "false"}
+    # barn.launch's barn_dir default is $(env FLEETSIM_BARN_DIR), which roslaunch resolves even
+    # when the arg is given: set it too
+    os.environ["FLEETSIM_BARN_DIR"] = str(barn_dir)
+    session = LaunchSession(load_plan(LAUNCH, args, seed=seed), seed=seed, listen=None)
+    try:
+        rt, monitor = session.runtime, session.monitor
+        truth = GroundTruth(rt)
+        started: float | None = None
+        outcome = "timeout"
+        while True:
+            rt.run(duration=CHECK_PERIOD)
+            now = rt.now()
+            robot = monitor.results()[0] if monitor.results() else None
+            if truth.xy is None:
+                continue
+            if started is None and math.dist(truth.xy, truth.first) >= MOVED:
+                started = now
+            if robot is not None and robot.collisions > 0:
+                outcome = "collision"
+                break
+            if math.dist(truth.xy, GOAL) <= GOAL_RADIUS:
+                outcome = "success"
+                break
+            if robot is not None and robot.goals_failed > 0:
+                outcome = "aborted"
+                break
+            if now - (started if started is not None else 0.0) >= time_limit:
+                break
+        elapsed = now - (started if started is not None else 0.0)
+        success = outcome == "success"
+        return RunResult(
+            world=world,
+            outcome=outcome,
+            time=elapsed,
+            optimal_time=optimal,
+            metric=metric_of(success, elapsed, optimal),
+            final_gap=math.dist(truth.xy, GOAL) if truth.xy is not None else float("nan"),
+            wall=time.perf_counter() - t_wall,
+        )
+    finally:
+        session.close()
+
+
+def summary(results: list[RunResult]) -> dict[str, float]:
+    """Rates (fractions) of each outcome and the mean metric over ``results``."""
+    n = len(results)
+    count = {k: sum(r.outcome == k for r in results) for k in ("success", "collision")}
+    timeouts = sum(r.outcome in ("timeout", "aborted") for r in results)
+    return {
+        "runs": n,
+        "success": count["success"] / n,
+        "collision": count["collision"] / n,
+        "timeout": timeouts / n,
+        "metric": float(np.mean([r.metric for r in results])),
+    }
+
+
+def available_worlds(barn_dir: Path) -> list[int]:
+    return sorted(int(p.stem.split("_")[1]) for p in barn_dir.glob("world_*.world"))
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--worlds", help="comma-separated world numbers, e.g. 3,9,15")
+    ap.add_argument("--all", action="store_true", help="every world in --barn-dir")
+    ap.add_argument("--barn-dir", type=Path, default=BARN_DIR)
+    ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("-v", "--verbose", action="store_true", help="show the nodes' log")
+    a = ap.parse_args()
+    logging.basicConfig(level=logging.INFO if a.verbose else logging.ERROR)
+    if a.all:
+        worlds = available_worlds(a.barn_dir)
+    elif a.worlds:
+        worlds = [int(w) for w in a.worlds.split(",") if w.strip()]
+    else:
+        worlds = list(DEFAULT_WORLDS)
+    print(f"BARN: jackal + move_base (DWA), {len(worlds)} worlds from {a.barn_dir}")
+    print(
+        f"{'world':>5} {'outcome':>9} {'time s':>7} {'opt s':>6} {'metric':>6} {'gap m':>6} "
+        f"{'wall s':>6}"
+    )
+    results = []
+    for w in worlds:
+        r = run_world(w, a.barn_dir, seed=a.seed)
+        results.append(r)
+        print(
+            f"{r.world:>5} {r.outcome:>9} {r.time:7.1f} {r.optimal_time:6.2f} {r.metric:6.3f} "
+            f"{r.final_gap:6.2f} {r.wall:6.1f}",
+            flush=True,
+        )
+    s = summary(results)
+    print(
+        f"runs {s['runs']}: success {100 * s['success']:.1f} %, collision "
+        f"{100 * s['collision']:.1f} %, timeout {100 * s['timeout']:.1f} %, "
+        f"mean metric {s['metric']:.3f}"
+    )
+    print(
+        "reference (ROS move_base + DWA, 50 test worlds): success 85.0 %, collision 5.6 %, "
+        "timeout 9.4 %; target >= 90 % success"
+    )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,51 @@
+"""BARN smoke test: one BARN world through the whole pipeline for a few sim seconds.
+
+The shipped ``barn.launch`` (simulator on ``world_3.world``, the jackal, move_base, send_goals)
+runs for 8 s of sim time; the jackal must have left its start towards the goal, without a
+contact. Success rates are ``benchmarks/barn.py``'s job. Also checks the benchmark's protocol
+arithmetic (reference path, optimal time, metric) against the README's definitions.
+"""
+
+import math
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
+import barn
+
+pytestmark = pytest.mark.skipif(
+    not (barn.BARN_DIR / "world_3.world").is_file(), reason="BARN data not present"
+)
+
+
+def test_reference_path_and_metric_follow_the_readme():
+    path = barn.path_from_grid(np.array([[0, 0], [30, 0]]))
+    assert np.allclose(path[0], barn.START) and np.allclose(path[-1], barn.GOAL)
+    assert np.allclose(path[1], (-4.575, 5.075)) and np.allclose(path[2], (-0.075, 5.075))
+    length = math.dist(barn.START, path[1]) + 4.5 + math.dist(path[2], barn.GOAL)
+    assert barn.optimal_time_of(path) == pytest.approx(length / 2.0)
+    assert barn.metric_of(True, 1.0, 10.0) == pytest.approx(0.5)  # clipped up to 2 x optimal
+    assert barn.metric_of(True, 40.0, 10.0) == pytest.approx(0.25)
+    assert barn.metric_of(True, 500.0, 10.0) == pytest.approx(0.125)  # clipped to 8 x optimal
+    assert barn.metric_of(False, 30.0, 10.0) == 0.0
+
+
+def test_summary_rates():
+    r = [
+        barn.RunResult(3, outcome, 10.0, 5.0, 0.25 if outcome == "success" else 0.0, 0.5, 1.0)
+        for outcome in ("success", "success", "collision", "aborted")
+    ]
+    s = barn.summary(r)
+    assert (s["success"], s["collision"], s["timeout"]) == (0.5, 0.25, 0.25)
+    assert s["metric"] == pytest.approx(0.125)
+
+
+@pytest.mark.scenario
+def test_jackal_sets_off_towards_the_goal_in_world_3():
+    r = barn.run_world(3, time_limit=6.0)
+    assert r.outcome in ("timeout", "success"), r  # no collision, no aborted goal
+    start_gap = math.dist(barn.START, barn.GOAL)
+    assert r.final_gap < start_gap - 1.0, r  # at least 1 m closer to the goal

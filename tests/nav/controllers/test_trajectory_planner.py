@@ -113,3 +113,17 @@ def test_blocked_and_empty():
     tp.set_plan(np.array([[4.0, 1.0, 0.0], [5.0, 1.0, 0.0]]))
     with pytest.raises(NoValidTrajectory, match="no valid trajectory"):
         tp.compute_velocity_commands((1.0, 1.0, 0.0), (0, 0, 0))
+
+
+def test_a_replan_to_the_same_goal_keeps_goal_reached():
+    # move_base may hand over a fresh plan before every control cycle (planner_frequency);
+    # the reached flag must survive until move_base reads it
+    planner = make(corridor())
+    goal = [[1.0, 1.0, 0.0], [1.2, 1.0, 0.0]]
+    planner.set_plan(goal)
+    planner.compute_velocity_commands((1.2, 1.0, 0.0), (0.0, 0.0, 0.0))
+    assert planner.is_goal_reached()
+    planner.set_plan([[1.1, 1.0, 0.0], [1.2, 1.0, 0.0]])
+    assert planner.is_goal_reached()
+    planner.set_plan([[1.1, 1.0, 0.0], [2.0, 1.0, 0.0]])
+    assert not planner.is_goal_reached()

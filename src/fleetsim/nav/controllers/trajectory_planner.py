@@ -111,9 +111,19 @@ class TrajectoryPlanner(LocalPlanner):
             raise EmptyPlan(f"set_plan: a plan must be (N, 3) x, y, yaw poses, got {poses.shape}")
         if poses.shape[1] == 2:
             poses = np.concatenate([poses, np.zeros((poses.shape[0], 1))], axis=1)
+        same_goal = (
+            self.plan.shape[0] > 0
+            and poses.shape[0] > 0
+            and np.allclose(self.plan[-1], poses[-1], rtol=0.0, atol=1e-6)
+        )
         self.plan = poses
-        self.reached_goal = False
-        self.xy_tolerance_latch = False
+        if not same_goal:
+            # ROS resets these on every setPlan; with move_base replanning at
+            # planner_frequency, a new plan can arrive before every control cycle and the
+            # reached flag would never survive to move_base's check. A replan to the same
+            # goal keeps them.
+            self.reached_goal = False
+            self.xy_tolerance_latch = False
 
     def is_goal_reached(self) -> bool:
         return self.reached_goal

@@ -19,7 +19,7 @@ DEMO_LIMIT = 150.0
 def run_demo(out: str | Path = "out", limit: float = DEMO_LIMIT, progress: bool = True) -> bool:
     """Run the demo; returns True when every robot reached its goal without a collision."""
     from fleetsim.cli.launch import results_table, run_launch
-    from fleetsim.viz import render
+    from fleetsim.viz.render import render
 
     console = Console(stderr=True)
     out = Path(out)

@@ -16,6 +16,8 @@ from fleetsim.msgs import actionlib_msgs, move_base_msgs
 from fleetsim.runtime import names
 
 SAMPLE_PERIOD = 0.1  # s of sim time between ground-truth samples
+#: a contact with the same partner within this long of the last one is the same collision
+COLLISION_GAP = 1.0  # s
 
 
 @dataclass
@@ -66,7 +68,7 @@ class RunMonitor:
                     queue_size=0,
                 )
         self._last_pos: dict[str, tuple[float, float]] = {}
-        self._touching: dict[str, set[str]] = {}
+        self._last_contact: dict[tuple[str, str], float] = {}
         if self.sim is not None:
             runtime.create_timer(SAMPLE_PERIOD, self._sample, priority=-40)
 
@@ -120,9 +122,12 @@ class RunMonitor:
             if last is not None:
                 r.path_length += math.hypot(x - last[0], y - last[1])
             self._last_pos[model] = (x, y)
-            new = touching[model] - self._touching.get(model, set())
-            r.collisions += len(new)
-        self._touching = touching
+            now = self.runtime.now()
+            for other in touching[model]:
+                last = self._last_contact.get((model, other))
+                if last is None or now - last > COLLISION_GAP:
+                    r.collisions += 1  # a new collision, not the same one going on
+                self._last_contact[(model, other)] = now
 
     # -- summary ------------------------------------------------------------------------
     def results(self) -> list[RobotResult]:

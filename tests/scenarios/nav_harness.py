@@ -110,12 +110,8 @@ def bottleneck_width(
 
 
 def lesson_starts(grid: OccupancyMap) -> list[tuple[float, float, float]]:
-    """The lesson's starts moved to free cells for lizi, each facing its robot's goal."""
-    out = []
-    for (sx, sy), goal in zip(LESSON_STARTS, GOALS.values(), strict=True):
-        x, y = nearest_free_start(grid, (sx, sy), LIZI_FOOTPRINT)
-        out.append((x, y, round(yaw_towards((x, y), goal[:2]), 3)))
-    return out
+    """The lesson's starts moved to free cells for lizi, facing +x as the lesson spawns them."""
+    return [(*nearest_free_start(grid, xy, LIZI_FOOTPRINT), 0.0) for xy in LESSON_STARTS]
 
 
 def goals_arg(goals: dict[str, tuple[float, float, float]]) -> str:

@@ -43,11 +43,6 @@ def test_initial_poses_reach_each_robots_amcl():
 
 
 @pytest.mark.scenario
-@pytest.mark.xfail(
-    strict=True,
-    reason="the simulator's four-wheel skid steer turns lizi at 10-20 % of the commanded rate "
-    "(known, being fixed in src/fleetsim/sim/): lizi cannot turn through Willow's doors",
-)
 def test_three_lizis_with_amcl_reach_their_goals():
     starts = lesson_starts(load_map(WILLOW))
     session = willow_session(starts, GOALS, localization="amcl")

@@ -39,12 +39,6 @@ from fleetsim.nav.map_io import OccupancyMap, load_map
 from fleetsim.nav.navigator import Navigator, TaskResult
 from fleetsim.runtime import Node
 
-LIZI_SKID_XFAIL = pytest.mark.xfail(
-    strict=True,
-    reason="the simulator's four-wheel skid steer turns lizi at 10-20 % of the commanded rate "
-    "(known, being fixed in src/fleetsim/sim/): lizi cannot turn through Willow's doors",
-)
-
 
 @pytest.fixture(scope="module")
 def willow() -> OccupancyMap:
@@ -108,7 +102,6 @@ def test_lesson_starts_fit_lizi_and_the_goals_are_far_behind_doors(willow):
 
 # -- the scenarios ----------------------------------------------------------------------------
 @pytest.mark.scenario
-@LIZI_SKID_XFAIL
 def test_three_lizis_reach_goals_through_doors_without_collisions(willow):
     starts = lesson_starts(willow)
     session = willow_session(starts, GOALS)

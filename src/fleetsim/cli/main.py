@@ -91,7 +91,8 @@ _add_subapps()
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; returns the exit status."""
     try:
-        app(args=argv, standalone_mode=False)
+        # outside standalone mode click hands back a typer.Exit's code as the return value
+        code = app(args=argv, standalone_mode=False)
     except FleetsimError as e:
         err_console.print(f"[bold red]error:[/] {e}", highlight=False, soft_wrap=True)
         return 1
@@ -105,7 +106,7 @@ def main(argv: list[str] | None = None) -> int:
     except typer.TyperException as e:  # usage errors: typer prints them its own way
         e.show()
         return e.exit_code
-    return 0
+    return code if isinstance(code, int) else 0
 
 
 if __name__ == "__main__":

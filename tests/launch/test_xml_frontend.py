@@ -5,7 +5,8 @@ from pathlib import Path
 import pytest
 
 from fleetsim.errors import FleetsimError, LaunchError
-from fleetsim.launch.xml_frontend import convert_value, load_xml
+from fleetsim.launch.xml_frontend import load_xml
+from fleetsim.launch.xml_params import convert_value
 
 FIX = Path(__file__).parent / "fixtures" / "multi_pkg"
 

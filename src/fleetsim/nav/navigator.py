@@ -88,13 +88,18 @@ def yaw_of(q: Any) -> float:
     return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
 
 
-def pose_stamped(x: float, y: float, yaw: float, frame: str, stamp: float) -> Any:
-    """A geometry_msgs/PoseStamped at (x, y) m heading ``yaw`` rad in ``frame``."""
+def pose_stamped(
+    x: float, y: float, yaw: float, frame: str, stamp: float, what: str = "Navigator: pose"
+) -> Any:
+    """A geometry_msgs/PoseStamped at (x, y) m heading ``yaw`` rad in ``frame``.
+
+    ``what`` names the pose in the error for a value that is not a finite number.
+    """
     from fleetsim.msgs import builtin_interfaces, geometry_msgs, std_msgs
 
     for label, v in (("x", x), ("y", y), ("yaw", yaw)):
         if not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise ActionError(f"Navigator: pose {label} must be a finite number, got {v!r}")
+            raise ActionError(f"{what} {label} must be a finite number, got {v!r}")
     return geometry_msgs.PoseStamped(
         header=std_msgs.Header(stamp=builtin_interfaces.Time.from_sec(stamp), frame_id=frame),
         pose=geometry_msgs.Pose(

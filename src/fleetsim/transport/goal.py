@@ -14,7 +14,7 @@ import time as _wall
 from collections.abc import Callable
 from typing import Any
 
-from fleetsim.errors import ActionError, GraphError, TransportError
+from fleetsim.errors import GraphError, TransportError
 from fleetsim.runtime import names
 from fleetsim.transport.client import SimulationClient
 
@@ -25,20 +25,9 @@ INITIALPOSE_COVARIANCE_YAW = 0.06853891945200942
 
 def pose_stamped(x: float, y: float, yaw: float, frame: str, stamp: float) -> Any:
     """A geometry_msgs/PoseStamped at ``(x, y)`` m heading ``yaw`` rad in ``frame``."""
-    from fleetsim.msgs import builtin_interfaces, geometry_msgs, std_msgs
+    from fleetsim.nav.navigator import pose_stamped as navigator_pose
 
-    for label, v in (("x", x), ("y", y), ("yaw", yaw)):
-        if not math.isfinite(v):
-            raise ActionError(f"goal {label} must be a finite number, got {v}")
-    return geometry_msgs.PoseStamped(
-        header=std_msgs.Header(stamp=builtin_interfaces.Time.from_sec(stamp), frame_id=frame),
-        pose=geometry_msgs.Pose(
-            position=geometry_msgs.Point(x=float(x), y=float(y), z=0.0),
-            orientation=geometry_msgs.Quaternion(
-                x=0.0, y=0.0, z=math.sin(yaw / 2.0), w=math.cos(yaw / 2.0)
-            ),
-        ),
-    )
+    return navigator_pose(x, y, yaw, frame, stamp, what="goal")
 
 
 def initial_pose(x: float, y: float, yaw: float, frame: str, stamp: float) -> Any:

@@ -2,7 +2,10 @@
 
 The monitor listens to each robot's move_base action topics (``<ns>/move_base/goal`` and
 ``result``), so it counts goals however they were sent (a send_goals node, the CLI, a user
-node), and samples the simulator's ground truth for path length and contacts.
+node), and samples the simulator's ground truth for path length and contacts. It listens in the
+namespace of every move_base in the plan and of every robot the simulator spawns, so a robot
+whose move_base runs in another process (``fleetsim node run``, over the Zenoh bridge) is
+counted too.
 """
 
 from __future__ import annotations
@@ -47,32 +50,39 @@ class RunMonitor:
         self.robots: dict[str, RobotResult] = {}
         self.senders = [n for n in nodes.values() if hasattr(n, "done") and _is_sender(n)]
         self.sim = next((n for n in nodes.values() if hasattr(n, "engine")), None)
-        graph = runtime.graph
+        self._watched: set[str] = set()
         for spec in plan.nodes:
             if (spec.pkg, spec.type) == ("move_base", "move_base"):
-                ns = spec.namespace
-                r = self.robots.setdefault(ns, RobotResult(ns))
-                # move_base serves its action in the robot's namespace, whatever the node's name
-                # (the lesson names the node move_base_node)
-                base = names.join(ns, "move_base")
-                graph.subscribe(
-                    f"{base}/goal",
-                    move_base_msgs.MoveBase.ActionGoal,
-                    lambda _m, r=r: self._on_goal(r),
-                    queue_size=0,
-                )
-                graph.subscribe(
-                    f"{base}/result",
-                    move_base_msgs.MoveBase.ActionResult,
-                    lambda m, r=r: self._on_result(r, m),
-                    queue_size=0,
-                )
+                self._watch(spec.namespace)
         self._last_pos: dict[str, tuple[float, float]] = {}
         self._last_contact: dict[tuple[str, str], float] = {}
         if self.sim is not None:
             runtime.create_timer(SAMPLE_PERIOD, self._sample, priority=-40)
 
     # -- goals --------------------------------------------------------------------------
+    def _watch(self, ns: str) -> None:
+        """Count the goals and results of the move_base action in robot namespace ``ns``."""
+        if ns in self._watched:
+            return
+        self._watched.add(ns)
+        r = self.robots.setdefault(ns, RobotResult(ns))
+        # move_base serves its action in the robot's namespace, whatever the node's name
+        # (the lesson names the node move_base_node)
+        base = names.join(ns, "move_base")
+        graph = self.runtime.graph
+        graph.subscribe(
+            f"{base}/goal",
+            move_base_msgs.MoveBase.ActionGoal,
+            lambda _m, r=r: self._on_goal(r),
+            queue_size=0,
+        )
+        graph.subscribe(
+            f"{base}/result",
+            move_base_msgs.MoveBase.ActionResult,
+            lambda m, r=r: self._on_result(r, m),
+            queue_size=0,
+        )
+
     def _on_goal(self, r: RobotResult) -> None:
         r.goals_sent += 1
 
@@ -114,7 +124,8 @@ class RunMonitor:
                 if me in touching:
                     touching[me].add(other)
         for ns, model in models.items():
-            r = self.robots.setdefault(ns, RobotResult(ns))
+            self._watch(ns)  # a spawned robot's move_base may live in another process
+            r = self.robots[ns]
             r.model = model
             pos, _ = engine.model_pose(model)
             x, y = float(pos[0]), float(pos[1])

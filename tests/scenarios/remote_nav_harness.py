@@ -27,6 +27,7 @@ import sys
 import tempfile
 import threading
 import time
+from collections.abc import Sequence
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -167,12 +168,17 @@ def start_host(endpoint: str, namespaces: list[str]) -> Subprocess:
     return Subprocess([sys.executable, str(Path(__file__).resolve()), endpoint, *namespaces])
 
 
-def wait_for_action_servers(client, namespaces: list[str], timeout: float) -> list[str]:
+def wait_for_action_servers(
+    client, namespaces: list[str], timeout: float, hosts: Sequence[Subprocess] = ()
+) -> list[str]:
     """Wait (wall s) until each ``<ns>/move_base`` publishes its status somewhere in the
-    graph; returns the namespaces still missing (empty when all are up)."""
+    graph; returns the namespaces still missing (empty when all are up). Gives up early when
+    one of ``hosts`` has exited."""
     deadline = time.monotonic() + timeout
     missing = list(namespaces)
     while missing and time.monotonic() < deadline:
+        if any(h.proc.poll() is not None for h in hosts):
+            break
         topics = client.graph()["topics"]
         missing = [
             ns

@@ -83,7 +83,7 @@ def test_move_base_in_another_process_drives_lizi_to_its_goal():
         mb = start_node_run(endpoint, "/lizi1")
         try:
             with SimulationClient(endpoint, timeout=5.0) as client:
-                missing = wait_for_action_servers(client, ["/lizi1"], timeout=40.0)
+                missing = wait_for_action_servers(client, ["/lizi1"], 40.0, [mb])
                 assert not missing, f"move_base never came up:\n{mb.stderr()[-3000:]}"
                 # the action server is remote: the graph lists it, the simulation lacks it
                 assert "/lizi1/move_base" in client.graph()["nodes"]
@@ -105,7 +105,7 @@ def test_two_processes_each_host_half_the_robots_move_base():
         hosts = [start_host(endpoint, half) for half in halves]
         try:
             with SimulationClient(endpoint, timeout=5.0) as client:
-                missing = wait_for_action_servers(client, [*halves[0], *halves[1]], 40.0)
+                missing = wait_for_action_servers(client, [*halves[0], *halves[1]], 40.0, hosts)
                 errs = "\n".join(h.stderr()[-2000:] for h in hosts)
                 assert not missing, f"no move_base for {missing}:\n{errs}"
                 by_pid = {s["pid"]: set(s["nodes"]) for s in client.snapshots()}

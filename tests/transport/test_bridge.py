@@ -29,7 +29,9 @@ def test_topics_latched_and_services_between_processes(sim):
         assert len(echo.heard) >= 7
         stamps = [float(data[2:]) for _, data in echo.heard]
         assert stamps == sorted(stamps)  # in order
-        assert all(t_recv >= t_pub - 0.02 for (t_recv, _), t_pub in zip(echo.heard, stamps))
+        # the follower's clock trails the simulation's by the /clock period plus the transport
+        # latency; on a loaded machine that is tens of milliseconds, never a fifth of a second
+        assert all(t_recv >= t_pub - 0.2 for (t_recv, _), t_pub in zip(echo.heard, stamps))
         assert [g.data for g in greetings] == ["hello"]  # the latched message, once
         assert len(sim.talker.back) >= 5
         assert sim.talker.back[0].data.startswith("echo:t=")

@@ -9,7 +9,7 @@ count, never the robots' own estimates.
 Starts: the lesson's (20, 15), (22, 15), (24, 15), each moved to the nearest cell where lizi's
 footprint fits (`nearest_free_start`; (20, 15) is 0.2 m from a wall and moves). Goals are
 >= 15 m away in a straight line and behind openings no wider than a door (`bottleneck_width`),
-one to the west, one to the north and one to the east so that the robots do not queue at one
+one to the north-west, one to the north and one to the east so that the robots do not queue at one
 door.
 """
 
@@ -97,7 +97,7 @@ def test_lesson_starts_fit_lizi_and_the_goals_are_far_behind_doors(willow):
         assert math.dist((x, y), lesson) <= 0.5
         assert clear[int(y / 0.1), int(x / 0.1)] >= radius
         assert math.dist((x, y), goal[:2]) >= 15.0
-        assert bottleneck_width(willow, (x, y), goal[:2]) <= 1.2
+        assert bottleneck_width(willow, (x, y), goal[:2]) <= 1.2 + 1e-9  # door-wide
 
 
 # -- the scenarios ----------------------------------------------------------------------------

@@ -48,7 +48,9 @@ class RunMonitor:
     def __init__(self, runtime, plan: LaunchPlan, nodes: dict[str, Any]) -> None:
         self.runtime = runtime
         self.robots: dict[str, RobotResult] = {}
-        self.senders = [n for n in nodes.values() if hasattr(n, "done") and _is_sender(n)]
+        # nodes that send goals (send_goals, user nodes) say so with `sends_goals = True` and
+        # a `done` property; a run waits for them before its goals can all be done
+        self.senders = [n for n in nodes.values() if getattr(n, "sends_goals", False)]
         self.sim = next((n for n in nodes.values() if hasattr(n, "engine")), None)
         self._watched: set[str] = set()
         for spec in plan.nodes:
@@ -147,7 +149,3 @@ class RunMonitor:
     def success(self) -> bool:
         rs = [r for r in self.results() if r.goals_sent > 0]
         return bool(rs) and all(r.ok for r in rs) and all(r.collisions == 0 for r in self.results())
-
-
-def _is_sender(node: Any) -> bool:
-    return type(node).__name__ in ("SendGoals",) or getattr(node, "sends_goals", False)

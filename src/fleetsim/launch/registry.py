@@ -63,8 +63,9 @@ def resolve_node(pkg: str, type_: str, where: str = "") -> Any:
     if "." in pkg or pkg.startswith("fleetsim"):
         try:
             importlib.import_module(pkg)
-        except ImportError:
-            pass
+        except ModuleNotFoundError as e:
+            if e.name != pkg and not pkg.startswith(f"{e.name}."):
+                raise LaunchError(f"{what}: cannot import module '{pkg}': {e}") from None
         else:
             return _import(f"{pkg}:{type_}", what)
     known = [f"{p}/{t}" for p, t in sorted(NODES)]

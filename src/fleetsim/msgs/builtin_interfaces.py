@@ -12,58 +12,45 @@ from fleetsim.msgs.registry import message
 _NS = 1_000_000_000
 
 
+class _SecNanosec:
+    """What Time and Duration share: ``sec`` + ``nanosec`` (0 <= nanosec < 1e9) conversions."""
+
+    __slots__ = ()
+
+    @classmethod
+    def from_sec(cls, t: float):
+        """``t`` seconds (a Duration may be negative), rounded to the nearest nanosecond."""
+        return cls.from_nsec(round(t * _NS)) if math.isfinite(t) else _not_finite(cls, t)
+
+    @classmethod
+    def from_nsec(cls, ns: int):
+        """``ns`` nanoseconds (an int); nanosec is always in [0, 1e9)."""
+        sec, nanosec = divmod(int(ns), _NS)
+        return cls(sec, nanosec)
+
+    def to_sec(self) -> float:
+        """Seconds as a float."""
+        return self.sec + self.nanosec * 1e-9
+
+    def to_nsec(self) -> int:
+        """Nanoseconds as an int (exact)."""
+        return self.sec * _NS + self.nanosec
+
+
 @message("builtin_interfaces/msg/Time")
-class Time:
+class Time(_SecNanosec):
     """A point in time: ``sec`` seconds plus ``nanosec`` (0 <= nanosec < 1e9) nanoseconds."""
 
     sec: int32
     nanosec: uint32
 
-    @classmethod
-    def from_sec(cls, t: float) -> Time:
-        """The time ``t`` seconds, rounded to the nearest nanosecond."""
-        return cls.from_nsec(round(t * _NS)) if math.isfinite(t) else _not_finite(cls, t)
-
-    @classmethod
-    def from_nsec(cls, ns: int) -> Time:
-        """The time ``ns`` nanoseconds (an int); nanosec is always in [0, 1e9)."""
-        sec, nanosec = divmod(int(ns), _NS)
-        return cls(sec, nanosec)
-
-    def to_sec(self) -> float:
-        """Seconds as a float."""
-        return self.sec + self.nanosec * 1e-9
-
-    def to_nsec(self) -> int:
-        """Nanoseconds as an int (exact)."""
-        return self.sec * _NS + self.nanosec
-
 
 @message("builtin_interfaces/msg/Duration")
-class Duration:
+class Duration(_SecNanosec):
     """A span of time: ``sec`` seconds plus ``nanosec`` (0 <= nanosec < 1e9) nanoseconds."""
 
     sec: int32
     nanosec: uint32
-
-    @classmethod
-    def from_sec(cls, t: float) -> Duration:
-        """The duration ``t`` seconds (may be negative), rounded to the nearest nanosecond."""
-        return cls.from_nsec(round(t * _NS)) if math.isfinite(t) else _not_finite(cls, t)
-
-    @classmethod
-    def from_nsec(cls, ns: int) -> Duration:
-        """The duration ``ns`` nanoseconds (an int); nanosec is always in [0, 1e9)."""
-        sec, nanosec = divmod(int(ns), _NS)
-        return cls(sec, nanosec)
-
-    def to_sec(self) -> float:
-        """Seconds as a float."""
-        return self.sec + self.nanosec * 1e-9
-
-    def to_nsec(self) -> int:
-        """Nanoseconds as an int (exact)."""
-        return self.sec * _NS + self.nanosec
 
 
 def _not_finite(cls: type, t: float) -> NoReturn:

@@ -120,6 +120,9 @@ class _Robot:
 class SendGoals(Node):
     """Sends each robot's goals in order through move_base and records the outcomes."""
 
+    #: the launch run monitor waits for `done` before a run's goals can all be done
+    sends_goals = True
+
     Params = SendGoalsParams
 
     def __init__(self, runtime, name: str = "send_goals", namespace: str = "/", **kw: Any):

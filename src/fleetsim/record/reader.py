@@ -40,12 +40,9 @@ def _read_errors() -> tuple[type[BaseException], ...]:
         OSError,
         EOFError,
     ]
-    try:
-        import zstandard
+    import zstandard
 
-        errors.append(zstandard.ZstdError)
-    except ImportError:  # pragma: no cover - mcap needs it for zstd chunks anyway
-        pass
+    errors.append(zstandard.ZstdError)
     return tuple(errors)
 
 

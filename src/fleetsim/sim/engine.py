@@ -117,7 +117,6 @@ class Engine(StateQueries):
         for entry in self.models.values():
             for p in entry.plugins:
                 p.bind(self)
-        self.attacher.bind(self)
         self.lasers.bind(self)
         self._schedule()
 
@@ -207,30 +206,20 @@ class Engine(StateQueries):
     def _make_plugins(self, entry: ModelEntry) -> list[base.Plugin]:
         out: list[base.Plugin] = []
         robot = entry.robot
+
+        def make(spec, *sensor) -> None:
+            cls = base.plugin_class(spec.filename, f"model '{entry.name}'")
+            if cls is not None:
+                where = f"{robot.source}:{spec.source_line or '?'}"
+                ctx = base.PluginContext(entry.name, entry.namespace, entry.tf_prefix, robot, where)
+                out.append(cls(ctx, spec, *sensor))
+
         for block in robot.gazebo:
             for spec in block.plugins:
-                cls = base.plugin_class(spec.filename, f"model '{entry.name}'")
-                if cls is not None:
-                    ctx = base.PluginContext(
-                        entry.name,
-                        entry.namespace,
-                        entry.tf_prefix,
-                        robot,
-                        f"{robot.source}:{spec.source_line or '?'}",
-                    )
-                    out.append(cls(ctx, spec))
+                make(spec)
             for sensor in block.sensors:
                 for spec in sensor.plugins:
-                    cls = base.plugin_class(spec.filename, f"model '{entry.name}'")
-                    if cls is not None:
-                        ctx = base.PluginContext(
-                            entry.name,
-                            entry.namespace,
-                            entry.tf_prefix,
-                            robot,
-                            f"{robot.source}:{spec.source_line or '?'}",
-                        )
-                        out.append(cls(ctx, spec, sensor))
+                    make(spec, sensor)
         return out
 
     def spawn_sdf(self, name: str, model: ModelDesc | str, pose: Pose | None = None) -> ModelEntry:

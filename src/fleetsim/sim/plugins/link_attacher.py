@@ -24,9 +24,6 @@ class LinkAttacher:
         self.pending: list[tuple[str, tuple[str, str, str, str]]] = []
         self.joints: set[tuple[str, str, str, str]] = set()
 
-    def bind(self, engine) -> None:
-        pass
-
     def _check(self, engine, m1: str, l1: str, m2: str, l2: str) -> None:
         engine.link_id(m1, l1)
         engine.link_id(m2, l2)

@@ -1,7 +1,7 @@
 """All planar lasers of the world in one batched ray cast.
 
-Static world: in a map world the extruded walls are the occupied cells themselves, so rays
-walk the occupancy grid (``occupancy_cast.ranges_from_occupancy``); every other static geom is
+Static world: in a map world the extruded walls are the occupied cells themselves, so each laser
+sweeps the wall boxes near it (``occupancy_cast.ranges_from_walls``); every other static geom is
 sliced into primitives binned once per compile (``raycast.ranges_from_primitives``). Movable
 models (robots, loose objects) are sliced at every sweep and tested only by the beams that fall
 inside their bounding circle (``raycast.ranges_with_bodies``), skipping the robot that carries
@@ -9,6 +9,8 @@ the laser.
 """
 
 from __future__ import annotations
+
+from dataclasses import dataclass
 
 import mujoco
 import numpy as np
@@ -19,15 +21,63 @@ from fleetsim.sim.slices import primitives_of
 STATIC_CELL = 0.5  # m
 
 
+@dataclass
+class _Layout:
+    """Per-call constants of one set of lasers (cached until the next compile)."""
+
+    body: np.ndarray  # (L,) int64 link body ids
+    pos: np.ndarray  # (L, 3) sensor origins in their links
+    xaxis: np.ndarray  # (L, 3) sensor x axes in their links
+    angle_min: np.ndarray  # (L,)
+    inc: np.ndarray  # (L,)
+    nb: np.ndarray  # (L,) int64
+    offsets: np.ndarray  # (L,) int64
+    owner: np.ndarray  # (L,) int64
+    rmin: np.ndarray  # (L,)
+    rmax: np.ndarray  # (L,)
+    noisy: np.ndarray  # (R,) bool, beams of lasers with noise
+    mean: np.ndarray  # (R,) noise mean of each beam, m
+    std: np.ndarray  # (R,) noise stddev of each beam, m
+    beam_rmin: np.ndarray  # (R,)
+    beam_rmax: np.ndarray  # (R,)
+
+    @classmethod
+    def of(cls, lasers: list) -> _Layout:
+        nb = np.array([lz.samples for lz in lasers], np.int64)
+        noisy = np.array([lz.noise_std > 0 or lz.noise_mean != 0 for lz in lasers])
+        rmin = np.array([lz.range_min for lz in lasers])
+        rmax = np.array([lz.range_max for lz in lasers])
+        return cls(
+            body=np.array([lz.body for lz in lasers], np.int64),
+            pos=np.array([lz.pos for lz in lasers], float).reshape(-1, 3),
+            xaxis=np.array([lz.xaxis for lz in lasers], float).reshape(-1, 3),
+            angle_min=np.array([lz.angle_min for lz in lasers]),
+            inc=np.array([lz.increment for lz in lasers]),
+            nb=nb,
+            offsets=np.concatenate([[0], np.cumsum(nb)[:-1]]).astype(np.int64),
+            owner=np.array([lz.owner for lz in lasers], np.int64),
+            rmin=rmin,
+            rmax=rmax,
+            noisy=np.repeat(noisy, nb),
+            mean=np.repeat([lz.noise_mean for lz in lasers], nb),
+            std=np.repeat([lz.noise_std for lz in lasers], nb),
+            beam_rmin=np.repeat(rmin, nb),
+            beam_rmax=np.repeat(rmax, nb),
+        )
+
+
 class LaserBatch:
     def __init__(self) -> None:
         self.static_grid: raycast.PrimitiveGrid | None = None
         self.dynamic_ids = np.zeros(0, np.int64)
         self.occupancy = None
+        self.walls: occupancy_cast.WallTiles | None = None
         self.wall_height = 0.0
+        self._layouts: dict[tuple[int, ...], _Layout] = {}
 
     def bind(self, engine) -> None:
         m = engine.model
+        self._layouts.clear()  # body ids change with every compile
         collide = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
         real = m.geom_type != mujoco.mjtGeom.mjGEOM_PLANE
         static = m.body_weldid[m.geom_bodyid] == 0
@@ -39,7 +89,7 @@ class LaserBatch:
             walls = engine._model_names.index("map_walls")
             static = static & (engine.geom_model != walls)
             if self.occupancy is not grid:
-                self.clearance = occupancy_cast.clearance_from_occupancy(grid.occupied)
+                self.walls = occupancy_cast.wall_tiles(grid.occupied)
             self.occupancy = grid
             self.wall_height = engine.wall_height
         sid = np.flatnonzero(collide & real & static)
@@ -71,60 +121,49 @@ class LaserBatch:
 
     def measure(self, engine, lasers: list, t: float) -> list:
         """Readings of ``lasers`` (``LaserPlugin``) from one batched cast."""
+        key = tuple(map(id, lasers))
+        lay = self._layouts.get(key)
+        if lay is None:
+            lay = self._layouts[key] = _Layout.of(lasers)
         n = len(lasers)
-        inc = np.array([lz.increment for lz in lasers])
-        nb = np.array([lz.samples for lz in lasers], np.int64)
-        owner = np.array([lz.owner for lz in lasers], np.int64)
-        body = np.array([lz.body for lz in lasers], np.int64)
-        R = engine.data.xmat[body].reshape(n, 3, 3)
-        origins = engine.data.xpos[body] + np.einsum("nij,nj->ni", R, [lz.pos for lz in lasers])
-        xaxis = np.einsum("nij,nj->ni", R, [lz.xaxis for lz in lasers])  # sensor x, world
-        angle0 = np.arctan2(xaxis[:, 1], xaxis[:, 0]) + [lz.angle_min for lz in lasers]
-        offsets = np.concatenate([[0], np.cumsum(nb)[:-1]]).astype(np.int64)
-        rmin = np.array([lz.range_min for lz in lasers])
-        rmax = np.array([lz.range_max for lz in lasers])
-        beam = np.concatenate([np.arange(k) for k in nb])
-        which = np.repeat(np.arange(n), nb)
-        ray_o = origins[which]
-        ray_a = angle0[which] + beam * inc[which]
-        ray_min, ray_max, ray_owner = rmin[which], rmax[which], owner[which]
+        R = engine.data.xmat[lay.body].reshape(n, 3, 3)
+        origins = engine.data.xpos[lay.body] + np.einsum("nij,nj->ni", R, lay.pos)
+        xaxis = np.einsum("nij,nj->ni", R, lay.xaxis)  # sensor x, world
+        angle0 = np.arctan2(xaxis[:, 1], xaxis[:, 0]) + lay.angle_min
+        ranges = np.full(int(lay.nb.sum()), np.inf)
         if len(self.static_grid.prims):
-            ranges = raycast.cast(self.static_grid, ray_o, ray_a, ray_min, ray_max, ray_owner)
-        else:
-            ranges = np.full(len(ray_a), np.inf)
-        if self.occupancy is not None:
-            g = self.occupancy
-            walls = occupancy_cast.ranges_from_occupancy(
-                ray_o,
-                ray_a,
-                ray_min,
-                ray_max,
-                g.occupied,
-                self.clearance,
-                g.origin[0],
-                g.origin[1],
-                g.resolution,
-                self.wall_height,
+            which = np.repeat(np.arange(n), lay.nb)
+            beam = np.arange(len(ranges)) - lay.offsets[which]
+            ranges = raycast.cast(
+                self.static_grid,
+                origins[which],
+                angle0[which] + beam * lay.inc[which],
+                lay.beam_rmin,
+                lay.beam_rmax,
+                lay.owner[which],
             )
-            ranges = np.minimum(ranges, walls)
+        if self.occupancy is not None:
+            g, wt = self.occupancy, self.walls
+            occupancy_cast.ranges_from_walls(
+                origins, angle0, lay.inc, lay.nb, lay.offsets, lay.rmin, lay.rmax,
+                wt.occupied, wt.boxes, wt.start, wt.items, wt.tile, wt.th, wt.tw,
+                g.origin[0], g.origin[1], g.resolution, self.wall_height, ranges,
+            )  # fmt: skip
         if len(self.dynamic_ids):
             centres, radii, ids, start, prims = self.bodies(engine)
             raycast.ranges_with_bodies(
-                ranges,
-                origins,
-                angle0,
-                inc,
-                nb,
-                offsets,
-                owner,
-                rmin,
-                rmax,
-                centres,
-                radii,
-                ids,
-                start,
-                prims,
+                ranges, origins, angle0, lay.inc, lay.nb, lay.offsets, lay.owner, lay.rmin,
+                lay.rmax, centres, radii, ids, start, prims,
+            )  # fmt: skip
+        # Gaussian noise on the beams that hit, drawn in laser order as the sensors would
+        hit = np.flatnonzero(lay.noisy & np.isfinite(ranges))
+        if len(hit):
+            noisy = (
+                ranges[hit] + lay.mean[hit] + lay.std[hit] * engine.rng.standard_normal(len(hit))
             )
+            ranges[hit] = np.clip(noisy, lay.beam_rmin[hit], lay.beam_rmax[hit])
+        out = ranges.astype(np.float32)
         return [
-            lz.reading(ranges[o : o + k], t, engine.rng) for lz, o, k in zip(lasers, offsets, nb)
+            lz.reading(out[o : o + k], t)
+            for lz, o, k in zip(lasers, lay.offsets.tolist(), lay.nb.tolist())
         ]

@@ -2,8 +2,9 @@
 
 Beam geometry comes from the enclosing ``<sensor type="ray">``: ``scan/horizontal`` samples,
 min_angle, max_angle; ``range`` min, max; ``noise`` gaussian mean, stddev; ``update_rate``.
-Rays are cast in the horizontal plane at the sensor's height, along its heading; the casting is
-batched over all lasers by ``fleetsim.sim.lasers.LaserBatch``. No hit within range: ``inf``.
+Rays are cast in the horizontal plane at the sensor's height, along its heading; the casting (and
+the noise) is batched over all lasers by ``fleetsim.sim.lasers.LaserBatch``. No hit within
+range: ``inf``.
 """
 
 from __future__ import annotations
@@ -108,12 +109,8 @@ class LaserPlugin(SensorPlugin):
             owner,
         )
 
-    def reading(self, ranges: np.ndarray, t: float, rng: np.random.Generator) -> ScanReading:
-        r = ranges.astype(np.float64)
-        if self.noise_std > 0 or self.noise_mean != 0:
-            hit = np.isfinite(r)
-            r[hit] += self.noise_mean + self.noise_std * rng.standard_normal(int(hit.sum()))
-            r[hit] = np.clip(r[hit], self.range_min, self.range_max)
+    def reading(self, ranges: np.ndarray, t: float) -> ScanReading:
+        """A scan of ``ranges`` ((samples,) float32 m, noise already applied by the batch)."""
         return ScanReading(
             t,
             self.params.topicName,
@@ -125,5 +122,5 @@ class LaserPlugin(SensorPlugin):
             1.0 / self.rate if self.rate > 0 else 0.0,
             self.range_min,
             self.range_max,
-            r.astype(np.float32),
+            ranges,
         )

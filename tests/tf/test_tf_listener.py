@@ -33,3 +33,27 @@ def test_listener_receives_dynamic_and_latched_static_transforms():
 def test_listener_needs_a_buffer():
     with pytest.raises(TransformError, match=r"buffer must be a fleetsim.tf.Buffer, got dict"):
         TransformListener(Node(Runtime(), "n"), {})
+
+
+def test_a_bad_transform_is_logged_and_skipped_not_fatal(caplog):
+    """tf2's listener logs a NaN or self-parent transform and keeps the rest of the message."""
+    rt = Runtime()
+    buf = Buffer()
+    TransformListener(Node(rt, "listener"), buf)
+    dyn = TransformBroadcaster(Node(rt, "talker"))
+    nan = make_transform_stamped("odom", "base_link", 1.0)
+    nan.transform.translation.x = float("nan")  # as a broken publisher would send it
+    good = make_transform_stamped("map", "odom", 1.0, (1, 0, 0))
+    loop = make_transform_stamped("map", "odom", 1.0)
+    loop.header.frame_id = "odom"
+    for _ in range(3):
+        dyn.send_transform([nan, good, loop])
+        rt.spin_once()
+    assert buf.lookup_tuple("map", "odom", 1.0)[0] == pytest.approx(1.0)
+    assert not buf.can_transform("map", "base_link", 1.0)
+    errors = [r.getMessage() for r in caplog.records if r.levelname == "ERROR"]
+    assert len(errors) == 2  # once per bad frame, not once per message
+    assert "'base_link'" in errors[0] and "finite" in errors[0]
+    assert "'odom'" in errors[1] and "own parent" in errors[1]
+    # the run's own buffer does the same
+    assert rt.tf_buffer.add_message(type("M", (), {"transforms": [nan, good]})()) == 1

@@ -131,8 +131,7 @@ class Runtime:
             buf = Buffer()
 
             def on_tf(msg, static=False):
-                for t in msg.transforms:
-                    buf.set_transform(t, authority="", is_static=static)
+                buf.add_message(msg, authority="", is_static=static)
 
             self._tf_subs = [
                 self.graph.subscribe("/tf", tf2_msgs.TFMessage, on_tf, queue_size=0),

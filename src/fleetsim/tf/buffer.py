@@ -23,6 +23,7 @@ import numpy as np
 from fleetsim.errors import (
     ConnectivityError,
     FrameNotFound,
+    InvalidName,
     ParameterError,
     TransformError,
     did_you_mean,
@@ -69,8 +70,25 @@ class Buffer:
         self._frames: dict[str, FrameCache] = {}
         self._version = 0  # bumped whenever an edge of the tree appears, moves or disappears
         self._paths: dict[tuple[str, str], tuple[int, list[FrameCache], list[FrameCache]]] = {}
+        self._rejected: set[tuple[str, str]] = set()  # (child, authority) already warned about
 
     # ------------------------------------------------------------------ writing
+    def add_message(self, msg: Any, authority: str = "", is_static: bool = False) -> int:
+        """Add every transform of a ``tf2_msgs/TFMessage``, as tf2's listener does: a bad one
+        (NaN, self parent, a loop, an empty frame) is logged, naming its frame and publisher,
+        and skipped; the others still go in. Returns how many were added."""
+        added = 0
+        for t in msg.transforms:
+            try:
+                self.set_transform(t, authority=authority, is_static=is_static)
+                added += 1
+            except (TransformError, InvalidName) as exc:
+                key = (str(t.child_frame_id), authority)
+                if key not in self._rejected:  # once per frame and publisher, not per message
+                    self._rejected.add(key)
+                    _log.error("ignoring transform for %r: %s", t.child_frame_id, exc)
+        return added
+
     def set_transform(self, transform: Any, authority: str = "", is_static: bool = False) -> bool:
         """Add one ``geometry_msgs/TransformStamped`` to the buffer.
 

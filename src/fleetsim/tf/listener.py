@@ -44,12 +44,10 @@ class TransformListener:
         ]
 
     def _on_tf(self, msg: TFMessage) -> None:
-        for t in msg.transforms:
-            self.buffer.set_transform(t, is_static=False)
+        self.buffer.add_message(msg, is_static=False)
 
     def _on_tf_static(self, msg: TFMessage) -> None:
-        for t in msg.transforms:
-            self.buffer.set_transform(t, is_static=True)
+        self.buffer.add_message(msg, is_static=True)
 
     def unregister(self) -> None:
         """Stop listening."""

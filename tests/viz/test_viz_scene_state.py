@@ -50,3 +50,28 @@ def test_scene_from_recording(room_recording):
     assert snap.particles["/robot1/particlecloud"].shape == (30, 3)
     assert snap.robots[1].trail[0, 0] < 2.1 and snap.robots[1].trail.shape[0] > 10
     assert state.bounds() == (0.0, 200 * np.float32(0.05), 0.0, 160 * np.float32(0.05))
+
+
+def test_a_plan_in_odom_stays_where_it_was_planned_when_odom_drifts():
+    from fleetsim.msgs import geometry_msgs, nav_msgs, tf2_msgs
+    from fleetsim.tf._msgs import make_transform_stamped
+
+    def tf(x):
+        return tf2_msgs.TFMessage(
+            transforms=[make_transform_stamped("map", "r/odom", 0.0, (x, 0, 0))]
+        )
+
+    state = SceneState("map")
+    state.handle("/tf", "tf2_msgs/msg/TFMessage", tf(1.0), 1)
+    plan = nav_msgs.Path()
+    plan.header.frame_id = "r/odom"
+    pose = geometry_msgs.PoseStamped()
+    pose.pose.position.x = 2.0
+    plan.poses = [pose]
+    state.handle("/r/plan", "nav_msgs/msg/Path", plan, 2)
+    state.handle("/tf", "tf2_msgs/msg/TFMessage", tf(1.5), 3)  # amcl corrects the drift
+    assert state.snapshot().paths["/r/plan"].tolist() == [[3.0, 0.0]]
+    orphan = SceneState("map")  # no tf yet: placed once its frame connects
+    orphan.handle("/r/plan", "nav_msgs/msg/Path", plan, 1)
+    orphan.handle("/tf", "tf2_msgs/msg/TFMessage", tf(0.5), 2)
+    assert orphan.snapshot().paths["/r/plan"].tolist() == [[2.5, 0.0]]

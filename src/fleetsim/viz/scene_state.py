@@ -168,8 +168,11 @@ class SceneState:
         self.scans[topic] = (msg.header.frame_id, pts)
 
     def _on_path(self, topic: str, msg: Any) -> None:
-        poses = _poses_array([p.pose for p in msg.poses])
-        self.paths[topic] = (msg.header.frame_id, poses[:, :2])
+        frame, pts = msg.header.frame_id, _poses_array([p.pose for p in msg.poses])[:, :2]
+        # placed with the tf of its own time (as rviz does with the stamp), so a plan in a
+        # drifting frame (odom) stays where it was planned instead of following later drift
+        xy = self._in_fixed(frame, pts)
+        self.paths[topic] = (frame, pts) if xy is None else (self.fixed_frame, xy)
 
     def _on_pose_array(self, topic: str, msg: Any) -> None:
         self.particles[topic] = (msg.header.frame_id, _poses_array(msg.poses))

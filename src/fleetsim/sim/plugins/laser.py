@@ -123,4 +123,8 @@ class LaserPlugin(SensorPlugin):
             self.range_min,
             self.range_max,
             ranges,
+            _NO_INTENSITIES,
         )
+
+
+_NO_INTENSITIES = np.zeros(0, np.float32)  # shared by every scan: empty, nothing to change

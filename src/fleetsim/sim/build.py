@@ -18,6 +18,7 @@ import mujoco
 import numpy as np
 
 from fleetsim.errors import SimulationError
+from fleetsim.sim.meshes import triangle_mesh_from_collada
 from fleetsim.sim.sdf import GAZEBO_COLOURS
 from fleetsim.sim.world import GeomDesc, ModelDesc, Pose, WorldDesc
 
@@ -26,6 +27,7 @@ COLLISION_GROUP = 3
 VISUAL_GROUP = 1
 MIN_MASS = 1e-3
 MIN_INERTIA = 1e-6
+MESH_FORMATS = (".stl", ".obj", ".msh", ".dae")  # mesh files add_geom reads
 
 
 def quat_from_rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
@@ -106,7 +108,15 @@ def add_geom(
     frame: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> None:
     """Add one ``GeomDesc`` to ``body`` (collision or visual, per ``g.collide``); ``shown``
-    puts a collision geom in the visual group (for links without visuals)."""
+    puts a collision geom in the visual group (for links without visuals).
+
+    Meshes: STL, OBJ and MSH load through MuJoCo, COLLADA (``.dae``) through
+    ``fleetsim.sim.meshes`` (node transforms and ``<unit>`` applied, ``up_axis`` ignored as
+    Gazebo classic does); other formats are skipped with a warning. The URDF/SDF ``scale``
+    applies to all. A mesh used for collision collides as its convex hull (MuJoCo's rule):
+    a concave shape such as an L-shaped desk or an open shelf fills in, so give it box
+    collisions, or split it into convex parts, where the hollow matters.
+    """
     pos, quat = np.array(g.pose[:3], float), quat_from_rpy(*g.pose[3:])
     if frame is not None:  # express the geom in ``body`` when it sits in another frame
         fpos, fquat = frame
@@ -124,16 +134,9 @@ def add_geom(
     elif g.kind == "plane":
         kw.update(type=G.mjGEOM_PLANE, size=[g.size[0] / 2, g.size[1] / 2, 1.0])
     elif g.kind == "mesh":
-        mesh_file = Path(g.mesh or "")
-        if mesh_file.suffix.lower() not in (".stl", ".obj", ".msh"):
-            warnings.warn(
-                f"mesh '{g.mesh}' of '{prefix}{g.name}': only STL/OBJ/MSH meshes load; "
-                "the shape is skipped",
-                stacklevel=2,
-            )
+        mesh_name = _add_mesh(spec, g, prefix, index)
+        if mesh_name is None:
             return
-        mesh_name = f"{prefix}mesh{index}"
-        spec.add_mesh(name=mesh_name, file=str(mesh_file), scale=list(g.size))
         kw.update(type=G.mjGEOM_MESH, meshname=mesh_name)
     else:
         raise SimulationError(f"geometry kind '{g.kind}' of '{prefix}{g.name}' is not supported")
@@ -157,6 +160,42 @@ def add_geom(
             geom.rgba = [1, 1, 1, 1]
         if g.kind == "plane":
             geom.material = _floor_material(spec)
+
+
+def _add_mesh(spec, g: GeomDesc, prefix: str, index: int) -> str | None:
+    """Add the mesh asset of a mesh geom; its name, or None when the format is not read."""
+    owner = prefix.rstrip("/")
+    mesh_file = Path(g.mesh or "")
+    suffix = mesh_file.suffix.lower()
+    if suffix not in MESH_FORMATS:
+        warnings.warn(
+            f"mesh '{g.mesh}' of geom '{g.name}' in '{owner}': fleetsim reads "
+            f"{'/'.join(s.lstrip('.').upper() for s in MESH_FORMATS)} meshes; the shape is skipped",
+            stacklevel=3,
+        )
+        return None
+    if not mesh_file.is_file():
+        raise SimulationError(
+            f"mesh file '{g.mesh}' of geom '{g.name}' in '{owner}' does not exist; "
+            "fix the <mesh> filename/uri (package:// and model:// must resolve to a file)"
+        )
+    mesh_name = f"{prefix}mesh{index}"
+    if suffix != ".dae":
+        spec.add_mesh(name=mesh_name, file=str(mesh_file), scale=list(g.size))
+        return mesh_name
+    vertices, faces = triangle_mesh_from_collada(mesh_file)
+    if len(vertices) < 4:
+        raise SimulationError(
+            f"mesh '{g.mesh}' of geom '{g.name}' in '{owner}' has {len(vertices)} vertices; "
+            "MuJoCo needs at least 4 (use a box or a thin solid instead)"
+        )
+    mesh = spec.add_mesh(
+        name=mesh_name, uservert=vertices.ravel(), userface=faces.ravel(), scale=list(g.size)
+    )
+    # shell inertia: COLLADA visuals are often open surfaces (a floor, a sign) with no volume;
+    # bodies carry explicit inertia, so the mesh's own inertia only places its frame
+    mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
+    return mesh_name
 
 
 def _floor_material(spec) -> str:
@@ -201,6 +240,9 @@ def add_sdf_model(spec: mujoco.MjSpec, m: ModelDesc, pose: Pose | None = None) -
         body = spec.worldbody.add_body(name=name, pos=lp, quat=lq)
         body.add_freejoint(name=f"{name}/free")
         body.mass = max(link.mass, MIN_MASS)
+        # centre of mass at the link origin; MuJoCo 4 leaves an unset ipos as NaN and then
+        # compiles it to the body's own pos, which throws a dropped object sideways
+        body.ipos = [0.0, 0.0, 0.0]
         inertia = link.inertia or (link.mass * 0.01,) * 3
         body.inertia = [max(i, MIN_INERTIA) for i in inertia]
         body.explicitinertial = True

@@ -121,6 +121,66 @@ def test_up_axis_is_ignored(tmp_path):
     np.testing.assert_allclose(bounds(y_up), [[-0.5, 4.5, -0.5], [0.5, 5.5, 0.5]])
 
 
+def exporter_style_collada():
+    """The cube as modelling tools write it: interleaved VERTEX/NORMAL/TEXCOORD indices, a bound
+    material whose texture image is missing, and a physics scene beside the visual scene."""
+    normals = "0 0 -1 0 0 1 0 -1 0 0 1 0 -1 0 0 1 0 0"
+    tris = np.array(TRIS.split(), int).reshape(12, 3)
+    p = " ".join(f"{v} {i // 2} {k}" for i, t in enumerate(tris) for k, v in enumerate(t))
+    prims = (
+        '<triangles count="12" material="paint">'
+        '<input offset="0" semantic="VERTEX" source="#cube-vtx"/>'
+        '<input offset="1" semantic="NORMAL" source="#cube-nrm"/>'
+        '<input offset="2" semantic="TEXCOORD" source="#cube-uv" set="0"/>'
+        f"<p>{p}</p></triangles>"
+    )
+    sources = (
+        f'<source id="cube-nrm"><float_array id="cube-nrm-array" count="18">{normals}'
+        '</float_array><technique_common><accessor source="#cube-nrm-array" count="6" '
+        'stride="3"><param name="X" type="float"/><param name="Y" type="float"/>'
+        '<param name="Z" type="float"/></accessor></technique_common></source>'
+        '<source id="cube-uv"><float_array id="cube-uv-array" count="6">0 0 1 0 1 1'
+        '</float_array><technique_common><accessor source="#cube-uv-array" count="3" '
+        'stride="2"><param name="S" type="float"/><param name="T" type="float"/>'
+        "</accessor></technique_common></source>"
+    )
+    nodes = (
+        '<node id="n"><translate sid="t">0 0 0.5</translate><rotate sid="r">0 0 1 0</rotate>'
+        '<instance_geometry url="#cube"><bind_material><technique_common>'
+        '<instance_material symbol="paint" target="#paint-mat"/>'
+        "</technique_common></bind_material></instance_geometry></node>"
+    )
+    libraries = (
+        '<library_images><image id="img"><init_from>missing.jpg</init_from></image>'
+        '</library_images><library_effects><effect id="paint-fx"><profile_COMMON>'
+        '<newparam sid="surf"><surface type="2D"><init_from>img</init_from></surface>'
+        '</newparam><newparam sid="samp"><sampler2D><source>surf</source></sampler2D>'
+        '</newparam><technique sid="common"><phong><diffuse><texture texture="samp" '
+        'texcoord="UV"/></diffuse></phong></technique></profile_COMMON></effect>'
+        '</library_effects><library_materials><material id="paint-mat">'
+        '<instance_effect url="#paint-fx"/></material></library_materials>'
+    )
+    text = collada(prims=sources + prims, nodes=nodes, unit='<unit meter="1.00" name="meter"/>')
+    return text.replace("<library_geometries>", libraries + "<library_geometries>")
+
+
+def test_exporter_style_file_with_normals_uvs_and_a_missing_texture(tmp_path):
+    v, f = triangle_mesh_from_collada(write(tmp_path, exporter_style_collada()))
+    np.testing.assert_allclose(bounds(v), [[-0.5, -0.5, 0], [0.5, 0.5, 1]], atol=1e-6)
+    assert f.shape == (12, 3) and signed_volume(v, f) == pytest.approx(1.0)
+
+
+def test_broken_references_are_reported(tmp_path):
+    text = exporter_style_collada().replace('target="#paint-mat"', 'target="#nope"')
+    with pytest.raises(SimulationError, match=r"nope\.dae' holds no triangles.*#nope not found"):
+        triangle_mesh_from_collada(write(tmp_path, text, "nope.dae"))
+    second = '<node id="m"><instance_geometry url="#cube"/></node>'
+    text = text.replace("</visual_scene>", second + "</visual_scene>")
+    with pytest.warns(UserWarning, match=r"parts that did not load are left out.*#nope"):
+        v, f = triangle_mesh_from_collada(write(tmp_path, text, "half.dae"))
+    assert f.shape == (12, 3)
+
+
 def test_broken_files_name_the_file_and_reason(tmp_path):
     bad = write(tmp_path, "<COLLADA><library_geometries>", "broken.dae")
     with pytest.raises(SimulationError, match=r"broken\.dae' does not parse"):
@@ -232,6 +292,7 @@ def test_urdf_robot_with_dae_visual_spawns_and_renders(tmp_path):
     m = e.model
     meshes = [g for g in range(m.ngeom) if m.geom_type[g] == mujoco.mjtGeom.mjGEOM_MESH]
     assert len(meshes) == 2 and all(m.geom_contype[g] == 0 for g in meshes)
+    assert m.nmesh == 1  # one asset for both robots
     centre = e.data.geom_xpos[meshes[0]]
     np.testing.assert_allclose(centre, [0, 0, 0.25], atol=2e-3)
     verts = m.mesh_vert[m.mesh_vertadr[0] : m.mesh_vertadr[0] + m.mesh_vertnum[0]]
@@ -246,4 +307,7 @@ def test_urdf_robot_with_dae_visual_spawns_and_renders(tmp_path):
     img = renderer.render().astype(int)
     red = (img[..., 0] > 120) & (img[..., 1] < 60) & (img[..., 2] < 60)
     assert 0.05 < red.mean() < 0.6  # the half-metre cube fills a good part of the view
+    e.delete_model("m1")
+    e.spawn_robot("m1", write(tmp_path, urdf, "meshbot.urdf"), (0, 0, 0, 0, 0, 0))
+    assert e.model.nmesh == 1  # spawned again under the same name, on the same asset
     e.close()

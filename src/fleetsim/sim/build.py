@@ -11,6 +11,7 @@ MuJoCo would otherwise take the larger).
 
 from __future__ import annotations
 
+import hashlib
 import warnings
 from pathlib import Path
 
@@ -134,7 +135,7 @@ def add_geom(
     elif g.kind == "plane":
         kw.update(type=G.mjGEOM_PLANE, size=[g.size[0] / 2, g.size[1] / 2, 1.0])
     elif g.kind == "mesh":
-        mesh_name = _add_mesh(spec, g, prefix, index)
+        mesh_name = _add_mesh(spec, g, prefix)
         if mesh_name is None:
             return
         kw.update(type=G.mjGEOM_MESH, meshname=mesh_name)
@@ -162,8 +163,10 @@ def add_geom(
             geom.material = _floor_material(spec)
 
 
-def _add_mesh(spec, g: GeomDesc, prefix: str, index: int) -> str | None:
-    """Add the mesh asset of a mesh geom; its name, or None when the format is not read."""
+def _add_mesh(spec, g: GeomDesc, prefix: str) -> str | None:
+    """The mesh asset of a mesh geom, added once per spec for each (file, version, scale) and
+    shared by every model that uses it (a hundred robots compile one mesh, and a deleted robot
+    can be spawned again); None when the format is not read."""
     owner = prefix.rstrip("/")
     mesh_file = Path(g.mesh or "")
     suffix = mesh_file.suffix.lower()
@@ -179,9 +182,14 @@ def _add_mesh(spec, g: GeomDesc, prefix: str, index: int) -> str | None:
             f"mesh file '{g.mesh}' of geom '{g.name}' in '{owner}' does not exist; "
             "fix the <mesh> filename/uri (package:// and model:// must resolve to a file)"
         )
-    mesh_name = f"{prefix}mesh{index}"
+    st = mesh_file.stat()
+    scale = [float(v) for v in g.size]
+    key = f"{mesh_file.resolve()}|{st.st_mtime_ns}|{st.st_size}|{scale}"
+    mesh_name = f"mesh:{mesh_file.name}:{hashlib.sha1(key.encode()).hexdigest()[:12]}"
+    if spec.mesh(mesh_name) is not None:
+        return mesh_name
     if suffix != ".dae":
-        spec.add_mesh(name=mesh_name, file=str(mesh_file), scale=list(g.size))
+        spec.add_mesh(name=mesh_name, file=str(mesh_file), scale=scale)
         return mesh_name
     vertices, faces = triangle_mesh_from_collada(mesh_file)
     if len(vertices) < 4:
@@ -190,7 +198,7 @@ def _add_mesh(spec, g: GeomDesc, prefix: str, index: int) -> str | None:
             "MuJoCo needs at least 4 (use a box or a thin solid instead)"
         )
     mesh = spec.add_mesh(
-        name=mesh_name, uservert=vertices.ravel(), userface=faces.ravel(), scale=list(g.size)
+        name=mesh_name, uservert=vertices.ravel(), userface=faces.ravel(), scale=scale
     )
     # shell inertia: COLLADA visuals are often open surfaces (a floor, a sign) with no volume;
     # bodies carry explicit inertia, so the mesh's own inertia only places its frame

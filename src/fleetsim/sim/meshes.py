@@ -81,8 +81,8 @@ def _parse(path: str) -> tuple[np.ndarray, np.ndarray]:
     from collada.common import DaeBrokenRefError, DaeUnsupportedError
 
     try:
-        # unsupported extras (animations, skins, effects) and missing images do not stop
-        # the geometry from loading, as in Gazebo
+        # unsupported extras (animations, skins) and broken references do not stop the rest
+        # of the file from loading, as in Gazebo; what they dropped is reported below
         dae = collada.Collada(path, ignore=[DaeUnsupportedError, DaeBrokenRefError])
     except Exception as exc:  # pycollada raises DaeError, lxml and ValueError alike
         raise SimulationError(
@@ -104,10 +104,17 @@ def _parse(path: str) -> tuple[np.ndarray, np.ndarray]:
         raise SimulationError(
             f"COLLADA mesh '{path}' has malformed geometry ({type(exc).__name__}: {exc})"
         ) from exc
+    dropped = "; ".join(dict.fromkeys(str(e) for e in dae.errors))  # pycollada's own words
     if not faces:
         raise SimulationError(
             f"COLLADA mesh '{path}' holds no triangles (only lines, points or empty geometry "
             "in its visual scene); a <mesh> needs <triangles>, <polylist> or <polygons>"
+            + (f"; parts that did not load: {dropped}" if dropped else "")
+        )
+    if dropped:
+        warnings.warn(
+            f"COLLADA mesh '{path}': parts that did not load are left out: {dropped}",
+            stacklevel=2,
         )
     offsets = np.cumsum([0] + [len(v) for v in verts[:-1]])
     vertices = np.concatenate(verts).astype(np.float64) * unit

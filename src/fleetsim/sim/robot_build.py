@@ -81,6 +81,7 @@ def _set_inertial(body, link: Any) -> None:
     if ine is None or ine.mass <= 0:
         body.mass = MIN_MASS
         body.inertia = [MIN_INERTIA] * 3
+        body.ipos = [0.0, 0.0, 0.0]  # unset, MuJoCo 4 compiles it to the body's offset
     else:
         body.mass = ine.mass
         body.ipos = list(ine.origin.xyz)

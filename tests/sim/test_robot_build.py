@@ -1,0 +1,31 @@
+"""Robots from URDF into MuJoCo: inertial details."""
+
+import numpy as np
+
+from fleetsim.description import parse_urdf
+from fleetsim.sim import Engine
+
+URDF = """<robot name="r">
+  <link name="base"><inertial><mass value="2"/><origin xyz="0.1 0 0"/>
+    <inertia ixx="0.1" iyy="0.1" izz="0.1" ixy="0" ixz="0" iyz="0"/></inertial>
+    <collision><geometry><box size="0.4 0.4 0.2"/></geometry></collision></link>
+  <link name="sensor"/>
+  <joint name="j" type="fixed"><parent link="base"/><child link="sensor"/>
+    <origin xyz="0.5 0.3 0.2"/></joint>
+  <link name="arm"/>
+  <joint name="hinge" type="revolute"><parent link="base"/><child link="arm"/>
+    <origin xyz="0.2 0 0.1"/><axis xyz="0 0 1"/>
+    <limit lower="-1" upper="1" effort="1" velocity="1"/>
+  </joint>
+</robot>"""
+
+
+def test_a_massless_link_keeps_its_centre_of_mass_at_its_origin():
+    """A link without <inertial> gets a tiny mass at its own origin, not at its offset (MuJoCo 4
+    would otherwise compile the unset centre to the body's position in its parent)."""
+    e = Engine(None)
+    e.spawn_robot("r", parse_urdf(URDF), (3.0, 4.0, 0.5, 0, 0, 0))
+    arm = e.model.body("r/arm").id
+    np.testing.assert_allclose(e.model.body_ipos[arm], [0.0, 0.0, 0.0])
+    base = e.model.body("r/base").id
+    np.testing.assert_allclose(e.model.body_ipos[base], [0.1, 0.0, 0.0], atol=1e-12)

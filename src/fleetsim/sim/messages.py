@@ -87,6 +87,48 @@ def camera_info_msg(r: ImageReading) -> sensor_msgs.CameraInfo:
     return msg
 
 
+def cloud_msg(
+    t: float, frame_id: str, depth: np.ndarray, rgb: np.ndarray, K: np.ndarray
+) -> sensor_msgs.PointCloud2:
+    """An organised XYZRGB cloud from a depth image, as the Kinect plugin publishes it.
+
+    Points are in the optical frame of ``frame_id`` (x right, y down, z along the view):
+    ``x = (u - cx) z / fx``, ``y = (v - cy) z / fy``, ``z = depth``; NaN depth (outside the
+    cutoffs) gives NaN points, so the cloud is not dense. Layout is PCL's PointXYZRGB (x, y, z
+    float32 at 0/4/8, rgb packed in a float32 at 16, 32 bytes per point).
+
+    Parameters
+    ----------
+    depth : (H, W) float32 m; rgb : (H, W, 3) uint8; K : (3, 3) intrinsics of both images.
+    """
+    h, w = depth.shape
+    fx, fy, cx, cy = K[0, 0], K[1, 1], K[0, 2], K[1, 2]
+    z = depth.astype(np.float32)
+    u = np.arange(w, dtype=np.float32)[None, :]
+    v = np.arange(h, dtype=np.float32)[:, None]
+    pts = np.zeros((h, w, 8), np.float32)
+    pts[..., 0] = (u - np.float32(cx)) * z / np.float32(fx)
+    pts[..., 1] = (v - np.float32(cy)) * z / np.float32(fy)
+    pts[..., 2] = z
+    c = rgb.astype(np.uint32)
+    pts[..., 4] = ((c[..., 0] << 16) | (c[..., 1] << 8) | c[..., 2]).view(np.float32)
+    msg = sensor_msgs.PointCloud2()
+    msg.header.stamp = stamp(t)
+    msg.header.frame_id = frame_id
+    msg.height, msg.width = h, w
+    F = sensor_msgs.PointField
+    msg.fields = [
+        F(name=n, offset=o, datatype=F.FLOAT32, count=1)
+        for n, o in (("x", 0), ("y", 4), ("z", 8), ("rgb", 16))
+    ]
+    msg.is_bigendian = False
+    msg.point_step = 32
+    msg.row_step = 32 * w
+    msg.data = pts.view(np.uint8).reshape(-1)
+    msg.is_dense = False
+    return msg
+
+
 def joint_state_msg(r: JointStateReading) -> sensor_msgs.JointState:
     msg = sensor_msgs.JointState()
     msg.header.stamp = stamp(r.stamp)

@@ -24,6 +24,7 @@ from fleetsim.sim.plugins.diff_drive import WheeledDrive
 from fleetsim.sim.plugins.link_attacher import LinkAttacher
 from fleetsim.sim.queries import StateQueries
 from fleetsim.sim.robot_build import add_robot
+from fleetsim.sim.schedule import SensorSchedule
 from fleetsim.sim.world import WALL_HEIGHT, ModelDesc, Pose, WorldDesc, world_from_map
 
 
@@ -93,7 +94,7 @@ class Engine(StateQueries):
         self.lasers = LaserBatch()
         self.drives = DriveBatch()
         self.paused = False
-        self._next_due: dict[int, float] = {}
+        self.schedule = SensorSchedule()
         self._renderers: dict[tuple[int, int], mujoco.Renderer] = {}
         self._compile()
         self._qpos0 = self.data.qpos.copy()
@@ -257,8 +258,6 @@ class Engine(StateQueries):
         self.attacher.forget_model(self, name)
         self._remove_from_spec(entry)
         del self.models[name]
-        for p in entry.plugins:
-            self._next_due.pop(id(p), None)
         self._compile()
 
     # -------------------------------------------------------------------- queries
@@ -267,11 +266,11 @@ class Engine(StateQueries):
         return [p for e in self.models.values() for p in e.plugins]
 
     def _schedule(self) -> None:
-        """Refresh the plugin lists after the set of models changed."""
+        """Refresh the plugin lists and the sensor schedule after the set of models changed."""
         self._plugins = self.plugins()
         self._controllers = [p for p in self._plugins if type(p).control is not base.Plugin.control]
-        self.drives.bind([p for p in self._plugins if isinstance(p, WheeledDrive)])
-        self._min_due = 0.0
+        self.drives.bind([p for p in self._plugins if isinstance(p, WheeledDrive)], self)
+        self.schedule.bind(self._plugins)
 
     def step(self) -> None:
         """One physics step: plugin controls, link attacher, ``mj_step``."""
@@ -294,54 +293,14 @@ class Engine(StateQueries):
         n = round(duration / self.model.opt.timestep)
         for _ in range(n):
             self.step()
-            if self.time + 1e-9 >= self._min_due:
+            if self.time + 1e-9 >= self.schedule.next:
                 readings += self.due_readings()
         mujoco.mj_kinematics(self.model, self.data)  # poses of the current state for queries
         return readings
 
     def due_readings(self) -> list[Any]:
-        """Readings of every sensor/drive whose update time has come (lasers batched).
-
-        A plugin with rate ``r`` fires at ``t0, t0 + 1/r, ...`` (phase kept, no drift); rate 0
-        fires at every physics step.
-        """
-        t = self.time
-        out: list[Any] = []
-        lasers = []
-        batches: dict[type, list] = {}
-        min_due = np.inf
-        for p in self._plugins:
-            key = id(p)
-            due = self._next_due.get(key, 0.0)
-            if t + 1e-9 < due:
-                min_due = min(min_due, due)
-                continue
-            rate = p.update_rate
-            period = 1.0 / rate if rate > 0 else 0.0
-            nxt = due + period if due > 0 else t + period
-            if nxt <= t + 1e-9:
-                nxt = t + period
-            self._next_due[key] = nxt
-            min_due = min(min_due, nxt)
-            if getattr(p, "is_laser", False):
-                lasers.append(p)
-            elif hasattr(p, "measure_batch"):
-                batches.setdefault(type(p), []).append(p)
-            else:
-                r = p.measure(self, t)
-                if r is not None:
-                    r.namespace = p.ctx.namespace
-                    out.append(r)
-        self._min_due = min_due
-        for cls, group in batches.items():
-            for r, p in zip(cls.measure_batch(self, group, t), group):
-                r.namespace = p.ctx.namespace
-                out.append(r)
-        if lasers:
-            for r, p in zip(self.lasers.measure(self, lasers, t), lasers):
-                r.namespace = p.ctx.namespace
-                out.append(r)
-        return out
+        """Readings of every sensor/drive whose update time has come (``sim.schedule``)."""
+        return self.schedule.readings(self, self.time)
 
     # -------------------------------------------------------------------- rendering
     def renderer(self, width: int, height: int) -> mujoco.Renderer:

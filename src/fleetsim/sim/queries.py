@@ -186,8 +186,7 @@ class StateQueries:
         """reset_world plus sim time back to zero and sensor schedules restarted."""
         self.reset_world()
         self.data.time = 0.0
-        self._next_due.clear()
-        self._min_due = 0.0
+        self.schedule.restart()
 
     def world_properties(self) -> dict[str, Any]:
         return {"sim_time": self.time, "model_names": list(self.models), "rendering_enabled": True}

@@ -18,6 +18,7 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from fleetsim.errors import SimulationError
 from fleetsim.runtime.params import param
 from fleetsim.sim.drives import rotor_armature
 from fleetsim.sim.plugins.base import (
@@ -90,6 +91,8 @@ class WheeledDrive(DrivePlugin):
         self.radius = p.wheelDiameter / 2
         self.cmd = (0.0, 0.0)
         self.last_cmd_t = -math.inf
+        self.batch = None  # the engine's DriveBatch while bound (holds the live state)
+        self.slot = -1
         self.reset()
 
     def reset(self) -> None:
@@ -174,64 +177,62 @@ class WheeledDrive(DrivePlugin):
     def command(self, vx: float, wz: float, t: float) -> None:
         if not (math.isfinite(vx) and math.isfinite(wz)):
             _log.warning("%s: ignoring non-finite command (%s, %s); stopping", self.where, vx, wz)
-            self.cmd = (0.0, 0.0)
-            self.last_cmd_t = t
-            return
+            vx = wz = 0.0
         self.cmd = (float(vx), float(wz))
         self.last_cmd_t = t
+        if self.batch is not None:
+            self.batch.set_command(self.slot, self.cmd[0], self.cmd[1], t)
 
     @property
     def update_rate(self) -> float:
         return self.params.updateRate
 
-    def _encoder_step(self, engine, t: float) -> None:
-        q = engine.data.qpos
-        left = sum(float(q[i]) for i in self.q_left) / len(self.q_left)
-        right = sum(float(q[i]) for i in self.q_right) / len(self.q_right)
-        if self.prev_angles is None:
-            self.prev_angles = (left, right)
-            self.prev_t = t
-            return
-        dl = (left - self.prev_angles[0]) * self.radius
-        dr = (right - self.prev_angles[1]) * self.radius
-        self.prev_angles = (left, right)
-        ds = (dl + dr) / 2
-        dth = (dr - dl) / self.sep
-        x, y, yaw = self.pose
-        mid = yaw + dth / 2
-        self.pose = (x + ds * math.cos(mid), y + ds * math.sin(mid), yaw + dth)
-        dt = t - self.prev_t
-        self.prev_t = t
-        if dt > 0:
-            self.twist = (ds / dt, dth / dt)
-
     def measure(self, engine, t: float) -> OdometryReading:
-        p = self.params
-        if self.encoder:
-            self._encoder_step(engine, t)
-            x, y, yaw = self.pose
-            pos = np.array([x, y, 0.0])
-            quat = np.array([0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2)])
-            lin = np.array([self.twist[0], 0.0, 0.0])
-            ang = np.array([0.0, 0.0, self.twist[1]])
-        else:
-            d = engine.data
-            pos = d.xpos[self.root].copy()
-            w, qx, qy, qz = d.xquat[self.root]
-            quat = np.array([qx, qy, qz, w])
-            vel = np.zeros(6)
-            mujoco.mj_objectVelocity(engine.model, d, mujoco.mjtObj.mjOBJ_XBODY, self.root, vel, 1)
-            lin, ang = vel[3:].copy(), vel[:3].copy()
-        return OdometryReading(
-            t,
-            p.odometryTopic,
-            *self.frames,
-            pos,
-            quat,
-            lin,
-            ang,
-            publish_tf=self.publish_tf,
-        )
+        return self.measure_each(engine, [self], t)[0]
+
+    @classmethod
+    def measure_each(cls, engine, plugins: list, t: float) -> list[OdometryReading]:
+        """Odometry of many bound drives at once (encoder odometry in one compiled step), in
+        the order of ``plugins``; each reading equals what ``measure`` returns for it."""
+        batch = engine.drives
+        enc = [p for p in plugins if p.encoder]
+        parts = {}
+        if enc:
+            if any(p.batch is not batch for p in enc):
+                p = next(p for p in enc if p.batch is not batch)
+                raise SimulationError(f"{p.where}: the drive is not spawned in this engine")
+            slots = np.fromiter((p.slot for p in enc), np.int64, len(enc))
+            out = batch.encoder_odometry(slots, t)
+            rows = zip(out[:, 0:3], out[:, 3:7], out[:, 7:10], out[:, 10:13])
+            parts = dict(zip(map(id, enc), rows))
+        readings = []
+        for p in plugins:
+            pos, quat, lin, ang = parts[id(p)] if p.encoder else p._true_odometry(engine)
+            readings.append(
+                OdometryReading(
+                    t,
+                    p.params.odometryTopic,
+                    p.frames[0],
+                    p.frames[1],
+                    pos,
+                    quat,
+                    lin,
+                    ang,
+                    p.publish_tf,
+                    namespace=p.ctx.namespace,
+                )
+            )
+        return readings
+
+    def _true_odometry(self, engine) -> tuple[np.ndarray, ...]:
+        """World pose (x, y, z; quaternion x, y, z, w) and body-frame twist of the base."""
+        d = engine.data
+        pos = d.xpos[self.root].copy()
+        w, qx, qy, qz = d.xquat[self.root]
+        quat = np.array([qx, qy, qz, w])
+        vel = np.zeros(6)
+        mujoco.mj_objectVelocity(engine.model, d, mujoco.mjtObj.mjOBJ_XBODY, self.root, vel, 1)
+        return pos, quat, vel[3:].copy(), vel[:3].copy()
 
 
 @register("libgazebo_ros_diff_drive.so")

@@ -50,13 +50,29 @@ class JointStatePlugin(SensorPlugin):
         self.qadr, self.dadr = joint_addresses(engine, self.ctx.model, self.joints)
 
     def measure(self, engine, t: float) -> JointStateReading:
+        return self.measure_each(engine, [self], t)[0]
+
+    @classmethod
+    def measure_each(cls, engine, plugins: list, t: float) -> list[JointStateReading]:
+        """Joint states of many plugins from one gather, in the order of ``plugins``."""
         d = engine.data
-        effort = d.qfrc_actuator[self.dadr] if len(self.dadr) else np.zeros(0)
-        return JointStateReading(
-            t,
-            self.params.topicName,
-            list(self.joints),
-            d.qpos[self.qadr].copy(),
-            d.qvel[self.dadr].copy(),
-            np.asarray(effort, float).copy(),
-        )
+        qadr = np.concatenate([p.qadr for p in plugins])
+        dadr = np.concatenate([p.dadr for p in plugins])
+        pos, vel, eff = d.qpos[qadr], d.qvel[dadr], d.qfrc_actuator[dadr]
+        out = []
+        a = 0
+        for p in plugins:
+            b = a + len(p.joints)
+            out.append(
+                JointStateReading(
+                    t,
+                    p.params.topicName,
+                    list(p.joints),
+                    pos[a:b],
+                    vel[a:b],
+                    eff[a:b],
+                    p.ctx.namespace,
+                )
+            )
+            a = b
+        return out

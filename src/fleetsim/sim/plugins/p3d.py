@@ -101,38 +101,70 @@ class P3dPlugin(SensorPlugin):
 
     @classmethod
     def measure_batch(cls, engine, plugins: list, t: float) -> list:
-        """Readings of many p3d plugins at once (world-frame ones vectorised)."""
+        """Readings of many p3d plugins at once (world-frame ones vectorised).
+
+        Noise is drawn in the order of ``plugins`` (relative-frame ones first), nine normals
+        per noisy plugin, so the readings equal those of one-by-one measurement.
+        """
+        if not any(p.ref for p in plugins):
+            return cls._world_readings(engine, plugins, t)
+        out = {}
+        for p in plugins:
+            if p.ref:
+                r = p.measure(engine, t)
+                r.namespace = p.ctx.namespace
+                out[id(p)] = r
         world = [p for p in plugins if not p.ref]
-        out = {id(p): p.measure(engine, t) for p in plugins if p.ref}
         if world:
-            d, m = engine.data, engine.model
-            b = np.array([p.body for p in world])
-            pos = d.xpos[b] + np.array([p.params.xyzOffsets for p in world])
-            ang = d.cvel[b, :3]
-            lever = d.xpos[b] - d.subtree_com[m.body_rootid[b]]
-            lin = d.cvel[b, 3:] + np.cross(ang, lever)
-            quat = quats_multiplied(np.array([p.off_q for p in world]), d.xquat[b])
-            xyzw = quat[:, [1, 2, 3, 0]]
-            for i, p in enumerate(world):
-                sigma = p.params.gaussianNoise
-                pi, li, ai = pos[i], lin[i].copy(), ang[i].copy()
-                if sigma > 0:
-                    pi = pi + sigma * engine.rng.standard_normal(3)
-                    li = li + sigma * engine.rng.standard_normal(3)
-                    ai = ai + sigma * engine.rng.standard_normal(3)
-                out[id(p)] = OdometryReading(
-                    t,
-                    p.params.topicName,
-                    p.frames[0],
-                    p.frames[1],
-                    pi,
-                    xyzw[i],
-                    li,
-                    ai,
-                    publish_tf=False,
-                    covariance=sigma * sigma,
-                )
+            out.update(zip(map(id, world), cls._world_readings(engine, world, t)))
         return [out[id(p)] for p in plugins]
+
+    @classmethod
+    def _world_readings(cls, engine, plugins: list, t: float) -> list:
+        """Readings of world-frame p3d plugins, vectorised over the plugins."""
+        d, m = engine.data, engine.model
+        n = len(plugins)
+        b = np.fromiter((p.body for p in plugins), np.int64, n)
+        pos = d.xpos[b] + np.array([p.params.xyzOffsets for p in plugins])
+        cvel = d.cvel[b]
+        ang = cvel[:, :3]
+        lever = d.xpos[b] - d.subtree_com[m.body_rootid[b]]
+        lin = cvel[:, 3:] + cross_products(ang, lever)
+        quat = quats_multiplied(np.array([p.off_q for p in plugins]), d.xquat[b])
+        xyzw = quat[:, [1, 2, 3, 0]]
+        sigma = np.fromiter((p.params.gaussianNoise for p in plugins), float, n)
+        noisy = np.flatnonzero(sigma > 0)
+        if len(noisy):
+            z = engine.rng.standard_normal(9 * len(noisy)).reshape(-1, 3, 3)
+            s = sigma[noisy, None]
+            pos[noisy] = pos[noisy] + s * z[:, 0]
+            lin[noisy] = lin[noisy] + s * z[:, 1]
+            ang = ang.copy()
+            ang[noisy] = ang[noisy] + s * z[:, 2]
+        return [
+            OdometryReading(
+                t,
+                p.params.topicName,
+                p.frames[0],
+                p.frames[1],
+                pi,
+                qi,
+                li,
+                ai,
+                False,
+                sg * sg,
+                p.ctx.namespace,
+            )
+            for p, pi, qi, li, ai, sg in zip(plugins, pos, xyzw, lin, ang, sigma.tolist())
+        ]
+
+
+def cross_products(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Row-wise cross products ``a x b`` of (N, 3) arrays (as ``np.cross``, without its
+    overhead)."""
+    a0, a1, a2 = a[:, 0], a[:, 1], a[:, 2]
+    b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
+    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=1)
 
 
 def quats_multiplied(a: np.ndarray, b: np.ndarray) -> np.ndarray:

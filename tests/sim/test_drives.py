@@ -1,5 +1,7 @@
 """The drive servos' support: the held-rotor armature of skid-steer wheels."""
 
+import math
+
 import mujoco
 import numpy as np
 import pytest
@@ -59,3 +61,62 @@ def test_no_gravity_or_mass_means_no_armature():
     assert rotor_armature(0.0, 0.1, 4, 1.0, 9.81, 0.004) == 0.0
     assert rotor_armature(10.0, 0.1, 4, 1.0, 0.0, 0.004) == 0.0
     assert np.isfinite(rotor_armature(10.0, 0.1, 0, 1.0, 9.81, 0.004))
+
+
+def encoder_reference(left, right, radius, sep, t, state):
+    """gazebo_ros wheel odometry for one drive, step by step in plain Python (the plugin's
+    former per-reading code); ``state`` = [pose, prev_angles, prev_t, twist]."""
+    import math
+
+    pose, prev, prev_t, twist = state
+    left = sum(float(a) for a in left) / len(left)
+    right = sum(float(a) for a in right) / len(right)
+    if prev is None:
+        return [pose, (left, right), t, twist]
+    dl, dr = (left - prev[0]) * radius, (right - prev[1]) * radius
+    ds, dth = (dl + dr) / 2, (dr - dl) / sep
+    x, y, yaw = pose
+    mid = yaw + dth / 2
+    pose = (x + ds * math.cos(mid), y + ds * math.sin(mid), yaw + dth)
+    if t - prev_t > 0:
+        twist = (ds / (t - prev_t), dth / (t - prev_t))
+    return [pose, (left, right), t, twist]
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    wheels=st.lists(st.sampled_from([1, 2]), min_size=1, max_size=4),
+    seed=st.integers(0, 10_000),
+)
+def test_encoder_odometry_kernel_equals_the_scalar_rule(wheels, seed):
+    from fleetsim.sim.drives import odometry_from_encoders
+
+    rng = np.random.default_rng(seed)
+    n = len(wheels)
+    counts = [2 * w for w in wheels]  # w left and w right wheels per drive
+    start = np.cumsum([0, *counts]).astype(np.int64)
+    qpos = np.zeros(start[-1] + 3)
+    wheel_q = np.arange(start[-1], dtype=np.int64) + 3
+    radius, sep = rng.uniform(0.03, 0.2, n), rng.uniform(0.2, 0.6, n)
+    pose, twist = np.zeros((n, 3)), np.zeros((n, 2))
+    prev, has_prev, prev_t = np.zeros((n, 2)), np.zeros(n, bool), np.zeros(n)
+    states = [[(0.0, 0.0, 0.0), None, None, (0.0, 0.0)] for _ in range(n)]
+    t = 0.0
+    for _ in range(6):
+        t += float(rng.choice([0.0, 0.02, 0.05]))
+        qpos[3:] += rng.normal(0, 0.5, len(qpos) - 3)
+        slots = np.flatnonzero(rng.random(n) < 0.7).astype(np.int64)
+        out = np.empty((len(slots), 13))
+        odometry_from_encoders(
+            qpos, wheel_q, start, np.array(wheels), radius, sep, slots, t,
+            pose, twist, prev, has_prev, prev_t, out,
+        )  # fmt: skip
+        for k, i in enumerate(slots):
+            q = qpos[wheel_q[start[i] : start[i + 1]]]
+            states[i] = encoder_reference(
+                q[: wheels[i]], q[wheels[i] :], radius[i], sep[i], t, states[i]
+            )
+            (x, y, yaw), _, _, (v, w) = states[i]
+            assert out[k].tolist() == [
+                x, y, 0.0, 0.0, 0.0, math.sin(yaw / 2), math.cos(yaw / 2), v, 0.0, 0.0, 0.0, 0.0, w
+            ]  # fmt: skip

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from fleetsim.description import parse_urdf
+from fleetsim.errors import SimulationError
 from fleetsim.sim import Engine
 from fleetsim.sim.plugins.base import OdometryReading
 
@@ -78,3 +79,55 @@ def test_wheel_acceleration_ramps_the_speed():
     r = e.spawn_robot("r", parse_urdf(text))
     run(e, r, [(1.0, 0.0, 0.5)])
     assert e.model_twist("r")[0][0] == pytest.approx(0.25, abs=0.05)
+
+
+def test_commands_and_odometry_survive_a_rebuild_of_the_world(diffbot):
+    """Spawning and deleting recompile the world; the drives' batched state (commands, servo,
+    odometry) is carried over, and a deleted robot's plugin no longer drives anything."""
+
+    def history(rebuild: bool):
+        e = Engine(None)
+        r = e.spawn_robot("r", diffbot)
+        r.plugins[0].command(0.4, 0.3, e.time)
+        out = e.advance(0.2)
+        if rebuild:
+            gone = e.spawn_robot("tmp", diffbot, (0, 3, 0, 0, 0, 0))
+            e.delete_model("tmp")
+            gone.plugins[0].command(1.0, 1.0, e.time)  # must not reach robot "r"
+        return out + e.advance(0.2)
+
+    plain, rebuilt = history(False), history(True)
+    odom = [(o.stamp, o.position.tolist()) for o in plain if o.topic == "odom"]
+    assert odom == [(o.stamp, o.position.tolist()) for o in rebuilt if o.topic == "odom"]
+    assert odom[-1][1][0] > 0.05
+
+
+def test_odometry_of_many_drives_at_once_equals_one_by_one(diffbot):
+    world = parse_urdf(
+        robot_text("diffbot.urdf").replace("<odometrySource>encoder", "<odometrySource>world")
+    )
+
+    def engine():
+        e = Engine(None)
+        for i, robot in enumerate([diffbot, world, diffbot]):
+            e.spawn_robot(f"r{i}", robot, (0, i, 0, 0, 0, 0)).plugins[0].command(0.3, i - 1, 0.0)
+        return e, [en.plugins[0] for en in e.models.values() if en.kind == "robot"]
+
+    (e1, d1), (e2, d2) = engine(), engine()
+    for _ in range(5):
+        e1.advance(0.06)
+        e2.advance(0.06)
+        many = type(d1[0]).measure_each(e1, d1, e1.time)
+        for m, p in zip(many, d2):
+            one = p.measure(e2, e2.time)
+            for field in ("position", "orientation", "linear", "angular"):
+                np.testing.assert_array_equal(getattr(m, field), getattr(one, field))
+            assert (m.frame_id, m.child_frame_id, m.namespace) == (
+                one.frame_id,
+                one.child_frame_id,
+                p.ctx.namespace,
+            )
+    assert many[2].position[1] > 0.005 and many[0].position[1] < -0.005  # turned left, right
+    other = Engine(None)
+    with pytest.raises(SimulationError, match="the drive is not spawned in this engine"):
+        d1[0].measure(other, 0.0)

@@ -86,3 +86,45 @@ def test_batched_readings_equal_single_ones(diffbot):
         for field in ("position", "orientation", "linear", "angular"):
             np.testing.assert_allclose(getattr(b, field), getattr(one, field), atol=1e-9)
         assert (b.frame_id, b.child_frame_id) == (one.frame_id, one.child_frame_id)
+
+
+def test_batched_noise_equals_one_by_one_draws(diffbot):
+    """Noisy, relative-frame and clean plugins together draw the seed's normals in the same
+    order as measuring them one by one (relative-frame ones first)."""
+    robots = [
+        p3d_robot("<gaussianNoise>0.05</gaussianNoise>"),
+        diffbot,
+        parse_urdf(
+            robot_text("diffbot.urdf").replace(
+                "<frameName>/map</frameName>",
+                "<frameName>base_link</frameName><gaussianNoise>0.02</gaussianNoise>",
+            )
+        ),
+        p3d_robot("<gaussianNoise>0.01</gaussianNoise><xyzOffsets>1 0 0</xyzOffsets>"),
+    ]
+
+    def engine():
+        e = Engine(None, rng=np.random.default_rng(5))
+        for i, r in enumerate(robots):
+            e.spawn_robot(f"r{i}", r, (i, 0, 0, 0, 0, 0)).plugins[0].command(0.3, 0.4, 0.0)
+        e.advance(0.2)
+        ps = [
+            next(p for p in en.plugins if isinstance(p, P3dPlugin))
+            for en in e.models.values()
+            if en.kind == "robot"
+        ]
+        return e, ps
+
+    e1, p1 = engine()
+    e2, p2 = engine()
+    batch = P3dPlugin.measure_batch(e1, p1, e1.time)
+    rel = [p.measure(e2, e2.time) for p in p2 if p.ref]
+    world = [p.measure(e2, e2.time) for p in p2 if not p.ref]
+    singles = [world[0], world[1], rel[0], world[2]]
+    for b, one in zip(batch, singles):
+        for field in ("position", "linear", "angular"):
+            np.testing.assert_allclose(getattr(b, field), getattr(one, field), atol=1e-9)
+        assert b.covariance == one.covariance
+    assert not np.array_equal(batch[0].position, e1.data.xpos[p1[0].body])  # noise was added
+    np.testing.assert_array_equal(batch[1].position, e1.data.xpos[p1[1].body])
+    assert e1.rng.random() == e2.rng.random()  # the same number of draws

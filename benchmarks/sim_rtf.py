@@ -1,7 +1,9 @@
 """Real-time factor of the simulator: N diff-drive robots with a 360-beam laser at 10 Hz each,
 driving in the Willow Garage map (physics, drives, odometry, p3d, lasers; no runtime).
 
-Targets (issue 4): 10 robots >= 10x real time, 100 robots >= 1x, on one core.
+Targets (issue 4): 10 robots >= 10x real time, 100 robots >= 1x, on one core. Each row also
+splits the wall time into physics (drive servos + mj_step), sensors (odometry, p3d, joint
+states), lasers and other (commands, the stepping loop).
 Usage: python benchmarks/sim_rtf.py [--robots 1 10 50 100] [--seconds 5]
 """
 
@@ -42,6 +44,26 @@ def free_poses(engine: Engine, n: int, rng: np.random.Generator, clearance: floa
     return poses
 
 
+class PartTimer:
+    """Wall time spent inside wrapped callables, by part name (instance attributes wrap the
+    engine's own methods, so the engine's work is unchanged)."""
+
+    def __init__(self) -> None:
+        self.seconds: dict[str, float] = {}
+
+    def wrap(self, part: str, fn):
+        self.seconds.setdefault(part, 0.0)
+
+        def timed(*args, **kw):
+            t0 = time.perf_counter()
+            try:
+                return fn(*args, **kw)
+            finally:
+                self.seconds[part] += time.perf_counter() - t0
+
+        return timed
+
+
 def run(n: int, seconds: float, seed: int = 0) -> dict:
     rng = np.random.default_rng(seed)
     t0 = time.perf_counter()
@@ -52,6 +74,10 @@ def run(n: int, seconds: float, seed: int = 0) -> dict:
     )
     build = time.perf_counter() - t0
     engine.advance(0.2)  # warm-up (numba compile, contacts settle)
+    parts = PartTimer()
+    engine.step = parts.wrap("physics", engine.step)  # drive servos + mj_step
+    engine.due_readings = parts.wrap("sensors", engine.due_readings)  # incl. lasers
+    engine.lasers.measure = parts.wrap("lasers", engine.lasers.measure)
     cmds = np.c_[rng.uniform(0.1, 0.5, n), rng.uniform(-0.5, 0.5, n)]
     t0 = time.perf_counter()
     scans = 0
@@ -64,7 +90,12 @@ def run(n: int, seconds: float, seed: int = 0) -> dict:
         readings = engine.advance(0.1)
         scans += sum(1 for r in readings if type(r).__name__ == "ScanReading")
     wall = time.perf_counter() - t0
+    sec = parts.seconds
     return {
+        "physics_s": sec["physics"],
+        "sensors_s": sec["sensors"] - sec["lasers"],
+        "lasers_s": sec["lasers"],
+        "other_s": wall - sec["physics"] - sec["sensors"],
         "robots": n,
         "build_s": build,
         "sim_s": seconds,
@@ -80,12 +111,17 @@ def main() -> None:
     ap.add_argument("--robots", type=int, nargs="+", default=[1, 10, 50, 100])
     ap.add_argument("--seconds", type=float, default=5.0)
     args = ap.parse_args()
-    print(f"{'robots':>6} {'build s':>8} {'sim s':>6} {'wall s':>7} {'RTF':>7} {'scans':>6}")
+    print(
+        f"{'robots':>6} {'build s':>8} {'sim s':>6} {'wall s':>7} {'RTF':>7} {'scans':>6}   "
+        "wall s by part: physics (drives + mj_step), sensors (odometry, p3d, joint states), "
+        "lasers, other"
+    )
     for n in args.robots:
         r = run(n, args.seconds)
         print(
             f"{r['robots']:>6} {r['build_s']:>8.2f} {r['sim_s']:>6.1f} {r['wall_s']:>7.2f} "
-            f"{r['rtf']:>7.2f} {r['scans']:>6}"
+            f"{r['rtf']:>7.2f} {r['scans']:>6}   {r['physics_s']:.3f} {r['sensors_s']:.3f} "
+            f"{r['lasers_s']:.3f} {r['other_s']:.3f}"
         )
 
 

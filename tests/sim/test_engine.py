@@ -1,5 +1,6 @@
 import warnings
 
+import mujoco
 import numpy as np
 import pytest
 
@@ -8,7 +9,7 @@ from fleetsim.errors import ParameterError, SimulationError
 from fleetsim.sim import Engine
 from fleetsim.sim.build import quat_from_rpy
 
-from .conftest import robot_text
+from .conftest import WILLOW, robot_text
 
 
 def drive(engine, entry, vx, wz, seconds):
@@ -218,3 +219,36 @@ def test_static_models_spawn_and_delete_in_the_world_body(diffbot):
     e.delete_model("post")
     assert np.isinf(ahead())
     assert not any(e.model.geom(g).name.startswith("post/") for g in range(e.model.ngeom))
+
+
+def test_ground_planes_sit_in_static_bodies_of_their_own(diffbot):
+    """A plane in the world body makes MuJoCo walk the walls' whole bounding-volume tree for
+    every link; it moves into a static body of its own with all its geom properties."""
+    from fleetsim.sim.build import spec_from_world
+    from fleetsim.sim.engine import load_world
+
+    e = Engine(WILLOW)
+    m = e.model
+    (plane,) = np.flatnonzero(m.geom_type == mujoco.mjtGeom.mjGEOM_PLANE)
+    body = int(m.geom_bodyid[plane])
+    assert body != 0 and m.body_weldid[body] == 0 and m.body_geomnum[body] == 1
+    assert (m.geom_type[m.geom_bodyid == 0] == mujoco.mjtGeom.mjGEOM_BOX).all()  # the walls
+    assert e._model_names[e.geom_model[plane]] == "ground_plane"
+    ref = spec_from_world(load_world(WILLOW), 0.004)[0].compile()
+    (want,) = np.flatnonzero(ref.geom_type == mujoco.mjtGeom.mjGEOM_PLANE)
+    assert ref.geom(int(want)).name == m.geom(int(plane)).name
+    for field in ("size", "pos", "quat", "friction", "contype", "conaffinity", "condim",
+                  "priority", "solmix", "solref", "solimp", "margin", "gap", "group", "rgba",
+                  "matid"):  # fmt: skip
+        np.testing.assert_array_equal(
+            getattr(m, f"geom_{field}")[plane], getattr(ref, f"geom_{field}")[want], field
+        )
+    # robots still stand on it, and the static model deletes with its plane
+    e.spawn_robot("r", diffbot, (15.0, 30.0, 0, 0, 0, 0))
+    e.advance(0.5)
+    assert abs(e.model_pose("r")[0][2]) < 1e-3
+    e.delete_model("ground_plane")
+    assert not (e.model.geom_type == mujoco.mjtGeom.mjGEOM_PLANE).any()
+    assert not any(e.model.body(b).name.endswith(":plane") for b in range(e.model.nbody))
+    e.advance(0.3)
+    assert e.model_pose("r")[0][2] < -0.1  # falls without its floor

@@ -161,6 +161,7 @@ class Engine(StateQueries):
         self.geom_model = self._body_model[m.geom_bodyid]
         # geoms of static models sit in the world body (planes in bodies of their own), named
         # "<model>/<link>/..."
+        self._model_is_robot = np.array([e.kind == "robot" for e in self.models.values()], bool)
         index = {name: i for i, name in enumerate(self._model_names)}
         for g in np.flatnonzero(self.geom_model < 0):
             self.geom_model[g] = index.get(m.geom(int(g)).name.split("/", 1)[0], -1)

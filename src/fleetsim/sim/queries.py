@@ -28,6 +28,27 @@ class Contact:
     depth: float  # penetration, m (positive when overlapping)
 
 
+def contacts_kept(
+    geom: np.ndarray, geom_type: np.ndarray, geom_model: np.ndarray, model_is_robot: np.ndarray
+) -> np.ndarray:
+    """Which contacts are robot contacts worth reporting.
+
+    Parameters
+    ----------
+    geom : (C, 2) geom ids of each contact. geom_type : (G,) MuJoCo geom types.
+    geom_model : (G,) index of each geom's model (-1: none). model_is_robot : (M,) bool.
+
+    Returns
+    -------
+    (C,) bool: neither geom is a plane (the floor), the geoms belong to different models, and
+    at least one of them to a robot.
+    """
+    plane = int(mujoco.mjtGeom.mjGEOM_PLANE)  # an int: numpy compares enum objects one by one
+    i = geom_model[geom]
+    robot = np.append(model_is_robot, False)[i]  # index -1 (no model) reads the False
+    return (geom_type[geom] != plane).all(axis=1) & (i[:, 0] != i[:, 1]) & robot.any(axis=1)
+
+
 class StateQueries:
     """Pose, twist, contact and reset methods of ``Engine``."""
 
@@ -125,29 +146,31 @@ class StateQueries:
 
     def contacts(self) -> list[Contact]:
         """Current contacts between a robot and anything else except the floor (planes)."""
-        out = []
-        m, d = self.model, self.data
+        d = self.data
+        n = d.ncon
+        if not n:
+            return []
+        con = d.contact
+        geom = con.geom[:n]
+        keep = np.flatnonzero(
+            contacts_kept(geom, self.model.geom_type, self.geom_model, self._model_is_robot)
+        )
+        if not len(keep):
+            return []
         names = self._model_names
-        plane = mujoco.mjtGeom.mjGEOM_PLANE
-        for c in d.contact[: d.ncon] if d.ncon else []:
-            g1, g2 = int(c.geom1), int(c.geom2)
-            if m.geom_type[g1] == plane or m.geom_type[g2] == plane:
-                continue
+        out = []
+        for (g1, g2), pos, dist in zip(
+            geom[keep].tolist(), con.pos[:n][keep].tolist(), con.dist[:n][keep].tolist()
+        ):
             i1, i2 = self.geom_model[g1], self.geom_model[g2]
-            if i1 == i2:
-                continue
-            e1 = self.models[names[i1]] if i1 >= 0 else None
-            e2 = self.models[names[i2]] if i2 >= 0 else None
-            if not ((e1 and e1.kind == "robot") or (e2 and e2.kind == "robot")):
-                continue
             out.append(
                 Contact(
                     names[i1] if i1 >= 0 else "world",
                     self._link_of(g1),
                     names[i2] if i2 >= 0 else "world",
                     self._link_of(g2),
-                    tuple(float(v) for v in c.pos),
-                    float(-c.dist),
+                    tuple(pos),
+                    -dist,
                 )
             )
         return out

@@ -12,6 +12,11 @@ messages. Kinds:
   ``measure(engine, t) -> OdometryReading``.
 - ``SensorPlugin``: ``measure(engine, t) -> reading`` at ``update_rate``.
 - ``ActuatorPlugin``: joint commands applied in ``control``.
+
+A class may also measure many of its plugins in one call (``sim.schedule`` says when and in
+what order): the classmethod ``measure_each(engine, plugins, t)`` returns, for each plugin,
+what ``measure`` would (drives, joint states); ``measure_batch(engine, plugins, t)`` does the
+same with its readings placed after the others (p3d).
 """
 
 from __future__ import annotations

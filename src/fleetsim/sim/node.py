@@ -124,7 +124,11 @@ class Simulator(Node):
                 pp = p.params
                 names = [pp.imageTopicName, pp.cameraInfoTopicName]
                 if p.depth_enabled:
-                    names += [pp.depthImageTopicName, pp.depthImageCameraInfoTopicName]
+                    names += [
+                        pp.depthImageTopicName,
+                        pp.depthImageCameraInfoTopicName,
+                        pp.pointCloudTopicName,
+                    ]
                 topics = [self.topic(entry, p.topic(n)) for n in names]
                 p.wanted = lambda topics=topics: self._has_subscribers(topics)
         self._subs[entry.name] = subs
@@ -215,3 +219,8 @@ class Simulator(Node):
             self._publisher(rnames.resolve(r.depth_info_topic, ns), sensor_msgs.CameraInfo).publish(
                 info
             )
+            if r.cloud_topic:  # advertised always, computed only for subscribers
+                topic = rnames.resolve(r.cloud_topic, ns)
+                pub = self._publisher(topic, sensor_msgs.PointCloud2)
+                if self._has_subscribers([topic]):
+                    pub.publish(conv.cloud_msg(r.stamp, r.frame_id, r.depth, r.image, r.K))

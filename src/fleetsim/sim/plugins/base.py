@@ -243,6 +243,7 @@ class ImageReading:
     depth_topic: str = ""
     depth_info_topic: str = ""
     depth: np.ndarray | None = None  # (H, W) float32 m, for depth cameras
+    cloud_topic: str = ""  # depth cameras: the XYZRGB point cloud topic
     namespace: str = "/"  # ROS namespace the topic resolves in (set by the engine)
 
 

@@ -4,7 +4,8 @@
 The sensor's ``<camera>`` gives ``horizontal_fov``, ``image`` width/height/format and ``clip``
 near/far. Gazebo cameras look along their link's +x with +z up; the MuJoCo camera is rotated to
 match. Images are (H, W, 3) uint8 RGB; depth is (H, W) float32 metres, NaN outside the point
-cloud cutoffs (as the Kinect plugin reports).
+cloud cutoffs (as the Kinect plugin reports); depth cameras also publish an organised XYZRGB
+point cloud in the optical convention of ``frameName`` (z along the view, x right, y down).
 """
 
 from __future__ import annotations
@@ -49,7 +50,7 @@ class CameraParams:
 class DepthCameraParams(CameraParams):
     depthImageTopicName: str = param("depth/image_raw", help="depth image topic")
     depthImageCameraInfoTopicName: str = param("depth/camera_info", help="depth camera_info")
-    pointCloudTopicName: str = param("depth/points", help="unused (no point cloud yet)")
+    pointCloudTopicName: str = param("points", help="XYZRGB cloud topic (optical frame)")
     pointCloudCutoff: float = param(0.4, unit="m", range=(0.0, None), help="min valid depth")
     pointCloudCutoffMax: float = param(5.0, unit="m", range=(0.0, None), help="max valid depth")
     baseline: float = param(0.1, unit="m", help="unused")
@@ -156,6 +157,7 @@ class CameraPlugin(SensorPlugin):
             reading.depth = d
             reading.depth_topic = self.topic(p.depthImageTopicName)
             reading.depth_info_topic = self.topic(p.depthImageCameraInfoTopicName)
+            reading.cloud_topic = self.topic(p.pointCloudTopicName)
         return reading
 
 

@@ -119,21 +119,42 @@ class P3dPlugin(SensorPlugin):
             out.update(zip(map(id, world), cls._world_readings(engine, world, t)))
         return [out[id(p)] for p in plugins]
 
+    @staticmethod
+    def _layout(engine, plugins: list) -> tuple:
+        """Body ids, root ids, offsets, offset quaternions and noise of ``plugins``: constant
+        until the next compile (a new model), so kept per plugin set until then."""
+        cache = engine.__dict__.setdefault("_p3d_layouts", {})
+        if cache.get("model") is not engine.model:
+            cache.clear()
+            cache["model"] = engine.model
+        key = tuple(map(id, plugins))
+        lay = cache.get(key)
+        if lay is None:
+            n = len(plugins)
+            b = np.fromiter((p.body for p in plugins), np.int64, n)
+            sigma = np.fromiter((p.params.gaussianNoise for p in plugins), float, n)
+            lay = cache[key] = (
+                b,
+                engine.model.body_rootid[b],
+                np.array([p.params.xyzOffsets for p in plugins], float).reshape(n, 3),
+                np.array([p.off_q for p in plugins], float).reshape(n, 4),
+                sigma,
+                np.flatnonzero(sigma > 0),
+            )
+        return lay
+
     @classmethod
     def _world_readings(cls, engine, plugins: list, t: float) -> list:
         """Readings of world-frame p3d plugins, vectorised over the plugins."""
-        d, m = engine.data, engine.model
-        n = len(plugins)
-        b = np.fromiter((p.body for p in plugins), np.int64, n)
-        pos = d.xpos[b] + np.array([p.params.xyzOffsets for p in plugins])
+        d = engine.data
+        b, root, offsets, off_q, sigma, noisy = cls._layout(engine, plugins)
+        pos = d.xpos[b] + offsets
         cvel = d.cvel[b]
         ang = cvel[:, :3]
-        lever = d.xpos[b] - d.subtree_com[m.body_rootid[b]]
+        lever = d.xpos[b] - d.subtree_com[root]
         lin = cvel[:, 3:] + cross_products(ang, lever)
-        quat = quats_multiplied(np.array([p.off_q for p in plugins]), d.xquat[b])
+        quat = quats_multiplied(off_q, d.xquat[b])
         xyzw = quat[:, [1, 2, 3, 0]]
-        sigma = np.fromiter((p.params.gaussianNoise for p in plugins), float, n)
-        noisy = np.flatnonzero(sigma > 0)
         if len(noisy):
             z = engine.rng.standard_normal(9 * len(noisy)).reshape(-1, 3, 3)
             s = sigma[noisy, None]

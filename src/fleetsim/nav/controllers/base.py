@@ -8,6 +8,7 @@ those against ``controller_patience``.
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from typing import NamedTuple
 
 import numpy as np
@@ -31,18 +32,19 @@ class EmptyPlan(ControllerError):
     """compute_velocity_commands was called without a plan (or the plan left the local map)."""
 
 
-class LocalPlanner:
+class LocalPlanner(ABC):
     """Base of local planners."""
 
+    @abstractmethod
     def set_plan(self, plan: np.ndarray) -> None:
         """Take a new global plan: (N, 3) x, y, yaw (or (N, 2)) in the costmap's frame."""
-        raise NotImplementedError
 
+    @abstractmethod
     def compute_velocity_commands(
         self, pose: tuple[float, float, float], velocity: tuple[float, float, float]
     ) -> VelocityCommand:
         """The command for this cycle, from the robot's pose and measured velocity."""
-        raise NotImplementedError
 
+    @abstractmethod
     def is_goal_reached(self) -> bool:
-        raise NotImplementedError
+        """Whether the robot is at the plan's end within the goal tolerances."""

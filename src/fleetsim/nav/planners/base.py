@@ -8,6 +8,7 @@ NoPathFound, PlannerTimeout).
 
 from __future__ import annotations
 
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 
 import numpy as np
@@ -53,7 +54,7 @@ class Path:
         return float(np.hypot(d[:, 0], d[:, 1]).sum())
 
 
-class GlobalPlanner:
+class GlobalPlanner(ABC):
     """Base of global planners: holds the costmap; subclasses implement `create_plan`."""
 
     def __init__(self, costmap: Costmap2D, frame_id: str = "map") -> None:
@@ -64,6 +65,6 @@ class GlobalPlanner:
         """Plan on another grid from now on (the global costmap after a resize)."""
         self.costmap = costmap
 
+    @abstractmethod
     def create_plan(self, start: tuple[float, ...], goal: tuple[float, ...]) -> Path:
         """A path from ``start`` (x, y, yaw) to ``goal`` (x, y, yaw), both in ``frame_id``."""
-        raise NotImplementedError

@@ -25,6 +25,7 @@ import dataclasses
 import logging
 import typing
 import warnings
+from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -180,11 +181,12 @@ class Plugin:
         return None
 
 
-class DrivePlugin(Plugin):
+class DrivePlugin(Plugin, ABC):
     kind = "drive"
 
+    @abstractmethod
     def command(self, vx: float, wz: float, t: float) -> None:
-        raise NotImplementedError
+        """Take a velocity command (cmd_vel's linear.x m/s, angular.z rad/s) at sim time t."""
 
 
 class SensorPlugin(Plugin):

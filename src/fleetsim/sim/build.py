@@ -19,7 +19,7 @@ import mujoco
 import numpy as np
 
 from fleetsim.errors import SimulationError
-from fleetsim.sim.meshes import triangle_mesh_from_collada
+from fleetsim.sim.meshes import collada_parts, triangle_mesh_from_collada
 from fleetsim.sim.sdf import GAZEBO_COLOURS
 from fleetsim.sim.world import GeomDesc, ModelDesc, Pose, WorldDesc
 
@@ -29,6 +29,7 @@ VISUAL_GROUP = 1
 MIN_MASS = 1e-3
 MIN_INERTIA = 1e-6
 MESH_FORMATS = (".stl", ".obj", ".msh", ".dae")  # mesh files add_geom reads
+MIN_PART_AREA = 1e-12  # m^2; a material part with less surface draws nothing and is left out
 
 
 def quat_from_rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
@@ -117,6 +118,12 @@ def add_geom(
     applies to all. A mesh used for collision collides as its convex hull (MuJoCo's rule):
     a concave shape such as an L-shaped desk or an open shelf fills in, so give it box
     collisions, or split it into convex parts, where the hollow matters.
+
+    A visual ``.dae`` without a colour or texture of its own (``g.rgba`` None, no
+    ``g.texture``) takes the file's materials, as Gazebo draws it: one mesh geom per material
+    part (``fleetsim.sim.meshes.collada_parts``), named ``<prefix><name>#<index>:<part>``, all
+    at the same pose and scale, each in its material's colour. A file without materials, an
+    explicit colour, and collision geoms keep one mesh geom named ``<prefix><name>#<index>``.
     """
     pos, quat = np.array(g.pose[:3], float), quat_from_rpy(*g.pose[3:])
     if frame is not None:  # express the geom in ``body`` when it sits in another frame
@@ -135,6 +142,19 @@ def add_geom(
     elif g.kind == "plane":
         kw.update(type=G.mjGEOM_PLANE, size=[g.size[0] / 2, g.size[1] / 2, 1.0])
     elif g.kind == "mesh":
+        if _coloured_by_file(g):
+            parts = _add_part_meshes(spec, g, prefix)
+            if parts:
+                for k, (mesh_name, rgba) in enumerate(parts):
+                    geom = body.add_geom(
+                        name=f"{prefix}{g.name or 'geom'}#{index}:{k}",
+                        type=G.mjGEOM_MESH,
+                        meshname=mesh_name,
+                        **kw,
+                    )
+                    _make_visual(geom)
+                    geom.rgba = list(rgba)
+                return
         mesh_name = _add_mesh(spec, g, prefix)
         if mesh_name is None:
             return
@@ -152,9 +172,7 @@ def add_geom(
         if shown and g.kind == "plane":
             geom.material = _floor_material(spec)
     else:
-        geom.group = VISUAL_GROUP
-        geom.contype = geom.conaffinity = 0
-        geom.density = 0
+        _make_visual(geom)
         geom.rgba = list(g.rgba) if g.rgba is not None else [0.7, 0.7, 0.7, 1.0]
         geom.material = _material_for(spec, g, prefix)
         if geom.material:
@@ -163,18 +181,29 @@ def add_geom(
             geom.material = _floor_material(spec)
 
 
-def _add_mesh(spec, g: GeomDesc, prefix: str) -> str | None:
-    """The mesh asset of a mesh geom, added once per spec for each (file, version, scale) and
-    shared by every model that uses it (a hundred robots compile one mesh, and a deleted robot
-    can be spawned again); None when the format is not read."""
+def _make_visual(geom) -> None:
+    """Visual group, no contacts, no mass."""
+    geom.group = VISUAL_GROUP
+    geom.contype = geom.conaffinity = 0
+    geom.density = 0
+
+
+def _coloured_by_file(g: GeomDesc) -> bool:
+    """A visual COLLADA mesh whose URDF/SDF gives it no colour or texture: its file's
+    materials colour it (Gazebo's rule)."""
+    dae = Path(g.mesh or "").suffix.lower() == ".dae"
+    return dae and not g.collide and g.rgba is None and not g.texture
+
+
+def _mesh_file(g: GeomDesc, prefix: str) -> Path | None:
+    """The mesh file of a mesh geom; None (with a warning) when its format is not read."""
     owner = prefix.rstrip("/")
     mesh_file = Path(g.mesh or "")
-    suffix = mesh_file.suffix.lower()
-    if suffix not in MESH_FORMATS:
+    if mesh_file.suffix.lower() not in MESH_FORMATS:
         warnings.warn(
             f"mesh '{g.mesh}' of geom '{g.name}' in '{owner}': fleetsim reads "
             f"{'/'.join(s.lstrip('.').upper() for s in MESH_FORMATS)} meshes; the shape is skipped",
-            stacklevel=3,
+            stacklevel=4,
         )
         return None
     if not mesh_file.is_file():
@@ -182,28 +211,71 @@ def _add_mesh(spec, g: GeomDesc, prefix: str) -> str | None:
             f"mesh file '{g.mesh}' of geom '{g.name}' in '{owner}' does not exist; "
             "fix the <mesh> filename/uri (package:// and model:// must resolve to a file)"
         )
+    return mesh_file
+
+
+def _mesh_asset_name(mesh_file: Path, scale: list[float]) -> str:
+    """Asset name of a mesh file at a scale: one per (file, version, scale) in a spec."""
     st = mesh_file.stat()
-    scale = [float(v) for v in g.size]
     key = f"{mesh_file.resolve()}|{st.st_mtime_ns}|{st.st_size}|{scale}"
-    mesh_name = f"mesh:{mesh_file.name}:{hashlib.sha1(key.encode()).hexdigest()[:12]}"
+    return f"mesh:{mesh_file.name}:{hashlib.sha1(key.encode()).hexdigest()[:12]}"
+
+
+def _add_user_mesh(spec, name: str, vertices: np.ndarray, faces: np.ndarray, scale) -> None:
+    mesh = spec.add_mesh(name=name, uservert=vertices.ravel(), userface=faces.ravel(), scale=scale)
+    # shell inertia: COLLADA visuals are often open surfaces (a floor, a sign) with no volume;
+    # bodies carry explicit inertia, so the mesh's own inertia only places its frame
+    mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
+
+
+def _add_mesh(spec, g: GeomDesc, prefix: str) -> str | None:
+    """The mesh asset of a mesh geom, added once per spec for each (file, version, scale) and
+    shared by every model that uses it (a hundred robots compile one mesh, and a deleted robot
+    can be spawned again); None when the format is not read."""
+    mesh_file = _mesh_file(g, prefix)
+    if mesh_file is None:
+        return None
+    scale = [float(v) for v in g.size]
+    mesh_name = _mesh_asset_name(mesh_file, scale)
     if spec.mesh(mesh_name) is not None:
         return mesh_name
-    if suffix != ".dae":
+    if mesh_file.suffix.lower() != ".dae":
         spec.add_mesh(name=mesh_name, file=str(mesh_file), scale=scale)
         return mesh_name
     vertices, faces = triangle_mesh_from_collada(mesh_file)
     if len(vertices) < 4:
         raise SimulationError(
-            f"mesh '{g.mesh}' of geom '{g.name}' in '{owner}' has {len(vertices)} vertices; "
-            "MuJoCo needs at least 4 (use a box or a thin solid instead)"
+            f"mesh '{g.mesh}' of geom '{g.name}' in '{prefix.rstrip('/')}' has "
+            f"{len(vertices)} vertices; MuJoCo needs at least 4 (use a box or a thin solid instead)"
         )
-    mesh = spec.add_mesh(
-        name=mesh_name, uservert=vertices.ravel(), userface=faces.ravel(), scale=scale
-    )
-    # shell inertia: COLLADA visuals are often open surfaces (a floor, a sign) with no volume;
-    # bodies carry explicit inertia, so the mesh's own inertia only places its frame
-    mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
+    _add_user_mesh(spec, mesh_name, vertices, faces, scale)
     return mesh_name
+
+
+def _add_part_meshes(spec, g: GeomDesc, prefix: str) -> list[tuple[str, tuple]] | None:
+    """Mesh assets ``(name, rgba)`` of the material parts of a ``.dae`` geom, added once per
+    spec for each (file, version, scale, part); None when the file has no materials (it is
+    then one plain mesh). Parts without surface (degenerate triangles) are left out; a
+    one-triangle part gets its centroid as an unused fourth vertex, MuJoCo's minimum."""
+    mesh_file = _mesh_file(g, prefix)
+    parts = collada_parts(mesh_file)
+    if all(not p.name for p in parts):
+        return None
+    scale = [float(v) for v in g.size]
+    base = _mesh_asset_name(mesh_file, scale)
+    assets = []
+    for k, part in enumerate(parts):
+        name = f"{base}:{k}"
+        if spec.mesh(name) is None:
+            v = part.vertices
+            a, b, c = (v[part.faces[:, i]] * scale for i in range(3))
+            if 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum() < MIN_PART_AREA:
+                continue
+            if len(v) < 4:
+                v = np.vstack([v, v.mean(axis=0)])
+            _add_user_mesh(spec, name, v, part.faces, scale)
+        assets.append((name, part.rgba))
+    return assets
 
 
 def _floor_material(spec) -> str:

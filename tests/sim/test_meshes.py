@@ -520,3 +520,24 @@ def test_one_triangle_and_degenerate_parts(tmp_path):
     m = spec.compile()
     assert m.ngeom == 2 and list(m.mesh_facenum) == [1, 8]  # the zero-area part is left out
     np.testing.assert_allclose(m.geom_rgba, [[0.9, 0.1, 0.1, 1], [0.1, 0.2, 0.9, 1]])
+
+
+@settings(max_examples=15, deadline=None)
+@given(st.lists(st.sampled_from(["red", "blue", "none"]), min_size=12, max_size=12))
+def test_parts_partition_the_triangles_property(tmp_path_factory, owners):
+    """Any assignment of the cube's triangles to materials: one part per material in order of
+    first use, each with its triangles, together exactly the file's triangles."""
+    tris = np.array(TRIS.split()).reshape(12, 3)
+    prims = "".join(
+        f'<triangles count="1" material="{o}">{VTX}<p>{" ".join(t)}</p></triangles>'
+        for o, t in zip(owners, tris)
+    )
+    text = material_collada(effects=RED_BLUE)
+    text = text.replace(text[text.index('<triangles count="4"') : text.index("</mesh>")], prims)
+    path = write(tmp_path_factory.mktemp("parts"), text)
+    parts = collada_parts(path)
+    names = {"red": "red-name", "blue": "blue-name", "none": ""}
+    assert [p.name for p in parts] == [names[o] for o in dict.fromkeys(owners)]
+    for p in parts:
+        mine = [t for o, t in zip(owners, tris.astype(int)) if names[o] == p.name]
+        np.testing.assert_array_equal(p.vertices[p.faces], CUBE[np.array(mine)])

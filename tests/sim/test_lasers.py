@@ -82,3 +82,29 @@ def test_laser_noise_is_seeded(diffbot):
     assert not np.array_equal(scans[0], scans[2])
     finite = np.isfinite(scans[0])
     assert 0.001 < np.std(scans[0][finite] - scans[2][finite]) < 0.05
+
+
+@pytest.mark.parametrize("roll", [0.0, np.pi])
+def test_a_laser_mounted_upside_down_sweeps_clockwise(roll):
+    """Rolled 180 degrees, the sensor's +y (beam angle +pi/2) points to the robot's right."""
+    from fleetsim.description import parse_urdf
+    from fleetsim.sim.world import GeomDesc, LinkDesc, ModelDesc, WorldDesc, ground_plane
+
+    from .conftest import replace_plugin_param, robot_text
+
+    text = replace_plugin_param(
+        robot_text("diffbot.urdf"), "<pose>0 0 0 0 0 0</pose>", f"<pose>0 0 0 {roll} 0 0</pose>"
+    )
+    wall = ModelDesc(
+        "wall", (0, -1.5, 0.5, 0, 0, 0), True, [LinkDesc("l", geoms=[GeomDesc("box", (6, 0.2, 1))])]
+    )
+    e = Engine(WorldDesc("w", [ground_plane(), wall]))
+    ent = e.spawn_robot("r", parse_urdf(text))
+    e.advance(0.1)
+    laser = next(p for p in ent.plugins if isinstance(p, LaserPlugin))
+    ranges = scan_now(e, laser)
+    angles = laser.angle_min + laser.increment * np.arange(laser.samples)
+    left, right = np.argmin(abs(angles - np.pi / 2)), np.argmin(abs(angles + np.pi / 2))
+    seen, blind = (right, left) if roll == 0.0 else (left, right)
+    assert ranges[seen] == pytest.approx(1.4, abs=0.01) and np.isinf(ranges[blind])
+    np.testing.assert_allclose(ranges, reference_ranges(e, laser, "r")[0], atol=1e-5)

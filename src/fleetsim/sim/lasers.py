@@ -28,6 +28,7 @@ class _Layout:
     body: np.ndarray  # (L,) int64 link body ids
     pos: np.ndarray  # (L, 3) sensor origins in their links
     xaxis: np.ndarray  # (L, 3) sensor x axes in their links
+    zaxis: np.ndarray  # (L, 3) sensor z axes in their links
     angle_min: np.ndarray  # (L,)
     inc: np.ndarray  # (L,)
     nb: np.ndarray  # (L,) int64
@@ -51,6 +52,7 @@ class _Layout:
             body=np.array([lz.body for lz in lasers], np.int64),
             pos=np.array([lz.pos for lz in lasers], float).reshape(-1, 3),
             xaxis=np.array([lz.xaxis for lz in lasers], float).reshape(-1, 3),
+            zaxis=np.array([lz.zaxis for lz in lasers], float).reshape(-1, 3),
             angle_min=np.array([lz.angle_min for lz in lasers]),
             inc=np.array([lz.increment for lz in lasers]),
             nb=nb,
@@ -129,7 +131,10 @@ class LaserBatch:
         R = engine.data.xmat[lay.body].reshape(n, 3, 3)
         origins = engine.data.xpos[lay.body] + np.einsum("nij,nj->ni", R, lay.pos)
         xaxis = np.einsum("nij,nj->ni", R, lay.xaxis)  # sensor x, world
-        angle0 = np.arctan2(xaxis[:, 1], xaxis[:, 0]) + lay.angle_min
+        # a laser mounted upside down sweeps its beams clockwise seen from above
+        sign = np.where(np.einsum("nj,nj->n", R[:, 2, :], lay.zaxis) < 0, -1.0, 1.0)
+        angle0 = np.arctan2(xaxis[:, 1], xaxis[:, 0]) + sign * lay.angle_min
+        inc = sign * lay.inc
         ranges = np.full(int(lay.nb.sum()), np.inf)
         if len(self.static_grid.prims):
             which = np.repeat(np.arange(n), lay.nb)
@@ -137,7 +142,7 @@ class LaserBatch:
             ranges = raycast.cast(
                 self.static_grid,
                 origins[which],
-                angle0[which] + beam * lay.inc[which],
+                angle0[which] + beam * inc[which],
                 lay.beam_rmin,
                 lay.beam_rmax,
                 lay.owner[which],
@@ -145,14 +150,14 @@ class LaserBatch:
         if self.occupancy is not None:
             g, wt = self.occupancy, self.walls
             occupancy_cast.ranges_from_walls(
-                origins, angle0, lay.inc, lay.nb, lay.offsets, lay.rmin, lay.rmax,
+                origins, angle0, inc, lay.nb, lay.offsets, lay.rmin, lay.rmax,
                 wt.occupied, wt.boxes, wt.start, wt.items, wt.tile, wt.th, wt.tw,
                 g.origin[0], g.origin[1], g.resolution, self.wall_height, ranges,
             )  # fmt: skip
         if len(self.dynamic_ids):
             centres, radii, ids, start, prims = self.bodies(engine)
             raycast.ranges_with_bodies(
-                ranges, origins, angle0, lay.inc, lay.nb, lay.offsets, lay.owner, lay.rmin,
+                ranges, origins, angle0, inc, lay.nb, lay.offsets, lay.owner, lay.rmin,
                 lay.rmax, centres, radii, ids, start, prims,
             )  # fmt: skip
         # Gaussian noise on the beams that hit, drawn in laser order as the sensors would

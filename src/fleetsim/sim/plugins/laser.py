@@ -75,6 +75,7 @@ class LaserPlugin(SensorPlugin):
         rot = np.zeros(9)
         mujoco.mju_quat2Mat(rot, self.quat)
         self.xaxis = rot.reshape(3, 3)[:, 0].copy()  # the sensor's x axis in its link frame
+        self.zaxis = rot.reshape(3, 3)[:, 2].copy()  # and its z axis (down: mounted upside down)
         self.frame_id = ctx.frame(self.params.frameName)
 
     @property
@@ -89,25 +90,22 @@ class LaserPlugin(SensorPlugin):
     def increment(self) -> float:
         return (self.angle_max - self.angle_min) / max(self.samples - 1, 1)
 
-    def pose(self, engine) -> tuple[np.ndarray, float, int]:
-        """World origin (3,) m, world yaw of the first beam (rad), owner model index."""
+    def pose(self, engine) -> tuple[np.ndarray, float, float, int]:
+        """World origin (3,) m, world yaw of the first beam (rad), world angle between beams
+        (rad; negative for a laser mounted upside down, whose beams sweep clockwise seen from
+        above), owner model index."""
         d = engine.data
         R = d.xmat[self.body].reshape(3, 3)
         origin = d.xpos[self.body] + R @ self.pos
-        rs = np.zeros(9)
-        q = np.zeros(4)
-        mujoco.mju_mulQuat(q, d.xquat[self.body], self.quat)
-        mujoco.mju_quat2Mat(rs, q)
-        return origin, float(np.arctan2(rs[3], rs[0])) + self.angle_min, self.owner
+        x, z = R @ self.xaxis, R @ self.zaxis
+        sign = -1.0 if z[2] < 0 else 1.0
+        yaw = float(np.arctan2(x[1], x[0]))
+        return origin, yaw + sign * self.angle_min, sign * self.increment, self.owner
 
     def rays(self, engine):
         """World ray origins (S, 3), world yaws (S,) and the owner model index."""
-        origin, a0, owner = self.pose(engine)
-        return (
-            np.tile(origin, (self.samples, 1)),
-            a0 + self.increment * np.arange(self.samples),
-            owner,
-        )
+        origin, a0, inc, owner = self.pose(engine)
+        return np.tile(origin, (self.samples, 1)), a0 + inc * np.arange(self.samples), owner
 
     def reading(self, ranges: np.ndarray, t: float) -> ScanReading:
         """A scan of ``ranges`` ((samples,) float32 m, noise already applied by the batch)."""

@@ -42,6 +42,14 @@ def test_until_goals_exits_nonzero_when_a_goal_fails(tmp_path: Path, capsys):
         (["launch", "pioneer_multi"], "give --duration S, --until-goals, or both"),
         (["launch", "pioneer_multi", "robot", "--duration", "1"], "not of the form name:=value"),
         (["launch", "pioneer_multi", "nope:=1", "--duration", "1"], r"unused args \['nope'\]"),
+        (
+            ["launch", "pioneer_multi", "--connect", "tcp/127.0.0.1:9", "--realtime"],
+            "--realtime has no effect with --connect",
+        ),
+        (
+            ["launch", "pioneer_multi", "--connect", "tcp/127.0.0.1:9"],
+            r"no simulation running at tcp/127.0.0.1:9",
+        ),
     ],
 )
 def test_bad_invocations_are_one_line_errors(argv, message, capsys):

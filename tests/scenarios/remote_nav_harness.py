@@ -8,8 +8,8 @@ background thread (`RunningSimulation`). The robots' move_base nodes run in subp
 
 * `start_node_run`: one move_base through the command line, ``fleetsim node run
   fleetsim.nav.move_base:MoveBase --ns /lizi1 --remap map:=/map --connect ENDPOINT``;
-* `start_host`: several robots' move_base nodes in one process (this module run as a script,
-  see `host_move_bases`), which stops cleanly on SIGTERM.
+* `start_host`: two robots' move_base nodes in one process, ``fleetsim launch
+  move_bases.launch ... --connect ENDPOINT``, which stops cleanly on SIGTERM.
 
 Both copy the simulation's parameter tree, so the move_base nodes read the YAML files that the
 launch file loaded. Every subprocess writes its stderr to a file (a pipe could fill and block
@@ -164,8 +164,22 @@ def start_node_run(endpoint: str, namespace: str) -> Subprocess:
 
 
 def start_host(endpoint: str, namespaces: list[str]) -> Subprocess:
-    """A process hosting the move_base nodes of ``namespaces`` (see `host_move_bases`)."""
-    return Subprocess([sys.executable, str(Path(__file__).resolve()), endpoint, *namespaces])
+    """A process hosting the move_base nodes of two robot ``namespaces``: ``fleetsim launch
+    move_bases.launch first:=NS second:=NS --connect ENDPOINT`` (stops cleanly on SIGTERM)."""
+    first, second = (ns.strip("/") for ns in namespaces)
+    return Subprocess(
+        [
+            sys.executable,
+            "-m",
+            "fleetsim.cli.main",
+            "launch",
+            str(PACKAGE / "launch" / "move_bases.launch"),
+            f"first:={first}",
+            f"second:={second}",
+            "--connect",
+            endpoint,
+        ]
+    )
 
 
 def wait_for_action_servers(
@@ -188,37 +202,3 @@ def wait_for_action_servers(
         if missing:
             time.sleep(0.2)
     return missing
-
-
-def host_move_bases(
-    endpoint: str, namespaces: list[str], stop: threading.Event, seed: int = 0
-) -> None:
-    """Run one move_base per namespace in this process, on the simulation's clock, until
-    ``stop`` is set or the simulation goes away (`TransportError`)."""
-    from fleetsim.nav.move_base import MoveBase
-    from fleetsim.runtime import Runtime
-    from fleetsim.transport import ZenohBridge
-    from fleetsim.transport.paramserver import request_param
-
-    rt = Runtime(seed=seed)
-    bridge = ZenohBridge(rt, mode="client", connect=[endpoint], follow_clock=True, role="node")
-    try:
-        tree = request_param(bridge.session, bridge.keys, "dump", "/")
-        rt.params.set("/", tree)
-        for ns in namespaces:
-            MoveBase(rt, namespace=ns, remaps={"map": "/map"})
-        bridge.run_following(stop=stop)
-    finally:
-        rt.shutdown()
-
-
-def main(argv: list[str]) -> int:
-    """``python remote_nav_harness.py ENDPOINT NS [NS ...]``: exits 0 after SIGTERM."""
-    stop = threading.Event()
-    signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    host_move_bases(argv[0], argv[1:], stop)
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main(sys.argv[1:]))

@@ -123,3 +123,31 @@ def test_two_processes_each_host_half_the_robots_move_base():
     assert codes == [0, 0], f"the host processes did not stop cleanly: {codes}"
     for model in GOALS:
         assert_reached(sim, model)
+
+
+def test_a_launch_file_joins_a_running_simulation():
+    """``fleetsim launch FILE --connect``: a robot spawned into the running simulation from
+    another runtime, with its parameters in the simulation's tree and its tf from there."""
+    import threading
+
+    from remote_nav_harness import PACKAGE
+
+    from fleetsim.launch.runner import LaunchSession, load_plan
+
+    endpoint = free_endpoint()
+    with RunningSimulation(endpoint, {"robots": "1"}, rate=2.0) as sim:
+        plan = load_plan(PACKAGE / "launch" / "join_robot.launch", {})
+        with LaunchSession(plan, connect=endpoint) as joined:
+            stop = threading.Event()
+            joined.follow(joined.runtime.now() + 3.0, stop=stop)
+            assert "/lizi9/robot_state_publisher" in joined.nodes
+            with SimulationClient(endpoint, timeout=5.0) as client:
+                # the plan's parameters went to the simulation's server
+                assert client.param("get", "/lizi9/tf_prefix") == "lizi9"
+                assert client.param("get", "/lizi9/move_base/controller_frequency") == 10.0
+            frames = joined.runtime.tf_buffer.all_frames_as_string()
+        sim.stop()
+    assert "lizi9" in sim.robot_models() and "lizi1" in sim.robot_models()
+    x, y, yaw = sim.final["lizi9"]
+    assert math.hypot(x - 12.0, y - 10.0) < 0.1 and abs(yaw - 1.0) < 0.1
+    assert "lizi9/base_link" in frames and "lizi9/odom" in frames

@@ -79,10 +79,25 @@ def run_launch(
     seed: int = 0,
     progress: bool = True,
     listen: str | None = None,
+    connect: str | None = None,
 ):
-    """Run a launch file; returns the finished session's monitor."""
+    """Run a launch file; returns the finished session's monitor.
+
+    With ``connect`` the file's nodes join the simulation at that endpoint (see
+    `fleetsim.launch.runner`) and run with its clock: for ``duration`` s of sim time from
+    joining, until their goals are done, or (neither given) until SIGTERM/Ctrl-C or the
+    simulation goes away.
+    """
     from fleetsim.launch.runner import LaunchSession, load_plan
 
+    if connect is not None:
+        if realtime:
+            raise LaunchError("--realtime has no effect with --connect: time is the simulation's")
+        plan = load_plan(resolve_launch_file(file), args, seed=seed)
+        with LaunchSession(plan, seed=seed, viz=viz, record=record, connect=connect) as session:
+            follow_until_stopped(session, duration, until_goals)
+            console.print(results_table(session.monitor))
+            return session.monitor
     if duration is None and not until_goals:
         raise LaunchError("give --duration S, --until-goals, or both")
     plan = load_plan(resolve_launch_file(file), args, seed=seed)
@@ -117,6 +132,27 @@ def run_launch(
         return session.monitor
 
 
+def follow_until_stopped(session, duration: float | None, until_goals: bool) -> None:
+    """Run a joined session with the simulation's clock until ``duration`` s of sim time have
+    passed, its goals are done, or SIGTERM arrives (a clean stop, as roslaunch's)."""
+    import signal
+    import threading
+
+    stop = threading.Event()
+    previous = signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    rt = session.runtime
+    end = None if duration is None else rt.now() + duration
+    console.print(f"joined at t = {rt.now():.1f} s; following the simulation's clock")
+    try:
+        while not stop.is_set() and (end is None or rt.now() < end - 1e-9):
+            step = rt.now() + 0.5
+            session.follow(step if end is None else min(step, end), stop=stop)
+            if until_goals and session.monitor.all_goals_done():
+                break
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
 def register(app: typer.Typer) -> None:
     @app.command("launch")
     def launch(
@@ -137,6 +173,12 @@ def register(app: typer.Typer) -> None:
             help="Zenoh endpoint for tools (default $FLEETSIM_ZENOH or tcp/127.0.0.1:7447).",
         ),
         no_bridge: bool = typer.Option(False, "--no-bridge", help="Do not listen for tools."),
+        connect: str = typer.Option(
+            None,
+            "--connect",
+            help="Join the simulation at this Zenoh endpoint instead of hosting one: the file's "
+            "nodes run here, on its clock (as roslaunch on a second machine).",
+        ),
     ) -> None:
         """Run a launch file headless, then print a results table per robot."""
         if list_:
@@ -157,7 +199,8 @@ def register(app: typer.Typer) -> None:
             viz,
             realtime,
             seed,
-            listen=endpoint,
+            listen=None if connect else endpoint,
+            connect=connect,
         )
         if until_goals and not monitor.success():
             raise typer.Exit(1)

@@ -1,5 +1,12 @@
 """Running a `LaunchPlan`: one runtime, parameters first, then every node in file order.
 
+A session either hosts the simulation (and, with ``listen``, lets tools and other processes
+join it) or, with ``connect``, joins a simulation running elsewhere, as roslaunch does on a
+second machine: its runtime follows the simulation's ``/clock``, starts from a copy of the
+simulation's parameters, sets the plan's parameters there too (the master's tree, for every
+process to read) and its nodes talk to the others over Zenoh (services of other processes,
+e.g. ``/gazebo/spawn_urdf_model``, are reachable as local ones).
+
 Viewer nodes (``rviz``, ``gazebo_ros/gzclient``) open the Foxglove live view when the run has
 one (``--viz``) and are otherwise noted and skipped: fleetsim runs headless.
 """
@@ -7,6 +14,7 @@ one (``--viz``) and are otherwise noted and skipped: fleetsim runs headless.
 from __future__ import annotations
 
 import logging
+import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -46,6 +54,8 @@ class LaunchSession:
     record: str | Path | None = None
     #: Zenoh endpoint the run listens on for tools and other processes; None: no bridge
     listen: str | None = None
+    #: Zenoh endpoint of a simulation to join instead of hosting one (see the module docstring)
+    connect: str | None = None
     runtime: Runtime = field(init=False)
     nodes: dict[str, Any] = field(default_factory=dict, init=False)
     skipped: list[str] = field(default_factory=list, init=False)
@@ -64,7 +74,10 @@ class LaunchSession:
 
     def _start(self) -> None:
         rt = self.runtime
-        self.plan.apply_params(rt.params)
+        if self.connect is not None:
+            self._join(self.connect)
+        else:
+            self.plan.apply_params(rt.params)
         if self.record is not None:
             from fleetsim.record import Recorder
 
@@ -74,11 +87,37 @@ class LaunchSession:
         for spec in self.plan.nodes:
             self._start_node(spec)
         self.monitor = RunMonitor(rt, self.plan, self.nodes)
-        if self.listen is not None:
+        if self.listen is not None and self.connect is None:
             from fleetsim.transport import ZenohBridge
 
             self.bridge = ZenohBridge(rt, listen=[self.listen])
             _log.info(f"listening for fleetsim tools on {self.listen}")
+
+    def _join(self, endpoint: str) -> None:
+        """Follow the simulation at ``endpoint``: its clock, its parameters plus the plan's."""
+        from fleetsim.transport import ZenohBridge
+        from fleetsim.transport.paramserver import request_param
+
+        rt = self.runtime
+        self.bridge = ZenohBridge(
+            rt, mode="client", connect=[endpoint], follow_clock=True, role="node"
+        )
+        session, keys = self.bridge.session, self.bridge.keys
+        tree = request_param(session, keys, "dump", "/", timeout=5.0)
+        if isinstance(tree, dict):
+            rt.params.set("/", tree)
+        own = self.plan.param_tree()
+        for name, value in leaves("/", own.get("/")):
+            rt.params.set(name, value)
+            request_param(session, keys, "set", name, value, timeout=5.0)
+        _log.info(f"joined the simulation at {endpoint} (t = {rt.now():.3f} s)")
+
+    def follow(self, until: float | None = None, stop: threading.Event | None = None) -> None:
+        """Joined sessions: run with the simulation's clock up to sim time ``until`` (None:
+        until ``stop`` is set or the simulation goes away, `TransportError`)."""
+        if self.connect is None:
+            raise LaunchError("follow() is for a session that joined a simulation (connect=...)")
+        self.bridge.run_following(until=until, stop=stop)
 
     def _start_node(self, spec: NodeSpec) -> None:
         if (spec.pkg, spec.type) in VIEWERS:
@@ -109,6 +148,14 @@ class LaunchSession:
         until = self.monitor.all_goals_done if until_goals else None
         if duration is None and until is None:
             raise LaunchError("give a duration (--duration S) or --until-goals")
+        if self.connect is not None:
+            end = None if duration is None else self.runtime.now() + duration
+            while end is None or self.runtime.now() < end - 1e-9:
+                step = self.runtime.now() + 0.5
+                self.follow(step if end is None else min(step, end))
+                if until is not None and until():
+                    return
+            return
         self.runtime.run(duration=duration, until=until, rate=rate)
 
     def close(self) -> None:
@@ -145,3 +192,14 @@ class LaunchSession:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
+
+
+def leaves(prefix: str, value) -> list[tuple[str, object]]:
+    """``(global name, value)`` of every leaf of a parameter namespace (dicts walked down; an
+    empty dict is a leaf)."""
+    if isinstance(value, dict) and value:
+        out = []
+        for k, v in value.items():
+            out += leaves(f"{prefix.rstrip('/')}/{k}", v)
+        return out
+    return [] if prefix == "/" else [(prefix, value)]

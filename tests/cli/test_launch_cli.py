@@ -1,5 +1,6 @@
 """`fleetsim launch`: listing, exit status with --until-goals, clear errors."""
 
+import re
 from pathlib import Path
 
 import pytest
@@ -55,4 +56,4 @@ def test_until_goals_exits_nonzero_when_a_goal_fails(tmp_path: Path, capsys):
 def test_bad_invocations_are_one_line_errors(argv, message, capsys):
     assert main(argv) == 1
     err = capsys.readouterr().err
-    assert pytest.importorskip("re").search(message, err.replace("\n", " ")), err
+    assert re.search(message, err.replace("\n", " ")), err

@@ -4,7 +4,7 @@ import math
 
 import numpy as np
 import pytest
-from nav_world import KinematicRobot, fill, room_grid, room_map
+from nav_world import GLOBAL, LOCAL, KinematicRobot, fill, room_grid, room_map
 
 from fleetsim.msgs import geometry_msgs, nav_msgs, sensor_msgs, std_msgs
 from fleetsim.msgs.builtin_interfaces import Time
@@ -23,11 +23,6 @@ COMMON = {  # a costmap_common_params.yaml in the lesson's style (pre-Hydro form
     "observation_sources": "scan",
     "scan": {"data_type": "LaserScan", "topic": "scan", "marking": True, "clearing": True},
 }
-GLOBAL = {"global_frame": "/map", "robot_base_frame": "base_link", "update_frequency": 5.0,
-          "publish_frequency": 1.0, "static_map": True}  # fmt: skip
-LOCAL = {"global_frame": "odom", "robot_base_frame": "base_link", "update_frequency": 5.0,
-         "publish_frequency": 2.0, "static_map": False, "rolling_window": True,
-         "width": 3.0, "height": 3.0, "resolution": 0.05}  # fmt: skip
 
 
 class MapPub(Node):

@@ -12,8 +12,6 @@ from fleetsim.cli.bag import app
 from fleetsim.record import BagReader
 from fleetsim.record.remote import record_remote
 
-pytest.importorskip("fleetsim.transport")
-
 
 def _free_endpoint() -> str:
     with socket.socket() as s:

@@ -16,10 +16,6 @@ import pytest
 sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "benchmarks"))
 import barn
 
-pytestmark = pytest.mark.skipif(
-    not (barn.BARN_DIR / "world_3.world").is_file(), reason="BARN data not present"
-)
-
 
 def test_reference_path_and_metric_follow_the_readme():
     path = barn.path_from_grid(np.array([[0, 0], [30, 0]]))

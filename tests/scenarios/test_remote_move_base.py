@@ -128,8 +128,6 @@ def test_two_processes_each_host_half_the_robots_move_base():
 def test_a_launch_file_joins_a_running_simulation():
     """``fleetsim launch FILE --connect``: a robot spawned into the running simulation from
     another runtime, with its parameters in the simulation's tree and its tf from there."""
-    import threading
-
     from remote_nav_harness import PACKAGE
 
     from fleetsim.launch.runner import LaunchSession, load_plan
@@ -138,8 +136,7 @@ def test_a_launch_file_joins_a_running_simulation():
     with RunningSimulation(endpoint, {"robots": "1"}, rate=2.0) as sim:
         plan = load_plan(PACKAGE / "launch" / "join_robot.launch", {})
         with LaunchSession(plan, connect=endpoint) as joined:
-            stop = threading.Event()
-            joined.follow(joined.runtime.now() + 3.0, stop=stop)
+            joined.run(duration=3.0)
             assert "/lizi9/robot_state_publisher" in joined.nodes
             with SimulationClient(endpoint, timeout=5.0) as client:
                 # the plan's parameters went to the simulation's server

@@ -133,22 +133,16 @@ def run_launch(
 
 
 def follow_until_stopped(session, duration: float | None, until_goals: bool) -> None:
-    """Run a joined session with the simulation's clock until ``duration`` s of sim time have
-    passed, its goals are done, or SIGTERM arrives (a clean stop, as roslaunch's)."""
+    """Run a joined session until ``duration`` s of sim time have passed, its goals are done,
+    or SIGTERM arrives (a clean stop, as roslaunch's)."""
     import signal
     import threading
 
     stop = threading.Event()
     previous = signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    rt = session.runtime
-    end = None if duration is None else rt.now() + duration
-    console.print(f"joined at t = {rt.now():.1f} s; following the simulation's clock")
+    console.print(f"joined at t = {session.runtime.now():.1f} s; following the simulation's clock")
     try:
-        while not stop.is_set() and (end is None or rt.now() < end - 1e-9):
-            step = rt.now() + 0.5
-            session.follow(step if end is None else min(step, end), stop=stop)
-            if until_goals and session.monitor.all_goals_done():
-                break
+        session.run(duration, until_goals, stop=stop)
     finally:
         signal.signal(signal.SIGTERM, previous)
 

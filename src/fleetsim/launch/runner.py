@@ -107,17 +107,12 @@ class LaunchSession:
         if isinstance(tree, dict):
             rt.params.set("/", tree)
         own = self.plan.param_tree()
-        for name, value in leaves("/", own.get("/")):
-            rt.params.set(name, value)
-            request_param(session, keys, "set", name, value, timeout=5.0)
+        for name in own.names():
+            if name != "/":  # names() of an empty tree
+                value = own.get(name)
+                rt.params.set(name, value)
+                request_param(session, keys, "set", name, value, timeout=5.0)
         _log.info(f"joined the simulation at {endpoint} (t = {rt.now():.3f} s)")
-
-    def follow(self, until: float | None = None, stop: threading.Event | None = None) -> None:
-        """Joined sessions: run with the simulation's clock up to sim time ``until`` (None:
-        until ``stop`` is set or the simulation goes away, `TransportError`)."""
-        if self.connect is None:
-            raise LaunchError("follow() is for a session that joined a simulation (connect=...)")
-        self.bridge.run_following(until=until, stop=stop)
 
     def _start_node(self, spec: NodeSpec) -> None:
         if (spec.pkg, spec.type) in VIEWERS:
@@ -143,20 +138,32 @@ class LaunchSession:
             raise LaunchError(f"{spec.source}: node {spec.full_name} failed to start: {e}") from e
         self.nodes[spec.full_name] = node
 
-    def run(self, duration: float | None = None, until_goals: bool = False, rate=None) -> None:
-        """Run for ``duration`` s of sim time, or until every robot's goals are done."""
+    def run(
+        self,
+        duration: float | None = None,
+        until_goals: bool = False,
+        rate=None,
+        stop: threading.Event | None = None,
+    ) -> None:
+        """Run for ``duration`` s of sim time, or until every robot's goals are done.
+
+        A session that joined a simulation runs with its clock (``rate`` does not apply) and
+        may also run until ``stop`` is set (neither duration nor goals given) or the
+        simulation goes away (`TransportError`).
+        """
         until = self.monitor.all_goals_done if until_goals else None
-        if duration is None and until is None:
-            raise LaunchError("give a duration (--duration S) or --until-goals")
-        if self.connect is not None:
-            end = None if duration is None else self.runtime.now() + duration
-            while end is None or self.runtime.now() < end - 1e-9:
-                step = self.runtime.now() + 0.5
-                self.follow(step if end is None else min(step, end))
-                if until is not None and until():
-                    return
+        if self.connect is None:
+            if duration is None and until is None:
+                raise LaunchError("give a duration (--duration S) or --until-goals")
+            self.runtime.run(duration=duration, until=until, rate=rate)
             return
-        self.runtime.run(duration=duration, until=until, rate=rate)
+        rt = self.runtime
+        end = None if duration is None else rt.now() + duration
+        while not (stop is not None and stop.is_set()) and (end is None or rt.now() < end - 1e-9):
+            step = rt.now() + 0.5  # check the goals every half second of sim time
+            self.bridge.run_following(until=step if end is None else min(step, end), stop=stop)
+            if until is not None and until():
+                return
 
     def close(self) -> None:
         """Shut the run down; the recording is finalised whatever happened."""
@@ -192,14 +199,3 @@ class LaunchSession:
 
     def __exit__(self, *exc: object) -> None:
         self.close()
-
-
-def leaves(prefix: str, value) -> list[tuple[str, object]]:
-    """``(global name, value)`` of every leaf of a parameter namespace (dicts walked down; an
-    empty dict is a leaf)."""
-    if isinstance(value, dict) and value:
-        out = []
-        for k, v in value.items():
-            out += leaves(f"{prefix.rstrip('/')}/{k}", v)
-        return out
-    return [] if prefix == "/" else [(prefix, value)]

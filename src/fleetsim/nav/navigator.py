@@ -175,7 +175,7 @@ class _LocalBackend:
             rt.run(duration=timeout, until=until)
 
     def close(self) -> None:
-        pass
+        """Nothing to release: the nodes live in the caller's runtime."""
 
 
 class Navigator:

@@ -297,9 +297,13 @@ def _floor_material(spec) -> str:
 def add_sdf_model(spec: mujoco.MjSpec, m: ModelDesc, pose: Pose | None = None) -> list[str]:
     """Add an SDF model; returns its top-level body names (one per link, ``<model>/<link>``).
 
-    A static model adds no bodies: its geoms go straight into the world body (named
+    A static model adds no moving bodies: its geoms go straight into the world body (named
     ``<model>/<link>/...``), which MuJoCo's broad phase handles far faster than many static
-    bodies (a map world has thousands of wall boxes).
+    bodies (a map world has thousands of wall boxes). Planes are the exception: each gets a
+    static body of its own (``<geom name>:plane``), because MuJoCo collides the world body's
+    geoms with every moving body through one bounding-volume tree, and a plane's infinite
+    bounds would make every descent walk all the walls (100 robots in Willow: 0.4 ms of 1.3 ms
+    per step).
     """
     pose = pose if pose is not None else m.pose
     mq = quat_from_rpy(*pose[3:])
@@ -315,7 +319,10 @@ def add_sdf_model(spec: mujoco.MjSpec, m: ModelDesc, pose: Pose | None = None) -
         has_visual = any(not g.collide for g in link.geoms)
         if m.static:
             for i, g in enumerate(link.geoms):
-                add_geom(spec, spec.worldbody, g, True, f"{name}/", i, not has_visual, (lp, lq))
+                parent = spec.worldbody
+                if g.kind == "plane":
+                    parent = parent.add_body(name=f"{name}/{g.name or 'geom'}#{i}:plane")
+                add_geom(spec, parent, g, True, f"{name}/", i, not has_visual, (lp, lq))
             continue
         body = spec.worldbody.add_body(name=name, pos=lp, quat=lq)
         body.add_freejoint(name=f"{name}/free")

@@ -63,32 +63,6 @@ def load_world(
     return sdf.load_sdf_world(path)
 
 
-# geom attributes a plane keeps when it moves into a body of its own
-PLANE_ATTRS = (
-    "type", "size", "pos", "quat", "friction", "contype", "conaffinity", "condim", "priority",
-    "solmix", "solref", "solimp", "margin", "gap", "group", "rgba", "material", "castshadow",
-)  # fmt: skip
-
-
-def planes_into_own_bodies(spec: mujoco.MjSpec) -> None:
-    """Move the planes of the world body (ground planes) into static bodies of their own.
-
-    MuJoCo collides the world body's geoms with every moving body through one bounding-volume
-    tree. A plane's bounds are infinite, so with a plane in that tree every descent reaches the
-    leaves: with a map's thousands of wall boxes, each robot link paid for a deep walk through
-    the walls at every step (100 robots in Willow: 0.4 ms of 1.3 ms per step). A plane in a
-    static body of its own collides with each link directly; the walls' tree is then walked
-    only near the walls. The plane keeps its geom properties and name (the body is named
-    ``<geom name>:plane``).
-    """
-    for g in [g for g in spec.worldbody.geoms if g.type == mujoco.mjtGeom.mjGEOM_PLANE]:
-        body = spec.worldbody.add_body(name=f"{g.name}:plane")
-        attrs = {a: getattr(g, a) for a in PLANE_ATTRS}
-        name = g.name
-        spec.delete(g)
-        body.add_geom(name=name, **attrs)
-
-
 class Engine(StateQueries):
     """MuJoCo world plus models, plugins and sensor scheduling.
 
@@ -110,7 +84,6 @@ class Engine(StateQueries):
         self.wall_height = wall_height
         self.rng = rng if rng is not None else np.random.default_rng(0)
         self.spec, bodies = spec_from_world(self.world, timestep)
-        planes_into_own_bodies(self.spec)
         self.models: dict[str, ModelEntry] = {
             m.name: ModelEntry(m.name, "world", m.static, bodies[m.name], m.pose, desc=m)
             for m in self.world.models
@@ -122,6 +95,9 @@ class Engine(StateQueries):
         self.drives = DriveBatch()
         self.paused = False
         self.schedule = SensorSchedule()
+        #: constants of batched measurements (body ids, offsets, noise) per set of plugins,
+        #: keyed by (kind, plugin ids); body ids change with every compile, which clears it
+        self.layouts: dict[tuple, Any] = {}
         self._renderers: dict[tuple[int, int], mujoco.Renderer] = {}
         self._compile()
         self._qpos0 = self.data.qpos.copy()
@@ -138,6 +114,7 @@ class Engine(StateQueries):
             raise SimulationError(f"MuJoCo cannot compile the world: {exc}") from exc
         self.drives.sync_back()
         mujoco.mj_forward(self.model, self.data)
+        self.layouts.clear()
         self._index()
         for r in self._renderers.values():
             r.close()
@@ -259,7 +236,6 @@ class Engine(StateQueries):
         desc.name = name
         pose = tuple(float(v) for v in (pose if pose is not None else desc.pose))
         bodies = add_sdf_model(self.spec, desc, pose)
-        planes_into_own_bodies(self.spec)
         entry = ModelEntry(name, "sdf", desc.static, bodies, pose, desc=desc)
         self.models[name] = entry
         self._compile()

@@ -23,7 +23,7 @@ STATIC_CELL = 0.5  # m
 
 @dataclass
 class _Layout:
-    """Per-call constants of one set of lasers (cached until the next compile)."""
+    """Constants of one set of lasers (kept in ``Engine.layouts`` until the next compile)."""
 
     body: np.ndarray  # (L,) int64 link body ids
     pos: np.ndarray  # (L, 3) sensor origins in their links
@@ -75,11 +75,9 @@ class LaserBatch:
         self.occupancy = None
         self.walls: occupancy_cast.WallTiles | None = None
         self.wall_height = 0.0
-        self._layouts: dict[tuple[int, ...], _Layout] = {}
 
     def bind(self, engine) -> None:
         m = engine.model
-        self._layouts.clear()  # body ids change with every compile
         collide = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
         real = m.geom_type != mujoco.mjtGeom.mjGEOM_PLANE
         static = m.body_weldid[m.geom_bodyid] == 0
@@ -123,10 +121,10 @@ class LaserBatch:
 
     def measure(self, engine, lasers: list, t: float) -> list:
         """Readings of ``lasers`` (``LaserPlugin``) from one batched cast."""
-        key = tuple(map(id, lasers))
-        lay = self._layouts.get(key)
+        key = ("laser", *map(id, lasers))
+        lay = engine.layouts.get(key)
         if lay is None:
-            lay = self._layouts[key] = _Layout.of(lasers)
+            lay = engine.layouts[key] = _Layout.of(lasers)
         n = len(lasers)
         R = engine.data.xmat[lay.body].reshape(n, 3, 3)
         origins = engine.data.xpos[lay.body] + np.einsum("nij,nj->ni", R, lay.pos)

@@ -54,6 +54,19 @@ def _beam_offsets(ranges, bearings):
     return rc, rs
 
 
+@njit(cache=True, inline="always")
+def _laser_in_cells(particles, k, laser_pose, origin_x, origin_y, inv):
+    """Particle ``k``'s laser origin in (fractional) map cells and its heading's cosine and
+    sine scaled to cells per metre, so a beam endpoint is ``origin + R(heading) (rc, rs)``."""
+    c = math.cos(particles[k, 2])
+    s = math.sin(particles[k, 2])
+    sx = (particles[k, 0] + laser_pose[0] * c - laser_pose[1] * s - origin_x) * inv
+    sy = (particles[k, 1] + laser_pose[0] * s + laser_pose[1] * c - origin_y) * inv
+    ca = math.cos(particles[k, 2] + laser_pose[2]) * inv
+    sa = math.sin(particles[k, 2] + laser_pose[2]) * inv
+    return sx, sy, ca, sa
+
+
 @njit(cache=True)
 def endpoint_table_sums(
     particles, laser_pose, ranges, bearings, table, off_value, origin_x, origin_y, resolution
@@ -81,12 +94,7 @@ def endpoint_table_sums(
     inv = 1.0 / resolution
     out = np.empty(n)
     for k in range(n):
-        c = math.cos(particles[k, 2])
-        s = math.sin(particles[k, 2])
-        sx = (particles[k, 0] + laser_pose[0] * c - laser_pose[1] * s - origin_x) * inv
-        sy = (particles[k, 1] + laser_pose[0] * s + laser_pose[1] * c - origin_y) * inv
-        ca = math.cos(particles[k, 2] + laser_pose[2]) * inv
-        sa = math.sin(particles[k, 2] + laser_pose[2]) * inv
+        sx, sy, ca, sa = _laser_in_cells(particles, k, laser_pose, origin_x, origin_y, inv)
         acc = 0.0
         for m in range(rc.shape[0]):
             fx = sx + ca * rc[m] - sa * rs[m]
@@ -139,12 +147,7 @@ def endpoint_likelihoods(
     pz = np.empty((n, b))
     near = np.zeros(b, dtype=np.int64)
     for k in range(n):
-        c = math.cos(particles[k, 2])
-        s = math.sin(particles[k, 2])
-        sx = (particles[k, 0] + laser_pose[0] * c - laser_pose[1] * s - origin_x) * inv
-        sy = (particles[k, 1] + laser_pose[0] * s + laser_pose[1] * c - origin_y) * inv
-        ca = math.cos(particles[k, 2] + laser_pose[2]) * inv
-        sa = math.sin(particles[k, 2] + laser_pose[2]) * inv
+        sx, sy, ca, sa = _laser_in_cells(particles, k, laser_pose, origin_x, origin_y, inv)
         for m in range(b):
             fx = sx + ca * rc[m] - sa * rs[m]
             fy = sy + sa * rc[m] + ca * rs[m]

@@ -77,6 +77,18 @@ def _ahead_goal_dist(tp: TrajectoryPlanner, index: int) -> float | None:
     return None if cell is None else float(tp.goal_dist[cell[1], cell[0]])
 
 
+def _end_escape_when_clear(tp: TrajectoryPlanner, x: float, y: float, th: float) -> None:
+    """Stop escaping once the robot is escape_reset_dist or escape_reset_theta away from
+    where the escape began."""
+    ex, ey, eth = tp.escape_pose
+    dth = abs((eth - th + math.pi) % (2 * math.pi) - math.pi)
+    if (
+        math.hypot(x - ex, y - ey) > tp.params.escape_reset_dist
+        or dth > tp.params.escape_reset_theta
+    ):
+        tp.escaping = False
+
+
 def _bookkeep(tp: TrajectoryPlanner, sample, pose) -> None:
     """Oscillation flags and escape reset after a legal choice."""
     vx, vy, vth = sample
@@ -101,13 +113,7 @@ def _bookkeep(tp: TrajectoryPlanner, sample, pose) -> None:
         tp.prev = (x, y)
     if math.hypot(x - tp.prev[0], y - tp.prev[1]) > tp.params.oscillation_reset_dist:
         tp._reset_oscillation_flags()
-    ex, ey, eth = tp.escape_pose
-    dth = abs((eth - th + math.pi) % (2 * math.pi) - math.pi)
-    if (
-        math.hypot(x - ex, y - ey) > tp.params.escape_reset_dist
-        or dth > tp.params.escape_reset_theta
-    ):
-        tp.escaping = False
+    _end_escape_when_clear(tp, x, y, th)
 
 
 def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
@@ -158,13 +164,7 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
     if not tp.escaping and cost > -2.0:
         tp.escape_pose = (x, y, th)
         tp.escaping = True
-    ex, ey, eth = tp.escape_pose
-    dth = abs((eth - th + math.pi) % (2 * math.pi) - math.pi)
-    if (
-        math.hypot(x - ex, y - ey) > tp.params.escape_reset_dist
-        or dth > tp.params.escape_reset_theta
-    ):
-        tp.escaping = False
+    _end_escape_when_clear(tp, x, y, th)
     if cost == -1.0:
         cost = 1.0
     return tuple(samples[i]), cost, i

@@ -218,20 +218,22 @@ class ObstacleLayer(CostmapLayer):
             poly = footprint_at(lc.footprint, robot_x, robot_y, robot_yaw)
             bounds.include(*poly.min(axis=0), *poly.max(axis=0))
 
+    def marking_points(self, obs: Observation) -> tuple[np.ndarray, np.ndarray]:
+        """The points of ``obs`` that mark: within obstacle_range, under max_obstacle_height
+        and on the grid; returns them (K, 3) and their cells (K, 2) (x, y indices)."""
+        pts = obs.points
+        d2 = ((pts - obs.origin) ** 2).sum(axis=1)
+        pts = pts[(pts[:, 2] <= self.params.max_obstacle_height) & (d2 < obs.obstacle_range**2)]
+        cells, inside = self.grid.cells_of(pts[:, :2])
+        return pts[inside], cells[inside]
+
     def mark(self, obs: Observation, bounds: Bounds) -> None:
         """Set the cells of points within range and under max_obstacle_height to LETHAL."""
-        pts = obs.points
-        if pts.shape[0] == 0:
-            return
-        d2 = ((pts - obs.origin) ** 2).sum(axis=1)
-        keep = (pts[:, 2] <= self.params.max_obstacle_height) & (d2 < obs.obstacle_range**2)
-        cells, inside = self.grid.cells_of(pts[keep, :2])
-        cells = cells[inside]
+        pts, cells = self.marking_points(obs)
         if cells.shape[0] == 0:
             return
         self.grid.costs[cells[:, 1], cells[:, 0]] = LETHAL_OBSTACLE
-        lo = pts[keep][inside, :2].min(axis=0)
-        hi = pts[keep][inside, :2].max(axis=0)
+        lo, hi = pts[:, :2].min(axis=0), pts[:, :2].max(axis=0)
         bounds.include(lo[0], lo[1], hi[0], hi[1])
 
     def raytrace_freespace(self, obs: Observation, bounds: Bounds) -> None:

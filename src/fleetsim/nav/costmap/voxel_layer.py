@@ -144,14 +144,7 @@ class VoxelLayer(ObstacleLayer):
         super().update_bounds(robot_x, robot_y, robot_yaw, bounds)
 
     def mark(self, obs: Observation, bounds: Bounds) -> None:
-        pts = obs.points
-        if pts.shape[0] == 0:
-            return
-        d2 = ((pts - obs.origin) ** 2).sum(axis=1)
-        keep = (pts[:, 2] <= self.params.max_obstacle_height) & (d2 < obs.obstacle_range**2)
-        pts = pts[keep]
-        cells, inside = self.grid.cells_of(pts[:, :2])
-        cells, pts = cells[inside], pts[inside]
+        pts, cells = self.marking_points(obs)
         if cells.shape[0] == 0:
             return
         bits = (1 << self._z_index(pts[:, 2]).astype(np.int64)).astype(np.uint16)

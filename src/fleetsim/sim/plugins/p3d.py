@@ -121,13 +121,10 @@ class P3dPlugin(SensorPlugin):
 
     @staticmethod
     def _layout(engine, plugins: list) -> tuple:
-        """Body ids, root ids, offsets, offset quaternions and noise of ``plugins``: constant
-        until the next compile (a new model), so kept per plugin set until then."""
-        cache = engine.__dict__.setdefault("_p3d_layouts", {})
-        if cache.get("model") is not engine.model:
-            cache.clear()
-            cache["model"] = engine.model
-        key = tuple(map(id, plugins))
+        """Body ids, root ids, offsets, offset quaternions and noise of ``plugins`` (kept in
+        ``Engine.layouts`` until the next compile)."""
+        cache = engine.layouts
+        key = ("p3d", *map(id, plugins))
         lay = cache.get(key)
         if lay is None:
             n = len(plugins)

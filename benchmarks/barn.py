@@ -3,7 +3,7 @@
 Each run is the shipped scenario ``fleetsim_launch/barn.launch`` (args ``world:=N``,
 ``barn_dir:=...``) in process, headless, no bridge: the jackal spawned at the start pose
 (-2.25, 3.0, yaw 1.57), move_base on laser-only costmaps, send_goals sending the goal
-(-2.25, 13.0). The protocol of /work/shared/data/barn/README.md:
+(-2.25, 13.0). The protocol of ../shared/data/barn/README.md:
 
 - success: the ground-truth position (``/jackal/ground_truth/state``, the simulator's p3d) within
   1.0 m of the goal;
@@ -41,7 +41,10 @@ from fleetsim.launch.runner import LaunchSession, load_plan
 from fleetsim.msgs import nav_msgs
 from fleetsim.runtime import Node
 
-BARN_DIR = Path("/work/shared/data/barn")
+#: the shared data folder beside the repository (../shared from its root)
+SHARED = Path(__file__).resolve().parents[1].parent / "shared"
+
+BARN_DIR = Path(SHARED, "data/barn")
 LAUNCH = ASSETS / "launch" / "barn.launch"
 START = (-2.25, 3.0)
 GOAL = (-2.25, 13.0)

@@ -5,6 +5,7 @@ robot radius 0.15. Prints the time per compute_velocity_commands (target <= 5 ms
 """
 
 import time
+from pathlib import Path
 
 import numpy as np
 
@@ -13,9 +14,12 @@ from fleetsim.nav.costmap import LayeredCostmap
 from fleetsim.nav.map_io import load_map
 from fleetsim.nav.planners import NavFn
 
+#: the shared data folder beside the repository (../shared from its root)
+SHARED = Path(__file__).resolve().parents[1].parent / "shared"
+
 
 def main() -> None:
-    m = load_map("/work/shared/data/maps/willow-full.yaml")
+    m = load_map(str(SHARED / "data/maps/willow-full.yaml"))
     glob = LayeredCostmap.from_params({"robot_radius": 0.15, "observation_sources": ""}, "g")
     glob.set_map(m)
     glob.update_map(0, 0, 0)

@@ -26,8 +26,11 @@ from scipy import ndimage
 from fleetsim.description import load_robot
 from fleetsim.sim import Engine
 
+#: the shared data folder beside the repository (../shared from its root)
+SHARED = Path(__file__).resolve().parents[1].parent / "shared"
+
 ROOT = Path(__file__).resolve().parent.parent
-WILLOW = Path("/work/shared/data/maps/willow-full.yaml")
+WILLOW = Path(SHARED, "data/maps/willow-full.yaml")
 ROBOT = ROOT / "tests" / "sim" / "fixtures" / "diffbot.urdf"
 
 

@@ -1,11 +1,16 @@
 """`fleetsim sim snapshot` writes a picture of a world."""
 
+from pathlib import Path
+
 import numpy as np
 from PIL import Image
 from typer.testing import CliRunner
 
 from fleetsim.cli.sim import _robot_option, app
 from fleetsim.errors import SimulationError
+
+#: the shared data folder beside the repository (../shared from its root)
+SHARED = Path(__file__).resolve().parents[2].parent / "shared"
 
 FIXTURE = "tests/sim/fixtures/diffbot.urdf"
 
@@ -16,7 +21,7 @@ def test_snapshot_of_a_barn_world_with_a_robot(tmp_path):
         app,
         [
             "snapshot",
-            "/work/shared/data/barn/world_3.world",
+            str(SHARED / "data/barn/world_3.world"),
             "-o",
             str(out),
             "--width",

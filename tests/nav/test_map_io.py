@@ -15,7 +15,10 @@ from fleetsim.nav.map_io import (
     save_map,
 )
 
-WILLOW = Path("/work/shared/data/maps/willow-full.yaml")
+#: the shared data folder beside the repository (../shared from its root)
+SHARED = Path(__file__).resolve().parents[2].parent / "shared"
+
+WILLOW = Path(SHARED, "data/maps/willow-full.yaml")
 
 
 def test_willow_loads_with_origin_row_first():

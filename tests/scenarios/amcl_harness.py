@@ -38,7 +38,10 @@ from fleetsim.sim.node import Simulator
 from fleetsim.tf import TransformBroadcaster, make_transform_stamped
 from fleetsim.tf.static_transform_publisher import StaticTransformPublisher
 
-WILLOW = Path("/work/shared/data/maps/willow-full.yaml")
+#: the shared data folder beside the repository (../shared from its root)
+SHARED = Path(__file__).resolve().parents[2].parent / "shared"
+
+WILLOW = Path(SHARED, "data/maps/willow-full.yaml")
 LIZI_XACRO = (
     Path(__file__).resolve().parents[2] / "src/fleetsim/assets/robots/lizi/urdf/lizi.urdf.xacro"
 )

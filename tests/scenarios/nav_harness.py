@@ -20,7 +20,10 @@ from fleetsim.msgs import nav_msgs
 from fleetsim.nav.map_io import OccupancyMap
 from fleetsim.runtime import Node
 
-WILLOW = Path("/work/shared/data/maps/willow-full.yaml")
+#: the shared data folder beside the repository (../shared from its root)
+SHARED = Path(__file__).resolve().parents[2].parent / "shared"
+
+WILLOW = Path(SHARED, "data/maps/willow-full.yaml")
 PACKAGE = Path(__file__).resolve().parent / "willow_nav"
 LAUNCH = PACKAGE / "launch" / "navigation_multi.launch"
 CONFIG = PACKAGE / "move_base_config"

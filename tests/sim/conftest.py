@@ -7,11 +7,14 @@ from pathlib import Path
 
 import pytest
 
+#: the shared data folder beside the repository (../shared from its root)
+SHARED = Path(__file__).resolve().parents[2].parent / "shared"
+
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 FIXTURES = Path(__file__).parent / "fixtures"
-BARN = Path("/work/shared/data/barn/world_3.world")
-WILLOW = Path("/work/shared/data/maps/willow-full.yaml")
+BARN = Path(SHARED, "data/barn/world_3.world")
+WILLOW = Path(SHARED, "data/maps/willow-full.yaml")
 
 
 @pytest.fixture(scope="session")

@@ -57,6 +57,19 @@ def test_world_odometry_source_is_the_true_pose():
     np.testing.assert_allclose(odom.position, truth.position, atol=1e-9)
 
 
+def test_odometry_source_defaults_to_world_as_gazebo():
+    """gazebo_ros_diff_drive (Kinetic to Noetic: ``odometrySource`` default WORLD; ROS 2:
+    ``odometry_source`` default 1, world) reports the true pose unless told ``encoder``."""
+    text = robot_text("diffbot.urdf").replace("<odometrySource>encoder</odometrySource>", "")
+    assert "odometrySource" not in text
+    e = Engine(None)
+    r = e.spawn_robot("r", parse_urdf(text), (1.0, 2.0, 0, 0, 0, 0.5))
+    readings = run(e, r, [(0.3, 0.6, 1.0)])
+    odom, truth = last(readings, "odom"), last(readings, "base_pose_ground_truth")
+    np.testing.assert_allclose(odom.position, truth.position, atol=1e-9)
+    assert yaw_of(odom.orientation) == pytest.approx(yaw_of(truth.orientation), abs=1e-9)
+
+
 def test_torque_limit_bounds_acceleration():
     weak = robot_text("diffbot.urdf").replace("<wheelTorque>1<", "<wheelTorque>0.05<")
     e = Engine(None)

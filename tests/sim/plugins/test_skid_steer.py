@@ -1,5 +1,5 @@
-"""Skid steer: straight runs track the truth, turning slips as Coulomb friction predicts,
-and odometry drifts."""
+"""Skid steer: straight runs track the truth, turning slips as Coulomb friction predicts;
+odometry is the true world pose (as Gazebo's plugin), encoder odometry (opt-in) drifts."""
 
 import math
 from pathlib import Path
@@ -7,17 +7,52 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fleetsim.description import load_robot
+from fleetsim.description import load_robot, parse_urdf
+from fleetsim.description.urdf import urdf_text
+from fleetsim.errors import FleetsimError
 from fleetsim.sim import Engine
 from fleetsim.sim.build import rpy_from_quat
 from fleetsim.sim.plugins.base import DrivePlugin, OdometryReading
 
+from ..conftest import replace_plugin_param, robot_text
 from .test_diff_drive import last, run, yaw_of
 
+ENCODER = "<broadcastTF>1</broadcastTF><odometrySource>encoder</odometrySource>"
 
-def test_skid_steer_odometry_drifts_when_turning(skidbot):
+
+def with_encoder_odometry(text: str) -> str:
+    return replace_plugin_param(text, "<broadcastTF>1</broadcastTF>", ENCODER)
+
+
+def test_skid_steer_odometry_is_the_world_pose_by_default(skidbot):
+    """gazebo_ros_skid_steer_drive publishes ``parent->WorldPose()``: no drift, no slip, and
+    the pose is in the world, not relative to where the robot started."""
     e = Engine(None)
-    r = e.spawn_robot("jackal", skidbot, (0, 0, 0.1, 0, 0, 0))
+    r = e.spawn_robot("jackal", skidbot, (1.0, -2.0, 0.1, 0, 0, 0.7))
+    readings = run(e, r, [(0.5, 0.0, 1.0), (0.2, 0.8, 2.0)])
+    odom, truth = last(readings, "odom"), last(readings, "base_pose_ground_truth")
+    assert odom.frame_id == "jackal/odom" and odom.child_frame_id == "jackal/base_link"
+    assert yaw_of(truth.orientation) - 0.7 > 0.15  # it turned, and its wheels scrubbed
+    np.testing.assert_allclose(odom.position, truth.position, atol=1e-9)
+    assert yaw_of(odom.orientation) == pytest.approx(yaw_of(truth.orientation), abs=1e-9)
+    assert odom.angular[2] == pytest.approx(truth.angular[2], abs=1e-4)
+    assert [w.number for w in e.data.warning] == [0] * len(e.data.warning)  # MuJoCo warnings
+
+
+def test_skid_steer_odometry_source_is_validated():
+    text = replace_plugin_param(
+        robot_text("skidbot.urdf"),
+        "<broadcastTF>1</broadcastTF>",
+        "<broadcastTF>1</broadcastTF><odometrySource>wheels</odometrySource>",
+    )
+    with pytest.raises(FleetsimError, match="odometrySource.*wheels"):
+        Engine(None).spawn_robot("jackal", parse_urdf(text))
+
+
+def test_skid_steer_encoder_odometry_drifts_when_turning():
+    e = Engine(None)
+    robot = parse_urdf(with_encoder_odometry(robot_text("skidbot.urdf")))
+    r = e.spawn_robot("jackal", robot, (0, 0, 0.1, 0, 0, 0))
     assert [type(p).__name__ for p in r.plugins] == ["SkidSteerPlugin", "P3dPlugin"]
     readings = run(e, r, [(0.5, 0.0, 2.0)])
     odom, truth = last(readings, "odom"), last(readings, "base_pose_ground_truth")
@@ -37,9 +72,15 @@ def test_skid_steer_odometry_drifts_when_turning(skidbot):
 ROBOTS = Path(__file__).resolve().parents[3] / "src" / "fleetsim" / "assets" / "robots"
 
 
-def spawn(name):
+def spawn(name, encoder=False):
     e = Engine(None)
-    entry = e.spawn_robot("r", load_robot(ROBOTS / name / "urdf" / f"{name}.urdf.xacro"))
+    path = ROBOTS / name / "urdf" / f"{name}.urdf.xacro"
+    if encoder:
+        text = with_encoder_odometry(urdf_text(path, None, None)[0])
+        robot = parse_urdf(text, str(path), base_dir=path.parent)
+    else:
+        robot = load_robot(path)
+    entry = e.spawn_robot("r", robot)
     return e, next(p for p in entry.plugins if isinstance(p, DrivePlugin))
 
 
@@ -106,9 +147,9 @@ def test_diff_drive_robot_still_tracks_its_commands(name):
 
 
 def test_encoder_odometry_reports_the_commanded_rotation():
-    """Wheel odometry assumes rolling wheels, so it reports about 1/0.57 of lizi's true
-    rotation in place (the slip factor documented in the plugin)."""
-    e, plugin = spawn("lizi")
+    """Wheel odometry (``odometrySource encoder``) assumes rolling wheels, so it reports about
+    1/0.57 of lizi's true rotation in place (the slip factor documented in the plugin)."""
+    e, plugin = spawn("lizi", encoder=True)
     e.advance(0.2)
     readings = []
     for _ in range(60):

@@ -11,8 +11,11 @@ state): lizi 0.57 in place (1.0 and 0.4 rad/s) and 0.52 on a 0.3 m/s, 0.5 rad/s 
 0.60); pioneer3at 0.65-0.68 (Coulomb 0.68); jackal 0.65-0.69 (Coulomb 0.67). Straight runs
 keep the commanded speed.
 
-Encoder odometry (the mean angle of each side's wheels, as the Gazebo plugin's wheel
-odometry) assumes rolling wheels, so it reports the commanded rotation: about 1/0.57 = 1.75x
+Odometry follows the Gazebo plugin: ``gazebo_ros_skid_steer_drive`` has no choice and reports
+the model's true world pose (``parent->WorldPose()``) and world velocity, so its odometry
+neither drifts nor slips. ``odometrySource encoder`` (a fleetsim addition, with the diff
+drive's parameter name) reports wheel odometry instead, from the mean angle of each side's
+wheels; it assumes rolling wheels, so it reports the commanded rotation: about 1/0.57 = 1.75x
 lizi's true rotation, 1.5x pioneer3at's and jackal's, and it drifts. Compare it with p3d ground
 truth; the torque also spins the held rotor, so a low ``torque`` slows starts.
 """
@@ -40,6 +43,12 @@ class SkidSteerParams:
     odometryFrame: str = param("odom", help="odometry frame (tf_prefix applied)")
     robotBaseFrame: str = param("base_footprint", help="child frame of the odometry")
     broadcastTF: bool = param(False, help="broadcast odom -> base on /tf")
+    odometrySource: str = param(
+        "world",
+        choices=("world", "encoder"),
+        help="world: true pose, as the Gazebo plugin (which has no choice); "
+        "encoder: integrated wheel angles with slip (fleetsim addition)",
+    )
     updateRate: float = param(100.0, unit="Hz", range=(0.0, None), help="odometry rate")
     covariance_x: float = param(0.0001, help="odometry x covariance")
     covariance_y: float = param(0.0001, help="odometry y covariance")
@@ -65,6 +74,6 @@ class SkidSteerPlugin(WheeledDrive):
         self.right = [p.rightFrontJoint, p.rightRearJoint]
         self.torque = p.torque
         self.accel = 0.0
-        self.encoder = True
+        self.encoder = p.odometrySource == "encoder"
         self.publish_tf = p.broadcastTF
         self._setup()

@@ -1,10 +1,15 @@
-"""The run monitor counts goals for robots whose move_base is not in the launch plan."""
+"""The run monitor counts goals for robots whose move_base is not in the launch plan, and
+counts a goal as reached only when the simulator's ground truth agrees."""
 
 import os
 from pathlib import Path
 
+import pytest
+
+from fleetsim.cli.launch import results_table
+from fleetsim.launch.monitor import DEFAULT_XY_GOAL_TOLERANCE, GOAL_MARGIN
 from fleetsim.launch.runner import LaunchSession, load_plan
-from fleetsim.msgs import actionlib_msgs, move_base_msgs
+from fleetsim.msgs import actionlib_msgs, geometry_msgs, move_base_msgs
 from fleetsim.runtime import Node
 
 #: the simulator and one lizi, no move_base: it would run in another process (node run)
@@ -34,7 +39,7 @@ def test_a_spawned_robot_without_move_base_in_the_plan_has_its_goals_counted(tmp
         goal_pub = stand_in.create_publisher(mb.ActionGoal, "move_base/goal", 1)
         result_pub = stand_in.create_publisher(mb.ActionResult, "move_base/result", 1)
         assert not s.monitor.all_goals_done()
-        goal_pub.publish(mb.ActionGoal(goal_id=actionlib_msgs.GoalID(id="g1")))
+        goal_pub.publish(action_goal("g1", 1.0, 2.0))  # where the robot stands
         s.runtime.run(duration=0.1)
         r = {r.namespace: r for r in s.monitor.results()}["/lizi1"]
         assert (r.model, r.goals_sent, r.goals_reached) == ("lizi1", 1, 0)
@@ -46,3 +51,109 @@ def test_a_spawned_robot_without_move_base_in_the_plan_has_its_goals_counted(tmp
         s.runtime.run(duration=0.1)
         assert (r.goals_sent, r.goals_reached, r.goals_failed) == (1, 1, 0)
         assert s.monitor.all_goals_done() and s.monitor.success()
+
+
+def action_goal(goal_id: str, x: float, y: float, frame: str = "map"):
+    mb = move_base_msgs.MoveBase
+    target = geometry_msgs.PoseStamped()
+    target.header.frame_id = frame
+    target.pose.position.x, target.pose.position.y = x, y
+    target.pose.orientation.w = 1.0
+    return mb.ActionGoal(
+        goal_id=actionlib_msgs.GoalID(id=goal_id), goal=mb.Goal(target_pose=target)
+    )
+
+
+def status(goal_id: str, code: int, text: str = ""):
+    return actionlib_msgs.GoalStatus(
+        goal_id=actionlib_msgs.GoalID(id=goal_id), status=code, text=text
+    )
+
+
+@pytest.fixture
+def robot_session(tmp_path: Path):
+    """A session with lizi1 at (1, 2) and a stand-in for its remote move_base."""
+    os.environ.setdefault("MUJOCO_GL", "egl")
+    f = tmp_path / "robot_only.launch"
+    f.write_text(ROBOT_ONLY)
+    with LaunchSession(load_plan(f), seed=1) as s:
+        s.runtime.run(duration=0.3)
+        mb = move_base_msgs.MoveBase
+        stand_in = Node(s.runtime, "move_base", "/lizi1")
+        pubs = (
+            stand_in.create_publisher(mb.ActionGoal, "move_base/goal", 1),
+            stand_in.create_publisher(mb.ActionResult, "move_base/result", 1),
+        )
+        yield s, pubs
+
+
+def test_a_succeeded_result_that_ground_truth_contradicts_fails_the_run(robot_session):
+    s, (goal_pub, result_pub) = robot_session
+    mb = move_base_msgs.MoveBase
+    goal_pub.publish(action_goal("far", 23.0, 2.0))  # 22 m from where lizi1 stands
+    s.runtime.run(duration=0.1)
+    result_pub.publish(mb.ActionResult(status=status("far", 3, "Goal reached.")))
+    s.runtime.run(duration=0.1)
+    r = {r.namespace: r for r in s.monitor.results()}["/lizi1"]
+    assert (r.goals_sent, r.goals_reached, r.goals_unconfirmed) == (1, 0, 1)
+    assert r.last_text == "reported reached, 22.0 m away by ground truth"
+    assert r.distance_to_goal == pytest.approx(22.0, abs=0.05)
+    assert r.localization_error is None  # nothing publishes map here
+    assert s.monitor.all_goals_done() and not s.monitor.success()
+    text = str([list(c.cells) for c in results_table(s.monitor).columns])
+    assert "reported reached, 22.0 m away by ground truth" in text and "22.00" in text
+
+
+def test_ground_truth_within_tolerance_plus_margin_confirms_the_goal(robot_session):
+    s, (goal_pub, result_pub) = robot_session
+    mb = move_base_msgs.MoveBase
+    near = DEFAULT_XY_GOAL_TOLERANCE + GOAL_MARGIN - 0.05
+    goal_pub.publish(action_goal("near", 1.0 + near, 2.0))
+    s.runtime.run(duration=0.1)
+    result_pub.publish(mb.ActionResult(status=status("near", 3, "Goal reached.")))
+    s.runtime.run(duration=0.1)
+    r = {r.namespace: r for r in s.monitor.results()}["/lizi1"]
+    assert (r.goals_reached, r.goals_unconfirmed) == (1, 0)
+    assert r.goal_tolerance == pytest.approx(DEFAULT_XY_GOAL_TOLERANCE + GOAL_MARGIN)
+    assert r.distance_to_goal == pytest.approx(near, abs=0.02)
+    assert s.monitor.success()
+
+
+def test_the_goal_tolerance_comes_from_the_local_planner_parameters(robot_session):
+    s, (goal_pub, result_pub) = robot_session
+    mb = move_base_msgs.MoveBase
+    s.runtime.params.set("/lizi1/move_base/base_local_planner", "dwa_local_planner/DWAPlannerROS")
+    s.runtime.params.set("/lizi1/move_base/DWAPlannerROS/xy_goal_tolerance", 1.0)
+    goal_pub.publish(action_goal("g", 2.0, 2.0))  # 1 m away: within 1.0 + margin
+    s.runtime.run(duration=0.1)
+    result_pub.publish(mb.ActionResult(status=status("g", 3)))
+    s.runtime.run(duration=0.1)
+    r = {r.namespace: r for r in s.monitor.results()}["/lizi1"]
+    assert r.goal_tolerance == pytest.approx(1.0 + GOAL_MARGIN)
+    assert (r.goals_reached, r.goals_unconfirmed) == (1, 0)
+
+
+def test_a_goal_in_an_unknown_frame_is_not_confirmed(robot_session):
+    s, (goal_pub, result_pub) = robot_session
+    mb = move_base_msgs.MoveBase
+    goal_pub.publish(action_goal("g", 1.0, 2.0, frame="nowhere"))
+    s.runtime.run(duration=0.1)
+    result_pub.publish(mb.ActionResult(status=status("g", 3)))
+    s.runtime.run(duration=0.1)
+    r = {r.namespace: r for r in s.monitor.results()}["/lizi1"]
+    assert r.goals_unconfirmed == 1 and "does not resolve" in r.last_text
+    assert not s.monitor.success()
+
+
+def test_the_localization_error_compares_map_to_base_with_ground_truth(robot_session):
+    """A localizer that is 0.5 m off (here a static map -> odom) shows as a 0.5 m error."""
+    from fleetsim.tf import StaticTransformBroadcaster, make_transform_stamped
+
+    s, _ = robot_session
+    localizer = Node(s.runtime, "localizer", "/lizi1")
+    StaticTransformBroadcaster(localizer).send_transform(
+        make_transform_stamped("map", "lizi1/odom", 0.0, (0.5, 0.0, 0.0))
+    )
+    s.runtime.run(duration=0.2)
+    r = {r.namespace: r for r in s.monitor.results()}["/lizi1"]
+    assert r.localization_error == pytest.approx(0.5, abs=0.01)

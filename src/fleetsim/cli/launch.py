@@ -2,7 +2,9 @@
 
 Shows a progress bar (sim time, real-time factor) and, at the end, a results table per robot.
 With ``--until-goals`` the run ends when every robot's goals are done, and the exit status is 0
-only if all were reached without a collision.
+only if all were reached without a collision. A goal counts as reached only when the
+simulator's ground truth agrees (`fleetsim.launch.monitor`); the table shows each robot's
+ground-truth distance to its last goal and, where a localizer publishes ``map``, its error.
 """
 
 from __future__ import annotations
@@ -52,9 +54,39 @@ def parse_launch_args(items: list[str]) -> dict[str, str]:
     return out
 
 
+UNTIL_GOALS_HELP = (
+    "Stop when every robot's goals are done. Goals are the move_base action goals "
+    "(<ns>/move_base/goal) of every robot, from any sender: send_goals nodes in the launch file, "
+    "'fleetsim goal', user nodes, other processes over the bridge; the run also waits for "
+    "send_goals nodes to send all theirs. Exit status 0 only if each goal was reached by "
+    "ground truth (within the local planner's xy_goal_tolerance plus the margin the results "
+    "table states) without a collision."
+)
+
+
+def _metres(value: float | None) -> str:
+    return "-" if value is None else f"{value:.2f}"
+
+
 def results_table(monitor) -> Table:
-    t = Table(title="results")
-    for col in ("robot", "goals reached", "time [s]", "path [m]", "collisions", "last status"):
+    from fleetsim.launch.monitor import GOAL_MARGIN
+
+    t = Table(
+        title="results",
+        caption=f"goal reached: move_base SUCCEEDED and ground truth within the local planner's "
+        f"xy_goal_tolerance + {GOAL_MARGIN:g} m of the goal",
+    )
+    columns = (
+        "robot",
+        "goals reached",
+        "time [s]",
+        "path [m]",
+        "collisions",
+        "to goal [m] (truth)",
+        "loc. error [m]",
+        "last status",
+    )
+    for col in columns:
         t.add_column(col)
     for r in monitor.results():
         t.add_row(
@@ -63,6 +95,8 @@ def results_table(monitor) -> Table:
             "-" if r.time_of_last_result is None else f"{r.time_of_last_result:.1f}",
             f"{r.path_length:.1f}",
             str(r.collisions),
+            _metres(r.distance_to_goal),
+            _metres(r.localization_error),
             r.last_text or "-",
         )
     return t
@@ -155,7 +189,7 @@ def register(app: typer.Typer) -> None:
         ),
         args: list[str] = typer.Argument(None, help="Launch arguments name:=value."),
         duration: float = typer.Option(None, "--duration", help="Sim seconds to run."),
-        until_goals: bool = typer.Option(False, "--until-goals", help="Stop when goals are done."),
+        until_goals: bool = typer.Option(False, "--until-goals", help=UNTIL_GOALS_HELP),
         record: str = typer.Option(None, "--record", help="Record every topic to this MCAP file."),
         viz: bool = typer.Option(False, "--viz", help="Serve the live view to Foxglove."),
         realtime: bool = typer.Option(False, "--realtime", help="Pace the run to the wall clock."),

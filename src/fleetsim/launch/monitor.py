@@ -6,21 +6,39 @@ node), and samples the simulator's ground truth for path length and contacts. It
 namespace of every move_base in the plan and of every robot the simulator spawns, so a robot
 whose move_base runs in another process (``fleetsim node run``, over the Zenoh bridge) is
 counted too.
+
+A goal counts as reached only when the simulator's ground truth agrees: when move_base reports
+SUCCEEDED, the robot's true position must be within the local planner's ``xy_goal_tolerance``
+(read from the parameter tree, default 0.1 m) plus `GOAL_MARGIN` of the goal. A SUCCEEDED
+result that ground truth contradicts (or that no ground truth can confirm) is counted as
+unconfirmed and fails the run. Ground truth is the engine when the simulator runs in this
+process, else the latest ``/gazebo/model_states`` (the model named as the namespace).
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
+from fleetsim.errors import FleetsimError
 from fleetsim.launch.model import LaunchPlan
-from fleetsim.msgs import actionlib_msgs, move_base_msgs
+from fleetsim.msgs import actionlib_msgs, gazebo_msgs, move_base_msgs
 from fleetsim.runtime import names
+from fleetsim.tf.transforms import transform_points
 
 SAMPLE_PERIOD = 0.1  # s of sim time between ground-truth samples
 #: a contact with the same partner within this long of the last one is the same collision
 COLLISION_GAP = 1.0  # s
+#: m beyond the goal tolerance that ground truth may put a robot whose goal move_base reports
+#: reached: move_base stops within the tolerance of the goal as *localized*, and a working
+#: localizer is off by centimetres to a decimetre or two (amcl's particle spread)
+GOAL_MARGIN = 0.25
+#: base_local_planner's (and dwa_local_planner's) ``xy_goal_tolerance`` default, m
+DEFAULT_XY_GOAL_TOLERANCE = 0.1
+DEFAULT_LOCAL_PLANNER = "base_local_planner/TrajectoryPlannerROS"
+#: goal frames that are the simulator's world frame (fleetsim's ``map`` is the world)
+WORLD_FRAMES = ("", "map", "world")
 
 
 @dataclass
@@ -34,14 +52,31 @@ class RobotResult:
     path_length: float = 0.0
     collisions: int = 0
     last_text: str = ""
+    #: SUCCEEDED results whose goal ground truth did not confirm (too far, or no ground truth)
+    goals_unconfirmed: int = 0
+    #: the latest goal, x, y in the map (world) frame, m; None if its frame did not resolve
+    goal: tuple[float, float] | None = None
+    #: m, ground truth within this of ``goal`` confirms a SUCCEEDED result
+    goal_tolerance: float = DEFAULT_XY_GOAL_TOLERANCE + GOAL_MARGIN
+    #: m, ground-truth distance to ``goal`` (at the last `RunMonitor.results`)
+    distance_to_goal: float | None = None
+    #: m, map -> base tf against ground truth, where a localizer publishes map (else None)
+    localization_error: float | None = None
+    goals_by_id: dict[str, tuple[float, float] | None] = field(default_factory=dict, repr=False)
 
     @property
     def all_done(self) -> bool:
-        return self.goals_sent > 0 and self.goals_reached + self.goals_failed >= self.goals_sent
+        finished = self.goals_reached + self.goals_failed + self.goals_unconfirmed
+        return self.goals_sent > 0 and finished >= self.goals_sent
 
     @property
     def ok(self) -> bool:
-        return self.goals_failed == 0 and self.collisions == 0 and self.all_done
+        return (
+            self.goals_failed == 0
+            and self.goals_unconfirmed == 0
+            and self.collisions == 0
+            and self.all_done
+        )
 
 
 class RunMonitor:
@@ -53,9 +88,17 @@ class RunMonitor:
         self.senders = [n for n in nodes.values() if getattr(n, "sends_goals", False)]
         self.sim = next((n for n in nodes.values() if hasattr(n, "engine")), None)
         self._watched: set[str] = set()
+        self._move_base: dict[str, str] = {}  # robot namespace -> move_base node name
         for spec in plan.nodes:
             if (spec.pkg, spec.type) == ("move_base", "move_base"):
+                self._move_base.setdefault(spec.namespace, names.join(spec.namespace, spec.name))
                 self._watch(spec.namespace)
+        self._states: dict[str, tuple[float, float]] = {}  # /gazebo/model_states, no local sim
+        self.tf = runtime.tf_buffer  # created now, so that it holds every frame from the start
+        if self.sim is None:
+            runtime.graph.subscribe(
+                "/gazebo/model_states", gazebo_msgs.ModelStates, self._on_states, queue_size=1
+            )
         self._last_pos: dict[str, tuple[float, float]] = {}
         self._last_contact: dict[tuple[str, str], float] = {}
         if self.sim is not None:
@@ -75,7 +118,7 @@ class RunMonitor:
         graph.subscribe(
             f"{base}/goal",
             move_base_msgs.MoveBase.ActionGoal,
-            lambda _m, r=r: self._on_goal(r),
+            lambda m, r=r: self._on_goal(r, m),
             queue_size=0,
         )
         graph.subscribe(
@@ -85,20 +128,52 @@ class RunMonitor:
             queue_size=0,
         )
 
-    def _on_goal(self, r: RobotResult) -> None:
+    def _on_goal(self, r: RobotResult, msg) -> None:
         r.goals_sent += 1
+        r.goal = self._goal_in_map(msg.goal.target_pose)
+        r.goals_by_id[msg.goal_id.id] = r.goal
+        r.goal_tolerance = self._goal_tolerance(r.namespace) + GOAL_MARGIN
+
+    def _goal_in_map(self, target) -> tuple[float, float] | None:
+        """The goal's x, y in the map (= world) frame, or None if its frame does not resolve."""
+        p = target.pose.position
+        frame = target.header.frame_id.lstrip("/")
+        if frame in WORLD_FRAMES:
+            return (float(p.x), float(p.y))
+        try:
+            tf = self.tf.lookup_transform("map", frame, 0.0).transform
+        except FleetsimError:
+            return None
+        t, q = tf.translation, tf.rotation
+        x, y = transform_points((t.x, t.y, t.z), (q.x, q.y, q.z, q.w), [[p.x, p.y]])[0]
+        return (float(x), float(y))
+
+    def _goal_tolerance(self, ns: str) -> float:
+        """``xy_goal_tolerance`` of the robot's move_base local planner, from the parameters."""
+        node = self._move_base.get(ns, names.join(ns, "move_base"))
+        params = self.runtime.params
+        try:
+            planner = str(params.get(f"{node}/base_local_planner", DEFAULT_LOCAL_PLANNER))
+            value = params.get(
+                f"{node}/{planner.rsplit('/', 1)[-1]}/xy_goal_tolerance",
+                DEFAULT_XY_GOAL_TOLERANCE,
+            )
+            return float(value)
+        except (FleetsimError, TypeError, ValueError):
+            return DEFAULT_XY_GOAL_TOLERANCE
 
     def _on_result(self, r: RobotResult, msg) -> None:
         S = actionlib_msgs.GoalStatus
+        goal = r.goals_by_id.pop(msg.status.goal_id.id, r.goal)
+        r.last_text = msg.status.text
         if msg.status.status == S.SUCCEEDED:
-            r.goals_reached += 1
+            self._confirm(r, goal, msg.status.text)
         elif msg.status.status == S.RECALLED or (
             msg.status.status == S.PREEMPTED and "another goal" in msg.status.text
         ):
             r.goals_sent -= 1  # replaced by a newer goal: not a failure, not a goal of its own
         else:
             r.goals_failed += 1
-        r.last_text = msg.status.text
         r.time_of_last_result = self.runtime.now()
 
     def all_goals_done(self) -> bool:
@@ -108,7 +183,56 @@ class RunMonitor:
         active = [r for r in self.robots.values() if r.goals_sent > 0]
         return bool(active) and all(r.all_done for r in active)
 
+    def _confirm(self, r: RobotResult, goal, text: str) -> None:
+        """Count a SUCCEEDED result as reached only if ground truth puts the robot at ``goal``."""
+        truth = self._true_xy(r.namespace)
+        if goal is None:
+            r.goals_unconfirmed += 1
+            r.last_text = "reported reached; the goal's frame does not resolve to map"
+        elif truth is None:
+            r.goals_unconfirmed += 1
+            r.last_text = "reported reached; no ground truth to confirm it"
+        else:
+            d = math.hypot(truth[0] - goal[0], truth[1] - goal[1])
+            r.distance_to_goal = d
+            if d <= r.goal_tolerance:
+                r.goals_reached += 1
+                r.last_text = text
+            else:
+                r.goals_unconfirmed += 1
+                r.last_text = f"reported reached, {d:.1f} m away by ground truth"
+
     # -- ground truth -------------------------------------------------------------------
+    def _on_states(self, msg) -> None:
+        self._states = {
+            n: (float(p.position.x), float(p.position.y)) for n, p in zip(msg.name, msg.pose)
+        }
+
+    def _true_xy(self, ns: str) -> tuple[float, float] | None:
+        """The robot's true x, y (world = map frame), or None where nothing tells it."""
+        if self.sim is None:
+            return self._states.get(ns.strip("/"))
+        model = self._robot_models().get(ns)
+        if model is None:
+            return None
+        pos, _ = self.sim.engine.model_pose(model)
+        return (float(pos[0]), float(pos[1]))
+
+    def _localization_error(self, ns: str, truth: tuple[float, float]) -> float | None:
+        """Distance between the map -> base tf and ground truth (None without a map frame)."""
+        if self.sim is None:
+            return None
+        entry = self.sim.engine.models.get(self._robot_models().get(ns, ""))
+        if entry is None or entry.robot is None:
+            return None
+        root = entry.robot.root_link()
+        frame = f"{entry.tf_prefix}/{root}" if entry.tf_prefix else root
+        try:
+            t = self.tf.lookup_transform("map", frame, 0.0).transform.translation
+        except FleetsimError:
+            return None
+        return math.hypot(t.x - truth[0], t.y - truth[1])
+
     def _robot_models(self) -> dict[str, str]:
         engine = self.sim.engine
         out = {}
@@ -144,6 +268,14 @@ class RunMonitor:
 
     # -- summary ------------------------------------------------------------------------
     def results(self) -> list[RobotResult]:
+        """Every robot's result, with ground-truth distance and localization error as of now."""
+        for ns, r in self.robots.items():
+            truth = self._true_xy(ns)
+            if truth is None:
+                continue
+            if r.goal is not None:
+                r.distance_to_goal = math.hypot(truth[0] - r.goal[0], truth[1] - r.goal[1])
+            r.localization_error = self._localization_error(ns, truth)
         return [self.robots[k] for k in sorted(self.robots)]
 
     def success(self) -> bool:

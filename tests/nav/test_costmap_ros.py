@@ -14,6 +14,7 @@ from fleetsim.nav.errors import CostmapError
 from fleetsim.nav.fake_localization import FakeLocalization
 from fleetsim.nav.map_server import grid_msg_from_map
 from fleetsim.runtime import Node, Runtime
+from fleetsim.tf.patience import GRACE
 
 COMMON = {  # a costmap_common_params.yaml in the lesson's style (pre-Hydro form)
     "obstacle_range": 2.5,
@@ -98,14 +99,25 @@ def test_scan_marks_an_unmapped_obstacle_in_the_odom_frame_and_clears_it():
     assert m.costs[cell[1], cell[0]] < LETHAL_OBSTACLE
 
 
-def test_pose_waits_for_tf_and_warns(caplog):
+def test_pose_waits_for_tf_and_warns_when_it_stays_missing(caplog):
     rt, bot, node, cm = world(robot=False)
-    rt.run(duration=0.5)
+    rt.run(duration=GRACE - 0.5)
     assert cm.robot_pose() is None and not cm.initialized
-    assert "cannot get the robot pose" in caplog.text
+    assert "WARNING" not in caplog.text  # waited for, as costmap_2d waits at start-up
+    rt.run(duration=1.0)
+    assert "cannot get the robot pose for 5." in caplog.text
     KinematicRobot(rt)  # tf arrives late: the costmap starts on its own
     rt.run(duration=0.5)
     assert cm.initialized
+
+
+def test_transforms_late_by_less_than_the_grace_period_are_not_reported(caplog):
+    rt, bot, node, cm = world(robot=False)
+    rt.run(duration=1.0)  # no tf at all for 1 s: readings and poses wait quietly
+    KinematicRobot(rt)
+    rt.run(duration=1.0)
+    assert cm.initialized
+    assert "WARNING" not in caplog.text
 
 
 def test_stale_tf_is_a_transform_timeout(caplog):
@@ -121,7 +133,7 @@ def test_stale_tf_is_a_transform_timeout(caplog):
 def test_bare_global_frame_gets_the_prefix_and_a_hint(caplog):
     rt, bot, node, cm = world(extra={"global_frame": "map"})
     assert cm.global_frame == "lizi1/map"
-    rt.run(duration=0.5)
+    rt.run(duration=GRACE + 0.5)
     assert not cm.initialized
     assert "write '/map' for the shared frame" in caplog.text
 

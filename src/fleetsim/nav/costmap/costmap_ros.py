@@ -46,6 +46,7 @@ from fleetsim.nav.errors import CostmapError, MapError
 from fleetsim.nav.map_server import grid_msg_from_map, map_from_grid_msg
 from fleetsim.tf import resolve_frame_once
 from fleetsim.tf.names import normalize_frame
+from fleetsim.tf.patience import TransformPatience
 
 _CLOUD_DTYPES = {7: "f4", 8: "f8"}  # PointField.FLOAT32, FLOAT64
 
@@ -117,6 +118,7 @@ class Costmap2DROS:
         self.update_count = 0
         self.last_pose: tuple[float, float, float] | None = None
         self._warned: dict[str, float] = {}
+        self._patience = TransformPatience()  # missing transforms: reported when they last
         self._last_reading: dict[tuple[str, str], float] = {}
         self._subs: list[Any] = []
         self._map_subs: dict[str, Any] = {}
@@ -268,11 +270,17 @@ class Costmap2DROS:
                     raise err
                 m = buf.lookup_matrix(self.global_frame, frame, 0.0)
             except TransformError as final:
-                self._warn(
-                    f"tf:{where}", f"dropping a reading of {where} in frame '{frame}': {final}"
-                )
-                self._hint_frame()
+                key = f"tf:{where}"
+                if self._patience.missing_too_long(key, self.node.now()):
+                    waited = self._patience.missing_for(key, self.node.now())
+                    self._warn(
+                        key,
+                        f"dropping readings of {where} in frame '{frame}' for {waited:.1f} s: "
+                        f"{final}",
+                    )
+                    self._hint_frame()
                 return None
+        self._patience.found(f"tf:{where}")
         return m[:3, :3], m[:3, 3]
 
     def _hint_frame(self) -> None:
@@ -296,9 +304,12 @@ class Costmap2DROS:
             pose = buf.lookup_pose2d(self.global_frame, self.robot_base_frame, 0.0)
             stamp = buf.latest_common_time(self.global_frame, self.robot_base_frame)
         except TransformError as err:
-            self._warn("pose", f"cannot get the robot pose: {err}")
-            self._hint_frame()
+            if self._patience.missing_too_long("pose", self.node.now()):
+                waited = self._patience.missing_for("pose", self.node.now())
+                self._warn("pose", f"cannot get the robot pose for {waited:.1f} s: {err}")
+                self._hint_frame()
             return None
+        self._patience.found("pose")
         now = self.node.now()
         if stamp > 0 and now - stamp > self.params.transform_tolerance:
             self._warn(

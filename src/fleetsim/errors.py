@@ -78,3 +78,14 @@ def did_you_mean(word: str, choices: Iterable[str]) -> str:
     """Return ``" (did you mean 'x'?)"`` for the closest choice, or ``""`` when none is close."""
     close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
     return f" (did you mean '{close[0]}'?)" if close else ""
+
+
+class PhysicsInstability(SimulationError):
+    """The physics blew up: NaN, infinite or huge accelerations, positions or velocities, a
+    non-finite actuator command, or a singular inertia. The message names the robot, body and
+    joint of the bad degree of freedom, the sim time, the likely cause and what to try."""
+
+
+class PhysicsBufferFull(SimulationError):
+    """MuJoCo ran out of room for contacts or constraints and dropped some: bodies would pass
+    through each other."""

@@ -58,9 +58,11 @@ def rpy_from_quat(q) -> tuple[float, float, float]:
 
 def new_world_spec(timestep: float = 0.002) -> mujoco.MjSpec:
     """An empty spec with fleetsim's physics options (implicit-fast integrator, no gravity
-    compensation tricks) and a large offscreen buffer for cameras."""
+    compensation tricks, no auto-reset) and a large offscreen buffer for cameras."""
     spec = mujoco.MjSpec()
     spec.option.timestep = timestep
+    # a blow-up is an error the engine reports (sim.health), never a silent reset of the world
+    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC  # pyramidal + early stop jitters at rest
     spec.option.tolerance = 1e-6  # solver stops early; ample for wheeled robots
@@ -195,87 +197,14 @@ def _coloured_by_file(g: GeomDesc) -> bool:
     return dae and not g.collide and g.rgba is None and not g.texture
 
 
-def _mesh_file(g: GeomDesc, prefix: str) -> Path | None:
-    """The mesh file of a mesh geom; None (with a warning) when its format is not read."""
-    owner = prefix.rstrip("/")
-    mesh_file = Path(g.mesh or "")
-    if mesh_file.suffix.lower() not in MESH_FORMATS:
-        warnings.warn(
-            f"mesh '{g.mesh}' of geom '{g.name}' in '{owner}': fleetsim reads "
-            f"{'/'.join(s.lstrip('.').upper() for s in MESH_FORMATS)} meshes; the shape is skipped",
-            stacklevel=4,
-        )
-        return None
-    if not mesh_file.is_file():
-        raise SimulationError(
-            f"mesh file '{g.mesh}' of geom '{g.name}' in '{owner}' does not exist; "
-            "fix the <mesh> filename/uri (package:// and model:// must resolve to a file)"
-        )
-    return mesh_file
 
 
-def _mesh_asset_name(mesh_file: Path, scale: list[float]) -> str:
-    """Asset name of a mesh file at a scale: one per (file, version, scale) in a spec."""
-    st = mesh_file.stat()
-    key = f"{mesh_file.resolve()}|{st.st_mtime_ns}|{st.st_size}|{scale}"
-    return f"mesh:{mesh_file.name}:{hashlib.sha1(key.encode()).hexdigest()[:12]}"
 
 
-def _add_user_mesh(spec, name: str, vertices: np.ndarray, faces: np.ndarray, scale) -> None:
-    mesh = spec.add_mesh(name=name, uservert=vertices.ravel(), userface=faces.ravel(), scale=scale)
-    # shell inertia: COLLADA visuals are often open surfaces (a floor, a sign) with no volume;
-    # bodies carry explicit inertia, so the mesh's own inertia only places its frame
-    mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
 
 
-def _add_mesh(spec, g: GeomDesc, prefix: str) -> str | None:
-    """The mesh asset of a mesh geom, added once per spec for each (file, version, scale) and
-    shared by every model that uses it (a hundred robots compile one mesh, and a deleted robot
-    can be spawned again); None when the format is not read."""
-    mesh_file = _mesh_file(g, prefix)
-    if mesh_file is None:
-        return None
-    scale = [float(v) for v in g.size]
-    mesh_name = _mesh_asset_name(mesh_file, scale)
-    if spec.mesh(mesh_name) is not None:
-        return mesh_name
-    if mesh_file.suffix.lower() != ".dae":
-        spec.add_mesh(name=mesh_name, file=str(mesh_file), scale=scale)
-        return mesh_name
-    vertices, faces = triangle_mesh_from_collada(mesh_file)
-    if len(vertices) < 4:
-        raise SimulationError(
-            f"mesh '{g.mesh}' of geom '{g.name}' in '{prefix.rstrip('/')}' has "
-            f"{len(vertices)} vertices; MuJoCo needs at least 4 (use a box or a thin solid instead)"
-        )
-    _add_user_mesh(spec, mesh_name, vertices, faces, scale)
-    return mesh_name
 
 
-def _add_part_meshes(spec, g: GeomDesc, prefix: str) -> list[tuple[str, tuple]] | None:
-    """Mesh assets ``(name, rgba)`` of the material parts of a ``.dae`` geom, added once per
-    spec for each (file, version, scale, part); None when the file has no materials (it is
-    then one plain mesh). Parts without surface (degenerate triangles) are left out; a
-    one-triangle part gets its centroid as an unused fourth vertex, MuJoCo's minimum."""
-    mesh_file = _mesh_file(g, prefix)
-    parts = collada_parts(mesh_file)
-    if all(not p.name for p in parts):
-        return None
-    scale = [float(v) for v in g.size]
-    base = _mesh_asset_name(mesh_file, scale)
-    assets = []
-    for k, part in enumerate(parts):
-        name = f"{base}:{k}"
-        if spec.mesh(name) is None:
-            v = part.vertices
-            a, b, c = (v[part.faces[:, i]] * scale for i in range(3))
-            if 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum() < MIN_PART_AREA:
-                continue
-            if len(v) < 4:
-                v = np.vstack([v, v.mean(axis=0)])
-            _add_user_mesh(spec, name, v, part.faces, scale)
-        assets.append((name, part.rgba))
-    return assets
 
 
 def _floor_material(spec) -> str:

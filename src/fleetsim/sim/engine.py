@@ -18,6 +18,7 @@ from fleetsim.errors import SimulationError
 from fleetsim.sim import sdf
 from fleetsim.sim.build import add_sdf_model, spec_from_world
 from fleetsim.sim.drives import DriveBatch
+from fleetsim.sim.health import WarningWatch, physics_error, route_mujoco_warnings
 from fleetsim.sim.lasers import LaserBatch
 from fleetsim.sim.plugins import base
 from fleetsim.sim.plugins.diff_drive import WheeledDrive
@@ -80,6 +81,7 @@ class Engine(StateQueries):
         rng: np.random.Generator | None = None,
         wall_height: float = WALL_HEIGHT,
     ) -> None:
+        route_mujoco_warnings()
         self.world = load_world(world, wall_height)
         self.wall_height = wall_height
         self.rng = rng if rng is not None else np.random.default_rng(0)
@@ -113,6 +115,7 @@ class Engine(StateQueries):
         except ValueError as exc:
             raise SimulationError(f"MuJoCo cannot compile the world: {exc}") from exc
         self.drives.sync_back()
+        self._warnings = WarningWatch(self.data)
         mujoco.mj_forward(self.model, self.data)
         self.layouts.clear()
         self._index()
@@ -282,7 +285,11 @@ class Engine(StateQueries):
         self.schedule.bind(self._plugins)
 
     def step(self) -> None:
-        """One physics step: plugin controls, link attacher, ``mj_step``."""
+        """One physics step: plugin controls, link attacher, ``mj_step``.
+
+        Raises `PhysicsInstability` (or `PhysicsBufferFull`) when MuJoCo flags the step
+        (``sim.health``); the world is not reset and stays as the failed step left it.
+        """
         t = self.time
         self.drives.control(self, t)
         for p in self._controllers:
@@ -290,6 +297,8 @@ class Engine(StateQueries):
         if self.attacher.pending:
             self.attacher.control(self, t)
         mujoco.mj_step(self.model, self.data)
+        if self._warnings.tripped():
+            raise physics_error(self, t)
 
     def advance(self, duration: float) -> list[Any]:
         """Step physics for ``duration`` seconds; returns the readings that fell due.

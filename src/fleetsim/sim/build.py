@@ -11,15 +11,20 @@ MuJoCo would otherwise take the larger).
 
 from __future__ import annotations
 
-import hashlib
-import warnings
 from pathlib import Path
 
 import mujoco
 import numpy as np
 
 from fleetsim.errors import SimulationError
-from fleetsim.sim.meshes import collada_parts, triangle_mesh_from_collada
+from fleetsim.sim.mesh_assets import (
+    HULL_GROUP,
+    MESH_FORMATS,
+    RAY_GROUP,
+    add_decomposed_mesh,
+    add_mesh_asset,
+    add_part_mesh_assets,
+)
 from fleetsim.sim.sdf import GAZEBO_COLOURS
 from fleetsim.sim.world import GeomDesc, ModelDesc, Pose, WorldDesc
 
@@ -28,8 +33,7 @@ COLLISION_GROUP = 3
 VISUAL_GROUP = 1
 MIN_MASS = 1e-3
 MIN_INERTIA = 1e-6
-MESH_FORMATS = (".stl", ".obj", ".msh", ".dae")  # mesh files add_geom reads
-MIN_PART_AREA = 1e-12  # m^2; a material part with less surface draws nothing and is left out
+__all__ = ["COLLISION_GROUP", "HULL_GROUP", "MESH_FORMATS", "RAY_GROUP", "VISUAL_GROUP"]
 
 
 def quat_from_rpy(roll: float, pitch: float, yaw: float) -> np.ndarray:
@@ -117,9 +121,10 @@ def add_geom(
     Meshes: STL, OBJ and MSH load through MuJoCo, COLLADA (``.dae``) through
     ``fleetsim.sim.meshes`` (node transforms and ``<unit>`` applied, ``up_axis`` ignored as
     Gazebo classic does); other formats are skipped with a warning. The URDF/SDF ``scale``
-    applies to all. A mesh used for collision collides as its convex hull (MuJoCo's rule):
-    a concave shape such as an L-shaped desk or an open shelf fills in, so give it box
-    collisions, or split it into convex parts, where the hollow matters.
+    applies to all. A movable model's collision mesh collides as its convex hull (MuJoCo's
+    and Gazebo-ODE's rule); a static model's non-convex collision mesh (a building) collides
+    as its convex parts, with its true triangles kept for rays
+    (``mesh_assets.add_decomposed_mesh``).
 
     A visual ``.dae`` without a colour or texture of its own (``g.rgba`` None, no
     ``g.texture``) takes the file's materials, as Gazebo draws it: one mesh geom per material
@@ -144,8 +149,10 @@ def add_geom(
     elif g.kind == "plane":
         kw.update(type=G.mjGEOM_PLANE, size=[g.size[0] / 2, g.size[1] / 2, 1.0])
     elif g.kind == "mesh":
+        if g.collide and static and add_decomposed_mesh(spec, body, g, prefix, index, kw, shown):
+            return
         if _coloured_by_file(g):
-            parts = _add_part_meshes(spec, g, prefix)
+            parts = add_part_mesh_assets(spec, g, prefix)
             if parts:
                 for k, (mesh_name, rgba) in enumerate(parts):
                     geom = body.add_geom(
@@ -157,7 +164,7 @@ def add_geom(
                     _make_visual(geom)
                     geom.rgba = list(rgba)
                 return
-        mesh_name = _add_mesh(spec, g, prefix)
+        mesh_name = add_mesh_asset(spec, g, prefix)
         if mesh_name is None:
             return
         kw.update(type=G.mjGEOM_MESH, meshname=mesh_name)
@@ -195,16 +202,6 @@ def _coloured_by_file(g: GeomDesc) -> bool:
     materials colour it (Gazebo's rule)."""
     dae = Path(g.mesh or "").suffix.lower() == ".dae"
     return dae and not g.collide and g.rgba is None and not g.texture
-
-
-
-
-
-
-
-
-
-
 
 
 def _floor_material(spec) -> str:

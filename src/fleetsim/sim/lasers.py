@@ -2,7 +2,10 @@
 
 Static world: in a map world the extruded walls are the occupied cells themselves, so each laser
 sweeps the wall boxes near it (``occupancy_cast.ranges_from_walls``); every other static geom is
-sliced into primitives binned once per compile (``raycast.ranges_from_primitives``). Movable
+sliced into primitives binned once per compile (``raycast.ranges_from_primitives``). A static
+mesh decomposed into convex parts (a building) is seen through its true triangles (the
+``RAY_GROUP`` copy), not through its parts (``HULL_GROUP``), which the slicer would reduce to
+bounding boxes. Movable
 models (robots, loose objects) are sliced at every sweep and tested only by the beams that fall
 inside their bounding circle (``raycast.ranges_with_bodies``), skipping the robot that carries
 the laser.
@@ -16,7 +19,8 @@ import mujoco
 import numpy as np
 
 from fleetsim.sim import occupancy_cast, raycast
-from fleetsim.sim.slices import primitives_of
+from fleetsim.sim.mesh_assets import HULL_GROUP, RAY_GROUP
+from fleetsim.sim.slices import primitives_of, triangle_primitives
 
 STATIC_CELL = 0.5  # m
 
@@ -92,9 +96,13 @@ class LaserBatch:
                 self.walls = occupancy_cast.wall_tiles(grid.occupied)
             self.occupancy = grid
             self.wall_height = engine.wall_height
-        sid = np.flatnonzero(collide & real & static)
+        sid = np.flatnonzero(collide & real & static & (m.geom_group != HULL_GROUP))
         self.dynamic_ids = np.flatnonzero(collide & real & (m.body_weldid[m.geom_bodyid] != 0))
         prims, _ = primitives_of(m, engine.data, sid)
+        rays = np.flatnonzero(static & (m.geom_group == RAY_GROUP))
+        tris = triangle_primitives(m, engine.data, rays)
+        if len(tris):
+            prims = np.vstack([np.pad(prims, ((0, 0), (0, tris.shape[1] - prims.shape[1]))), tris])
         self.static_grid = raycast.grid_from_primitives(prims, None, STATIC_CELL)
 
     def bodies(self, engine):

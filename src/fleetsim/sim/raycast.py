@@ -1,14 +1,17 @@
 """Batched planar ray casting against 2-D primitives on a uniform grid (numba kernels).
 
 A planar laser only needs the horizontal slice of the world at its own height. The world's
-geometry is reduced to *primitives*, rows of a ``(P, 7)`` float64 array in the world frame
-(metres)::
+geometry is reduced to *primitives*, rows of a ``(P, 7)`` or ``(P, 16)`` float64 array in the
+world frame (metres)::
 
-    [kind, a, b, c, d, zmin, zmax]
-    kind 0 (segment): a, b = x0, y0 and c, d = x1, y1
-    kind 1 (circle):  a, b = centre x, y, c = radius, d unused
+    [kind, a, b, c, d, zmin, zmax, x0, y0, z0, x1, y1, z1, x2, y2, z2]
+    kind 0 (segment):  a, b = x0, y0 and c, d = x1, y1
+    kind 1 (circle):   a, b = centre x, y, c = radius, d unused
+    kind 2 (triangle): a, b, c, d = xmin, ymin, xmax, ymax of the triangle whose corners
+                       follow (the true triangles of a mesh); sliced at the ray's height
 
-A primitive is hit only by rays whose origin height lies in ``[zmin, zmax]``. Primitives are
+A primitive is hit only by rays whose origin height lies in ``[zmin, zmax]``. Grids hold
+16-column rows (segments and circles padded with zeros). Primitives are
 binned into a uniform grid (``PrimitiveGrid``, CSR layout); each ray walks the grid cells it
 crosses (Amanatides & Woo traversal) and stops at the first cell holding a hit, so the cost per
 ray is the number of cells crossed, not the number of walls in the world.
@@ -23,6 +26,8 @@ import numpy as np
 
 SEGMENT = 0
 CIRCLE = 1
+TRIANGLE = 2
+PRIM_WIDTH = 16  # columns of a grid's primitives
 
 
 @dataclass(frozen=True)
@@ -33,7 +38,7 @@ class PrimitiveGrid:
     ``[x0 + ix * cell, x0 + (ix + 1) * cell) x [y0 + iy * cell, ...)``.
     """
 
-    prims: np.ndarray  # (P, 7) float64
+    prims: np.ndarray  # (P, 16) float64
     owner: np.ndarray  # (P,) int64, model index owning the primitive (-1: the static world)
     start: np.ndarray  # (nx * ny + 1,) int64
     items: np.ndarray  # (K,) int64 primitive indices
@@ -46,7 +51,7 @@ class PrimitiveGrid:
 
 @numba.njit(cache=True)
 def _bbox(p):
-    if p[0] == SEGMENT:
+    if p[0] != CIRCLE:  # segment, or triangle (its bounding box in a..d)
         return min(p[1], p[3]), min(p[2], p[4]), max(p[1], p[3]), max(p[2], p[4])
     return p[1] - p[3], p[2] - p[3], p[1] + p[3], p[2] + p[3]
 
@@ -82,8 +87,13 @@ def _cell_lists(prims, x0, y0, cell, nx, ny):
 def grid_from_primitives(
     prims: np.ndarray, owner: np.ndarray | None = None, cell: float = 0.5
 ) -> PrimitiveGrid:
-    """Bin ``(P, 7)`` primitives into a uniform grid of square cells ``cell`` metres wide."""
-    prims = np.ascontiguousarray(prims, dtype=np.float64).reshape(-1, 7)
+    """Bin ``(P, 7)`` or ``(P, 16)`` primitives into a uniform grid of square cells ``cell``
+    metres wide (rows are padded to 16 columns)."""
+    prims = np.asarray(prims, dtype=np.float64)
+    prims = prims.reshape(-1, prims.shape[-1] if prims.ndim == 2 else 7)
+    if prims.shape[1] < PRIM_WIDTH:
+        prims = np.pad(prims, ((0, 0), (0, PRIM_WIDTH - prims.shape[1])))
+    prims = np.ascontiguousarray(prims)
     owner = (
         np.full(len(prims), -1, np.int64)
         if owner is None
@@ -93,7 +103,7 @@ def grid_from_primitives(
         return PrimitiveGrid(
             prims, owner, np.zeros(2, np.int64), np.zeros(0, np.int64), 0.0, 0.0, cell, 1, 1
         )
-    seg = prims[:, 0] == SEGMENT
+    seg = prims[:, 0] != CIRCLE
     lo = np.where(
         seg[:, None], np.minimum(prims[:, 1:3], prims[:, 3:5]), prims[:, 1:3] - prims[:, 3:4]
     )
@@ -136,6 +146,41 @@ def _hit_distance(p, ox, oy, dx, dy, tmin):
         return t
     t = -b + sq
     if t >= tmin:
+        return t
+    return np.inf
+
+
+@numba.njit(cache=True)
+def _triangle_hit(p, ox, oy, oz, dx, dy, tmin):
+    """Distance along the horizontal unit ray at height ``oz`` to triangle row ``p`` (corners in
+    p[7:16]), or inf: the triangle is cut by the plane ``z = oz`` (a corner counts as above when
+    its z >= oz, so triangles sharing an edge cut it at the same point) and the cut segment is
+    hit as a segment."""
+    px = np.empty(2)
+    py = np.empty(2)
+    n = 0
+    for e in range(3):
+        a = 7 + 3 * e
+        b = 7 + 3 * ((e + 1) % 3)
+        za = p[a + 2]
+        zb = p[b + 2]
+        if (za >= oz) != (zb >= oz) and n < 2:
+            s = (oz - za) / (zb - za)
+            px[n] = p[a] + s * (p[b] - p[a])
+            py[n] = p[a + 1] + s * (p[b + 1] - p[a + 1])
+            n += 1
+    if n < 2:
+        return np.inf
+    ex = px[1] - px[0]
+    ey = py[1] - py[0]
+    den = dx * ey - dy * ex
+    if abs(den) < 1e-12:
+        return np.inf
+    wx = px[0] - ox
+    wy = py[0] - oy
+    t = (wx * ey - wy * ex) / den
+    s = (wx * dy - wy * dx) / den
+    if t >= tmin and -1e-12 <= s <= 1.0 + 1e-12:
         return t
     return np.inf
 
@@ -234,7 +279,10 @@ def ranges_from_primitives(
                 p = prims[i]
                 if oz < p[5] or oz > p[6]:
                     continue
-                t = _hit_distance(p, ox, oy, dx, dy, tmin)
+                if p[0] == TRIANGLE:
+                    t = _triangle_hit(p, ox, oy, oz, dx, dy, tmin)
+                else:
+                    t = _hit_distance(p, ox, oy, dx, dy, tmin)
                 if t < best:
                     best = t
             cell_exit = min(tmx, tmy)

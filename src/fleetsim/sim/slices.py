@@ -146,3 +146,38 @@ def primitives_of(model: mujoco.MjModel, data: mujoco.MjData, ids: np.ndarray):
         model.geom_aabb,
         np.asarray(ids, np.int64),
     )
+
+
+def triangle_primitives(model: mujoco.MjModel, data: mujoco.MjData, ids) -> np.ndarray:
+    """Triangle primitives (``raycast`` kind 2, 16 columns) of the true triangles of the mesh
+    geoms ``ids`` at their current pose, world frame (m). Horizontal triangles (a planar laser
+    skims them) and repeated triangles (double-sided meshes) are left out.
+
+    Returns
+    -------
+    (T, 16) float64: [2, xmin, ymin, xmax, ymax, zmin, zmax, 9 corner coordinates].
+    """
+    rows = []
+    for g in np.asarray(ids, np.int64):
+        mid = int(model.geom_dataid[g])
+        if mid < 0:
+            continue
+        v0, nv = model.mesh_vertadr[mid], model.mesh_vertnum[mid]
+        f0, nf = model.mesh_faceadr[mid], model.mesh_facenum[mid]
+        faces = model.mesh_face[f0 : f0 + nf]
+        _, keep = np.unique(np.sort(faces, axis=1), axis=0, return_index=True)
+        faces = faces[np.sort(keep)]
+        local = model.mesh_vert[v0 : v0 + nv].astype(np.float64)
+        world = local @ data.geom_xmat[g].reshape(3, 3).T + data.geom_xpos[g]
+        tri = world[faces]  # (F, 3 corners, 3)
+        lo, hi = tri.min(axis=1), tri.max(axis=1)
+        tall = hi[:, 2] - lo[:, 2] > 1e-9
+        out = np.empty((int(tall.sum()), 16))
+        out[:, 0] = 2.0
+        out[:, 1:3] = lo[tall, :2]
+        out[:, 3:5] = hi[tall, :2]
+        out[:, 5] = lo[tall, 2]
+        out[:, 6] = hi[tall, 2]
+        out[:, 7:16] = tri[tall].reshape(-1, 9)
+        rows.append(out)
+    return np.concatenate(rows) if rows else np.zeros((0, 16))

@@ -1,0 +1,168 @@
+"""Mesh assets of a spec, and the collision of static non-convex meshes as convex parts.
+
+Mesh assets are added once per spec for each (file, version, scale) and shared by every model
+that uses them. A static collision mesh that is not its own convex hull (a building, Gazebo's
+``model://willowgarage``) is decomposed (``decompose.convex_decomposition``, cached on disk)
+and becomes, at the geom's pose:
+
+- one collision geom per convex part, named ``<prefix><name>#<index>:cvx<k>``, in
+  ``HULL_GROUP`` (hidden in renders; lasers skip it);
+- a ray-only copy of the file's true triangles, ``<prefix><name>#<index>:rays``, in
+  ``RAY_GROUP`` with no contacts and no mass: lasers cast against its triangles and
+  ``mj_ray`` hits it, so sensors see the walls where the mesh puts them, not the parts' hulls;
+- when the link has no visual, a visual copy of the same triangles (what cameras render).
+
+Movable (robot) meshes keep MuJoCo's rule and collide as their convex hull, as with Gazebo's ODE.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import warnings
+from pathlib import Path
+
+import mujoco
+import numpy as np
+
+from fleetsim.errors import SimulationError
+from fleetsim.sim import decompose
+from fleetsim.sim.mesh_files import triangle_mesh
+from fleetsim.sim.meshes import collada_parts, triangle_mesh_from_collada
+from fleetsim.sim.world import GeomDesc
+
+G = mujoco.mjtGeom
+VISUAL_GROUP = 1
+RAY_GROUP = 4  # true triangles of decomposed meshes: seen by rays, not by contacts or cameras
+HULL_GROUP = 5  # convex parts of decomposed meshes: contacts only
+MESH_FORMATS = (".stl", ".obj", ".msh", ".dae")  # mesh files add_geom reads
+MIN_PART_AREA = 1e-12  # m^2; a material part with less surface draws nothing and is left out
+
+
+def mesh_file_of(g: GeomDesc, prefix: str) -> Path | None:
+    """The mesh file of a mesh geom; None (with a warning) when its format is not read."""
+    owner = prefix.rstrip("/")
+    mesh_file = Path(g.mesh or "")
+    if mesh_file.suffix.lower() not in MESH_FORMATS:
+        warnings.warn(
+            f"mesh '{g.mesh}' of geom '{g.name}' in '{owner}': fleetsim reads "
+            f"{'/'.join(s.lstrip('.').upper() for s in MESH_FORMATS)} meshes; the shape is skipped",
+            stacklevel=4,
+        )
+        return None
+    if not mesh_file.is_file():
+        raise SimulationError(
+            f"mesh file '{g.mesh}' of geom '{g.name}' in '{owner}' does not exist; "
+            "fix the <mesh> filename/uri (package:// and model:// must resolve to a file)"
+        )
+    return mesh_file
+
+
+def mesh_asset_name(mesh_file: Path, scale: list[float]) -> str:
+    """Asset name of a mesh file at a scale: one per (file, version, scale) in a spec."""
+    st = mesh_file.stat()
+    key = f"{mesh_file.resolve()}|{st.st_mtime_ns}|{st.st_size}|{scale}"
+    return f"mesh:{mesh_file.name}:{hashlib.sha1(key.encode()).hexdigest()[:12]}"
+
+
+def add_user_mesh(spec, name: str, vertices: np.ndarray, faces: np.ndarray, scale) -> None:
+    mesh = spec.add_mesh(name=name, uservert=vertices.ravel(), userface=faces.ravel(), scale=scale)
+    # shell inertia: COLLADA visuals are often open surfaces (a floor, a sign) with no volume;
+    # bodies carry explicit inertia, so the mesh's own inertia only places its frame
+    mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
+
+
+def add_mesh_asset(spec, g: GeomDesc, prefix: str) -> str | None:
+    """The mesh asset of a mesh geom, added once per spec for each (file, version, scale) and
+    shared by every model that uses it (a hundred robots compile one mesh, and a deleted robot
+    can be spawned again); None when the format is not read."""
+    mesh_file = mesh_file_of(g, prefix)
+    if mesh_file is None:
+        return None
+    scale = [float(v) for v in g.size]
+    mesh_name = mesh_asset_name(mesh_file, scale)
+    if spec.mesh(mesh_name) is not None:
+        return mesh_name
+    if mesh_file.suffix.lower() != ".dae":
+        spec.add_mesh(name=mesh_name, file=str(mesh_file), scale=scale)
+        return mesh_name
+    vertices, faces = triangle_mesh_from_collada(mesh_file)
+    if len(vertices) < 4:
+        raise SimulationError(
+            f"mesh '{g.mesh}' of geom '{g.name}' in '{prefix.rstrip('/')}' has "
+            f"{len(vertices)} vertices; MuJoCo needs at least 4 (use a box or a thin solid instead)"
+        )
+    add_user_mesh(spec, mesh_name, vertices, faces, scale)
+    return mesh_name
+
+
+def add_part_mesh_assets(spec, g: GeomDesc, prefix: str) -> list[tuple[str, tuple]] | None:
+    """Mesh assets ``(name, rgba)`` of the material parts of a ``.dae`` geom, added once per
+    spec for each (file, version, scale, part); None when the file has no materials (it is
+    then one plain mesh). Parts without surface (degenerate triangles) are left out; a
+    one-triangle part gets its centroid as an unused fourth vertex, MuJoCo's minimum."""
+    mesh_file = mesh_file_of(g, prefix)
+    parts = collada_parts(mesh_file)
+    if all(not p.name for p in parts):
+        return None
+    scale = [float(v) for v in g.size]
+    base = mesh_asset_name(mesh_file, scale)
+    assets = []
+    for k, part in enumerate(parts):
+        name = f"{base}:{k}"
+        if spec.mesh(name) is None:
+            v = part.vertices
+            a, b, c = (v[part.faces[:, i]] * scale for i in range(3))
+            if 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum() < MIN_PART_AREA:
+                continue
+            if len(v) < 4:
+                v = np.vstack([v, v.mean(axis=0)])
+            add_user_mesh(spec, name, v, part.faces, scale)
+        assets.append((name, part.rgba))
+    return assets
+
+
+def add_decomposed_mesh(
+    spec, body, g: GeomDesc, prefix: str, index: int, kw: dict, shown: bool
+) -> bool:
+    """Add a static collision mesh as its convex parts plus a ray-only copy (see the module
+    docstring); False (nothing added) when the mesh is convex, so the caller adds it as one
+    mesh geom. ``kw`` holds the geom's ``pos`` and ``quat`` in ``body``."""
+    mesh_file = mesh_file_of(g, prefix)
+    if mesh_file is None:
+        return True  # format not read: warned, nothing to add
+    vertices, faces = triangle_mesh(mesh_file)
+    scale = [float(v) for v in g.size]
+    result = decompose.convex_decomposition(
+        vertices * np.asarray(scale), faces, decompose.DEFAULT_PARAMS
+    )
+    model, _, link = prefix.rstrip("/").partition("/")
+    if result.problems:
+        warnings.warn(
+            f"model '{model}' link '{link}' collision '{g.name}': mesh '{mesh_file}' does not "
+            f"decompose well into convex parts ({'; '.join(result.problems)}); it may collide "
+            "bigger than it is: give it box collisions, or split the mesh into simpler pieces",
+            stacklevel=4,
+        )
+    if result.convex:
+        return False
+    base = mesh_asset_name(mesh_file, scale)
+    name = f"{prefix}{g.name or 'geom'}#{index}"
+    for k, part in enumerate(result.parts):
+        asset = f"{base}:cvx{k}"
+        if spec.mesh(asset) is None:
+            spec.add_mesh(name=asset, uservert=np.ascontiguousarray(part).ravel())
+        geom = body.add_geom(name=f"{name}:cvx{k}", type=G.mjGEOM_MESH, meshname=asset, **kw)
+        geom.group = HULL_GROUP
+        geom.contype, geom.conaffinity = 2, 1
+        if g.friction is not None:
+            geom.friction = [g.friction[0], 0.005, 0.0001]
+        geom.rgba = [0.6, 0.6, 0.62, 1.0]
+    true_mesh = add_mesh_asset(spec, g, prefix)
+    copies = [(f"{name}:rays", RAY_GROUP)] + ([(f"{name}:shown", VISUAL_GROUP)] if shown else [])
+    for geom_name, group in copies:
+        geom = body.add_geom(name=geom_name, type=G.mjGEOM_MESH, meshname=true_mesh, **kw)
+        geom.group = group
+        geom.contype = geom.conaffinity = 0
+        geom.density = 0
+        geom.rgba = list(g.rgba) if g.rgba else [0.7, 0.7, 0.7, 1.0]
+    return True

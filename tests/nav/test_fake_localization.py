@@ -12,6 +12,7 @@ from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.nav.fake_localization import FakeLocalization
 from fleetsim.runtime import Node, Runtime
 from fleetsim.tf import TransformBroadcaster, make_transform_stamped
+from fleetsim.tf.patience import GRACE
 
 
 def quat(yaw):
@@ -125,13 +126,58 @@ def test_ground_truth_before_its_tf_waits_for_it():
     assert tf.transform.translation.x == pytest.approx(5.0)
 
 
-def test_missing_odometry_is_warned_about_once(caplog):
+def test_missing_odometry_is_waited_for_then_warned_about_once(caplog):
     rt, node, sim = world()
     sim.truth(0.0, 1.0, 1.0, 0.0)
     sim.truth(0.1, 1.0, 1.0, 0.0)
     rt.spin_once()
-    assert caplog.text.count("waiting for tf lizi1/odom -> lizi1/base_link") == 1
-    assert len(node._pending) == 2
+    assert "WARNING" not in caplog.text and len(node._pending) == 2
+    rt.run(duration=GRACE)
+    sim.truth(GRACE, 1.0, 1.0, 0.0)
+    sim.truth(GRACE + 0.1, 1.0, 1.0, 0.0)
+    rt.spin_once()
+    assert caplog.text.count("waiting for tf lizi1/odom -> lizi1/base_link for 5.0 s") == 1
+    assert len(node._pending) == 4
+
+
+def test_ground_truth_is_published_at_publish_rate_and_its_tf_covers_the_present():
+    rt, node, sim = world()
+    for k in range(100):  # 1 s of 100 Hz odometry and ground truth, the robot driving in x
+        sim.odom(1.0 + k * 0.01, k * 0.01, 0.0, 0.0)
+        sim.truth(1.0 + k * 0.01, 10.0 + k * 0.01, 5.0, 0.0)
+        rt.spin_once()
+        if k >= 10:  # from transform_tolerance on (the first tf is dated 1.1 s, as in ROS),
+            # any consumer's lookup at the newest odometry stamp finds map -> base
+            got = rt.tf_buffer.lookup_pose2d("map", "lizi1/base_link", 1.0 + k * 0.01)
+            assert got[0] == pytest.approx(10.0 + k * 0.01, abs=1e-9)
+    stamps = [p.header.stamp.to_sec() for p in sim.poses]
+    assert stamps == pytest.approx([1.0 + 0.05 * k for k in range(20)])
+
+
+@pytest.mark.parametrize(("rate", "tolerance", "every"), [(0.0, 0.1, 1), (20.0, 0.04, 2)])
+def test_publish_rate_zero_is_every_message_and_the_tolerance_caps_the_period(
+    rate, tolerance, every
+):
+    rt, node, sim = world({"publish_rate": rate, "transform_tolerance": tolerance})
+    for k in range(10):
+        sim.odom(1.0 + k * 0.01, 0.0, 0.0, 0.0)
+        sim.truth(1.0 + k * 0.01, 1.0, 1.0, 0.0)
+        rt.spin_once()
+    assert len(sim.poses) == 10 // every
+
+
+def test_no_ground_truth_is_reported_with_what_provides_it(caplog):
+    rt, node, sim = world()
+    rt.run(duration=GRACE - 1.0)
+    assert "WARNING" not in caplog.text
+    rt.run(duration=2.0)
+    assert (
+        caplog.text.count("no ground truth on /lizi1/base_pose_ground_truth since the start") == 1
+    )
+    assert "libgazebo_ros_p3d.so" in caplog.text and "target_frame" not in caplog.text
+    hold(rt, sim, rt.now(), (0.0, 0.0, 0.0), (1.0, 1.0, 0.0))
+    rt.run(duration=GRACE + 1.0)  # it stopped again: said once more, with when it stopped
+    assert caplog.text.count("no ground truth on /lizi1/base_pose_ground_truth since") == 2
 
 
 def test_initialpose_moves_the_localized_pose():

@@ -10,8 +10,10 @@ The run is the lesson's setup without move_base: the ``Simulator`` on the Willow
 
 Choices made here, and why:
 
-- ``lizi`` rather than ``turtlebot3_burger``: its wheel-encoder odometry drifts (skid steer:
-  when turning, it reports several times the true rotation) and its 30 m, 270-degree laser
+- ``lizi`` with ``odometrySource encoder`` (opt-in; Gazebo's skid-steer plugin, and fleetsim's
+  by default, report the true pose) rather than ``turtlebot3_burger``: its wheel-encoder
+  odometry drifts (skid steer: when turning, it reports several times the true rotation), and a
+  teleport does not show in it (the kidnapped-robot test); and its 30 m, 270-degree laser
   sees far down Willow's corridors; the burger reports its true pose as odometry
   (``odometrySource world``) and sees only 3.5 m.
 - ``wall_height`` 2 m: lizi's laser sits 1.08 m above the floor, above the default 1 m walls.
@@ -109,8 +111,12 @@ def start_pose(waypoints: np.ndarray = ROUTE) -> tuple[float, float, float]:
 
 
 def lizi_robot(scan_rate: float = 10.0):
-    """The lizi model from its xacro, its laser at ``scan_rate`` Hz."""
+    """The lizi model from its xacro, its laser at ``scan_rate`` Hz, wheel-encoder odometry."""
     robot = load_robot(LIZI_XACRO)
+    for block in robot.gazebo:
+        for plugin in block.plugins:
+            if plugin.filename == "libgazebo_ros_skid_steer_drive.so":
+                plugin.params["odometrySource"] = "encoder"
     for sensor in robot.sensors():
         if sensor.type == "ray":
             sensor.update_rate = scan_rate

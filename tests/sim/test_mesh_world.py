@@ -1,0 +1,172 @@
+"""A world built from a non-convex building mesh (fixtures/models/mesh_building, one closed OBJ
+of two rooms and a corridor with doors): robots start free, drive through doors and are
+stopped by walls, lasers and the collision parts match the true triangles."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+from scipy.spatial import ConvexHull
+
+from fleetsim.description import load_robot
+from fleetsim.sim import Engine, decompose
+from fleetsim.sim.mesh_assets import HULL_GROUP, RAY_GROUP, VISUAL_GROUP
+from fleetsim.sim.mesh_files import triangle_mesh
+from fleetsim.sim.plugins.base import DrivePlugin
+from fleetsim.sim.plugins.laser import LaserPlugin
+
+from .conftest import FIXTURES
+
+WORLD = FIXTURES / "mesh_building.world"
+OBJ = FIXTURES / "models/mesh_building/meshes/building.obj"
+BURGER = (
+    Path(__file__).resolve().parents[2]
+    / "src/fleetsim/assets/robots/turtlebot3_burger/urdf/turtlebot3_burger.urdf.xacro"
+)
+
+
+@pytest.fixture(autouse=True)
+def models(monkeypatch, tmp_path):
+    monkeypatch.setenv("GAZEBO_MODEL_PATH", str(FIXTURES / "models"))
+    monkeypatch.setenv("FLEETSIM_CACHE_DIR", str(tmp_path / "cache"))
+    yield
+    assert not Path("MUJOCO_LOG.TXT").exists()
+
+
+@pytest.fixture(scope="module")
+def burger():
+    return load_robot(BURGER)
+
+
+def no_mujoco_warnings(e: Engine) -> None:
+    counts = [int(w.number) for w in e.data.warning]
+    assert not any(counts), counts
+
+
+def exact_ranges(origin, angles, rmax):
+    """First hit of horizontal rays against every triangle of the OBJ (Moller-Trumbore)."""
+    v, f = triangle_mesh(OBJ)
+    a, b, c = (v[f[:, i]] for i in range(3))
+    e1, e2 = b - a, c - a
+    out = np.full(len(angles), np.inf)
+    for i, ang in enumerate(angles):
+        d = np.array([np.cos(ang), np.sin(ang), 0.0])
+        p = np.cross(d, e2)
+        det = np.einsum("ij,ij->i", e1, p)
+        ok = np.abs(det) > 1e-12
+        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+        s = origin - a
+        u = np.einsum("ij,ij->i", s, p) * inv
+        q = np.cross(s, e1)
+        w = (q @ d) * inv
+        t = np.einsum("ij,ij->i", e2, q) * inv
+        hit = ok & (u >= 0) & (w >= 0) & (u + w <= 1) & (t > 0)
+        if hit.any():
+            out[i] = t[hit].min() if t[hit].min() <= rmax else np.inf
+    return out
+
+
+def test_building_is_cut_into_prisms_that_fill_exactly_its_volume():
+    v, f = triangle_mesh(OBJ)
+    d = decompose.decompose(v, f)
+    assert d.methods == ["prisms"] and not d.convex and not d.problems
+    volume = sum(ConvexHull(p).volume for p in d.parts)
+    assert volume == pytest.approx(decompose.mesh_volume(v, f), rel=1e-9)
+
+
+def test_robots_start_free_in_every_room_and_the_include_pose_is_used(burger):
+    e = Engine(WORLD)
+    assert e.world.models[-1].name == "building"
+    assert e.world.models[-1].pose == (0, 0, 0, 0, 0, 0)  # the include's, not the model's
+    names = [e.model.geom(i).name for i in range(e.model.ngeom)]
+    hulls = [n for n in names if ":cvx" in n]
+    assert len(hulls) > 1
+    for name, pose in [("a", (1.5, 1.5)), ("b", (9.0, 2.0)), ("c", (6.0, 6.5))]:
+        e.spawn_robot(name, burger, (*pose, 0, 0, 0, 0.3))
+    e.advance(0.2)
+    assert e.contacts() == []
+    for name, pose in [("a", (1.5, 1.5)), ("b", (9.0, 2.0)), ("c", (6.0, 6.5))]:
+        assert np.allclose(e.model_pose(name)[0][:2], pose, atol=0.01)
+    no_mujoco_warnings(e)
+
+
+def test_robot_drives_through_a_door_and_a_wall_stops_another(burger):
+    e = Engine(WORLD)
+    through = e.spawn_robot("through", burger, (3.0, 3.9, 0, 0, 0, np.pi / 2))
+    blocked = e.spawn_robot("blocked", burger, (1.2, 3.9, 0, 0, 0, np.pi / 2))
+    drives = [next(p for p in r.plugins if isinstance(p, DrivePlugin)) for r in (through, blocked)]
+    touched = False
+    for _ in range(120):  # 12 s at 0.22 m/s: 2.6 m north
+        for plugin in drives:
+            plugin.command(0.22, 0.0, e.time)
+        e.advance(0.1)
+        touched |= any("through" in (c.model1, c.model2) for c in e.contacts())
+    x, y = e.model_pose("through")[0][:2]
+    assert y > 6.0 and abs(x - 3.0) < 0.2  # in the corridor, through the door at x 2.5..3.5
+    assert not touched
+    by = e.model_pose("blocked")[0][1]
+    assert 4.5 < by < 4.9  # pressed against the wall between room A and the corridor
+    assert any("building" in (c.model1, c.model2) for c in e.contacts())
+    no_mujoco_warnings(e)
+
+
+def test_laser_and_collision_parts_match_the_true_walls_within_2cm(burger):
+    e = Engine(WORLD)
+    ent = e.spawn_robot("r", burger, (4.0, 3.0, 0, 0, 0, 0.4))
+    e.advance(0.1)
+    laser = next(p for p in ent.plugins if isinstance(p, LaserPlugin))
+    laser.noise_std = laser.noise_mean = 0.0
+    e.layouts.clear()
+    got = e.lasers.measure(e, [laser], e.time)[0].ranges.astype(np.float64)
+    origins, angles, _ = laser.rays(e)
+    want = exact_ranges(origins[0], angles, laser.range_max)
+    seen = np.isfinite(want)
+    assert seen.sum() > len(want) // 4  # the burger's 3.5 m reaches the walls of room A
+    assert np.array_equal(np.isfinite(got), seen)
+    assert np.max(np.abs(got[seen] - want[seen])) < 0.02
+    assert np.all(e.lasers.static_grid.prims[:, 0] == 2)  # the triangles, not the parts' boxes
+    # the collision parts (what robots touch) against the true triangles, from free points
+    m, d = e.model, e.data
+    mask = np.zeros(6, np.uint8)
+    mask[HULL_GROUP] = 1
+    gid = np.zeros(1, np.int32)
+    for origin in [(1.0, 1.0, 0.1), (5.0, 4.0, 0.5), (6.0, 2.5, 0.3), (3.0, 6.0, 1.0)]:
+        for ang in np.linspace(0, 2 * np.pi, 90, endpoint=False):
+            vec = np.array([np.cos(ang), np.sin(ang), 0.0])
+            dist = mujoco.mj_ray(m, d, np.array(origin, float), vec, mask, 1, -1, gid)
+            exact = exact_ranges(np.array(origin, float), [ang], 50.0)[0]
+            assert abs(dist - exact) < 0.02, (origin, ang, dist, exact)
+    no_mujoco_warnings(e)
+
+
+def test_cameras_render_the_true_mesh_not_the_parts():
+    e = Engine(WORLD)
+    m = e.model
+    hull = m.geom_group == HULL_GROUP
+    assert hull.any()
+    assert set(np.flatnonzero(m.geom_group == RAY_GROUP)).isdisjoint(np.flatnonzero(hull))
+    rendered = (m.geom_group <= 2) & (m.geom_type == mujoco.mjtGeom.mjGEOM_MESH)
+    _, f = triangle_mesh(OBJ)
+    faces = {int(m.mesh_facenum[m.geom_dataid[g]]) for g in np.flatnonzero(rendered)}
+    assert faces == {len(f)}  # the visual is the whole mesh, the hull parts are not drawn
+    assert np.all(m.geom_group[(m.geom_contype != 0) & (m.geom_type == 7)] == HULL_GROUP)
+    assert VISUAL_GROUP not in m.geom_group[hull]
+
+
+def test_second_build_reads_the_decomposition_from_the_cache(monkeypatch):
+    first = Engine(WORLD)
+    files = list(decompose.cache_dir().glob("convex/*.npz"))
+    assert len(files) == 1
+    stamp = files[0].stat().st_mtime_ns
+
+    def fail(*args, **kwargs):
+        raise AssertionError("decomposed again instead of reading the cache")
+
+    monkeypatch.setattr(decompose, "decompose", fail)
+    second = Engine(WORLD)
+    assert files[0].stat().st_mtime_ns == stamp
+    assert second.model.ngeom == first.model.ngeom
+    np.testing.assert_array_equal(second.model.geom_aabb, first.model.geom_aabb)

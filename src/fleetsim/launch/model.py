@@ -3,34 +3,59 @@
 A `LaunchPlan` is flat, as roslaunch's is after loading: the parameter operations in file order
 (all applied before any node starts) and the nodes in file order, each with its global
 namespace, remaps and arguments. Frontends (XML, YAML) produce plans; the runner executes them.
+
+Parameters are applied in roslaunch's phases, whatever their place in the file: first the
+``<rosparam command="delete">`` and ``dump`` commands (roslaunch runs them as setup
+executables, before any parameter is uploaded), then every ``clear_params`` namespace, then
+every value in file order (the last one set wins).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
+import yaml
+
+from fleetsim.errors import LaunchError
 from fleetsim.runtime.params import ParamTree
+
+#: the phase of each kind of parameter operation (roslaunch's order, see the module docstring)
+PHASES = {"delete": 0, "dump": 0, "clear": 1, "set": 2, "load": 2}
 
 
 @dataclass
 class ParamOp:
-    """One parameter operation: ``set`` a value, ``load`` (merge) a mapping, or ``delete``."""
+    """One parameter operation: ``set`` a value, ``load`` (merge) a mapping, ``delete`` a name
+    (``<rosparam command="delete">``), ``clear`` a namespace (``clear_params``), or ``dump`` a
+    namespace to the file ``value``.
+
+    ``origins`` maps the keys of a loaded mapping (``a/b``, relative to ``name``; ``""`` for the
+    value itself) to the ``file:line`` they came from, so a wrong value can be traced back.
+    """
 
     kind: str
     name: str
     value: Any = None
     source: str = ""
+    origins: dict[str, str] = field(default_factory=dict)
 
     def apply(self, tree: ParamTree) -> None:
         if self.kind == "set":
-            tree.set(self.name, self.value)
+            tree.set(self.name, self.value, origin=self.origins.get("", self.source))
         elif self.kind == "load":
-            tree.update(self.name, self.value)
-        elif self.kind == "delete":
+            tree.update(self.name, self.value, origins=self.origins)
+        elif self.kind in ("delete", "clear"):
             if tree.has(self.name):
                 tree.delete(self.name)
-        else:  # pragma: no cover - frontends only make the three kinds
+        elif self.kind == "dump":
+            data = tree.get(self.name, {})
+            try:
+                Path(self.value).write_text(yaml.safe_dump(data, sort_keys=False))
+            except OSError as e:
+                raise LaunchError(f"{self.source}: cannot dump to {self.value}: {e}") from None
+        else:  # pragma: no cover - frontends only make these kinds
             raise ValueError(self.kind)
 
 
@@ -46,7 +71,13 @@ class NodeSpec:
     remaps: dict[str, str] = field(default_factory=dict)
     output: str = "log"
     respawn: bool = False
+    respawn_delay: float = 0.0
     required: bool = False
+    #: roslaunch's ``cwd``: ROS_HOME (default) or node; nodes run in process, so the only
+    #: thing it could change is where relative paths in args are read from (they are read
+    #: from the current directory, as under ROS_HOME when roslaunch runs from there)
+    cwd: str = "ROS_HOME"
+    machine: str = ""
     env: dict[str, str] = field(default_factory=dict)
     source: str = ""
 
@@ -66,7 +97,8 @@ class LaunchPlan:
     notes: list[str] = field(default_factory=list)
 
     def apply_params(self, tree: ParamTree) -> None:
-        for op in self.params:
+        # sorted() is stable: file order within each phase
+        for op in sorted(self.params, key=lambda op: PHASES[op.kind]):
             op.apply(tree)
 
     def param_tree(self) -> ParamTree:

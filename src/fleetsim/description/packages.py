@@ -7,13 +7,14 @@ fleetsim's own ``assets/robots``. The first package found with a name wins, as i
 
 from __future__ import annotations
 
+import difflib
 import os
 from collections.abc import Iterable
 from pathlib import Path
 
 from lxml import etree
 
-from fleetsim.errors import DescriptionError, did_you_mean
+from fleetsim.errors import DescriptionError
 
 ASSET_ROBOTS = Path(__file__).resolve().parent.parent / "assets" / "robots"
 ENV_VARS = ("FLEETSIM_PACKAGE_PATH", "ROS_PACKAGE_PATH")
@@ -69,6 +70,21 @@ def env_package_path() -> list[Path]:
     return out
 
 
+def similar_names(word: str, choices: Iterable[str], n: int = 3) -> str:
+    """``" (did you mean 'a' or 'b'?)"`` for up to ``n`` close names: spelled alike (difflib),
+    or one containing the other (``lizi_description`` and ``lizi``); ``""`` when none is."""
+    choices = sorted(set(choices))
+    close = difflib.get_close_matches(word, choices, n=n, cutoff=0.6)
+    w = word.lower()
+    for c in choices:
+        lc = c.lower()
+        if len(close) < n and c not in close and min(len(lc), len(w)) >= 3 and (lc in w or w in lc):
+            close.append(c)
+    if not close:
+        return ""
+    return " (did you mean " + " or ".join(f"'{c}'" for c in close) + "?)"
+
+
 class PackageIndex:
     """Name → folder map built once from a search path; ``find`` raises a helpful error."""
 
@@ -97,8 +113,9 @@ class PackageIndex:
             return self.packages[name]
         except KeyError:
             where = ", ".join(str(p) for p in self.searched)
+            hint = similar_names(name, self.packages)
             raise DescriptionError(
-                f"package '{name}' not found{did_you_mean(name, self.packages)}; searched {where}. "
+                f"package '{name}' not found{hint}; searched {where}. "
                 "Add its parent folder to FLEETSIM_PACKAGE_PATH (or ROS_PACKAGE_PATH), or pass "
                 "package_path=[...]"
             ) from None

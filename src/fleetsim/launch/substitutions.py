@@ -1,9 +1,12 @@
 """roslaunch substitution args: ``$(find)``, ``$(arg)``, ``$(eval)``, ``$(env)``, ``$(optenv)``,
 ``$(anon)``, ``$(dirname)``, and ROS 2's ``$(var)`` and ``$(find-pkg-share)`` for YAML files.
 
-Semantics follow roslaunch: ``$(eval ...)`` must be the whole attribute; the others may be
-embedded in text and are expanded left to right. An ``$(arg x)`` that has no value is an error
-naming the arg and where it was used.
+Semantics follow roslaunch's ``substitution_args.py``: ``$(eval ...)`` must be the whole
+attribute and sees every Python builtin, the ``math`` module, ``true``/``false``, ``arg()``,
+``find()``, ``env()``, ``optenv()``, ``anon()``, ``dirname()`` and the args by bare name (both
+converted as roslaunch's ``auto`` type); the others may be embedded in text and are expanded
+left to right. An ``$(arg x)`` that has no value is an error naming the arg and where it was used.
+Where fleetsim differs on purpose: ``$(anon x)`` is deterministic (same seed, same name).
 """
 
 from __future__ import annotations
@@ -23,6 +26,9 @@ _EVAL = re.compile(r"\A\$\(eval\s+(.*)\)\Z", re.S)
 
 TRUE_WORDS = {"true", "1"}
 FALSE_WORDS = {"false", "0"}
+#: the substitution commands roslaunch (ROS 1) knows; XML files may use only these
+ROS1_KINDS = frozenset({"arg", "find", "env", "optenv", "anon", "dirname", "eval"})
+ALL_KINDS = ROS1_KINDS | {"var", "find-pkg-share", "find-pkg-prefix"}
 
 
 @dataclass
@@ -36,19 +42,43 @@ class Context:
     seed: int = 0
     #: args passed in by the includer or the command line, for the file's <arg> declarations
     passed: dict[str, str] = field(default_factory=dict)
+    #: the file was included with pass_all_args="true": re-declaring or overriding a passed
+    #: arg is allowed, and passed args the file does not declare are ignored (ROS Melodic+)
+    pass_all_args: bool = False
+    #: the substitution commands this frontend knows
+    kinds: frozenset[str] = ALL_KINDS
 
     def child(
-        self, args: dict[str, str | None], filename: Path | None, passed: dict[str, str]
+        self,
+        args: dict[str, str | None],
+        filename: Path | None,
+        passed: dict[str, str],
+        pass_all_args: bool = False,
     ) -> Context:
-        return Context(args, self.find, filename, self.anon, self.seed, passed)
+        return Context(
+            args, self.find, filename, self.anon, self.seed, passed, pass_all_args, self.kinds
+        )
+
+    def scoped(self) -> Context:
+        """A ``<group>``'s context: args declared inside it are not seen after it (roslaunch
+        copies the arg dictionary into each group)."""
+        return Context(dict(self.args), self.find, self.filename, self.anon, self.seed,
+                       dict(self.passed), False, self.kinds)  # fmt: skip
+
+    def value_of(self, name: str) -> str | None:
+        """The arg's current value: its declared value, else the one passed in."""
+        value = self.args.get(name)
+        return value if value is not None else self.passed.get(name)
 
     def arg(self, name: str, where: str) -> str:
-        if name not in self.args:
+        # roslaunch reads args from one dictionary holding declared and passed values, so a
+        # passed arg is readable even where it is not declared (pass_all_args relies on it)
+        if name not in self.args and name not in self.passed:
             raise LaunchError(
                 f"{where}: arg '{name}' is not declared{did_you_mean(name, self.args)}; "
                 f'add <arg name="{name}" default="..."/>'
             )
-        value = self.args[name]
+        value = self.value_of(name)
         if value is None:
             raise LaunchError(
                 f"{where}: arg '{name}' is required but not set; pass {name}:=VALUE or give it "
@@ -64,6 +94,12 @@ class Context:
 
 
 def _one(kind: str, words: list[str], ctx: Context, where: str) -> str:
+    if kind not in ctx.kinds:
+        raise LaunchError(
+            f"{where}: unknown substitution '$({kind} ...)'"
+            f"{did_you_mean(kind, sorted(ctx.kinds))}; roslaunch knows "
+            f"{', '.join(sorted(ctx.kinds))}"
+        )
     if kind in ("arg", "var"):
         _need(kind, words, 1, where)
         return ctx.arg(words[0], where)
@@ -98,18 +134,13 @@ def _need(kind: str, words: list[str], n: int, where: str) -> None:
 
 
 def _eval(expr: str, ctx: Context, where: str) -> str:
-    # roslaunch's $(eval): a Python expression over the args, with arg(), find(), env(),
-    # optenv(), anon(), dirname() and math. Only names, no builtins beyond a few safe ones.
-    class _Args(dict):
-        def __missing__(self, key):
-            # like roslaunch, a bare arg name reads as its converted value ("false" -> False,
-            # "3" -> 3); arg('name') gives the string
-            if key in ctx.args:
-                return auto_value(ctx.arg(key, where))
-            raise LaunchError(f"{where}: $(eval {expr}): unknown name '{key}'")
-
-    scope = _Args(
-        arg=lambda n: ctx.arg(n, where),
+    # roslaunch's $(eval): a Python expression whose names are, in this order, the helper
+    # functions and math, then the args (auto-converted), then Python's builtins; no '__'.
+    if "__" in expr:
+        raise LaunchError(f"{where}: $(eval ...) may not contain double underscore expressions")
+    functions = {k: v for k, v in vars(math).items() if not k.startswith("_")}
+    functions.update(
+        arg=lambda n: auto_value(ctx.arg(n, where)),
         find=lambda p: str(ctx.find(p)),
         env=lambda n: _one("env", [n], ctx, where),
         optenv=lambda n, d="": os.environ.get(n, d),
@@ -117,24 +148,24 @@ def _eval(expr: str, ctx: Context, where: str) -> str:
         dirname=lambda: _one("dirname", [], ctx, where),
         true=True,
         false=False,
-        int=int,
-        float=float,
-        str=str,
-        len=len,
-        min=min,
-        max=max,
-        abs=abs,
-        round=round,
-        **{k: getattr(math, k) for k in ("pi", "sin", "cos", "tan", "sqrt", "radians")},
     )
+
+    class _Names(dict):
+        def __missing__(self, key):
+            if key in ctx.args or key in ctx.passed:
+                return auto_value(ctx.arg(key, where))
+            raise KeyError(key)  # on to Python's builtins, as roslaunch's lookup falls through
+
     try:
-        value = eval(expr, {"__builtins__": {}}, scope)
+        value = eval(expr, {}, _Names(functions))
     except LaunchError:
         raise
+    except NameError as e:
+        raise LaunchError(
+            f"{where}: $(eval {expr}): {e}; declare it with <arg> or call arg('name')"
+        ) from None
     except Exception as e:
         raise LaunchError(f"{where}: $(eval {expr}) failed: {type(e).__name__}: {e}") from None
-    if isinstance(value, bool):
-        return "true" if value else "false"
     return str(value)
 
 
@@ -142,8 +173,8 @@ def substitute(text: str | None, ctx: Context, where: str) -> str | None:
     """Expand every substitution in ``text``; ``where`` names the file, line and attribute."""
     if text is None or "$(" not in text:
         return text
-    m = _EVAL.match(text.strip())
-    if m:
+    m = _EVAL.match(text)
+    if m and "eval" in ctx.kinds:
         return _eval(m.group(1), ctx, where)
     if "$(eval" in text:
         raise LaunchError(f"{where}: $(eval ...) must be the whole attribute value: {text!r}")
@@ -158,15 +189,19 @@ def substitute(text: str | None, ctx: Context, where: str) -> str | None:
 
 
 def auto_value(text: str):
-    """roslaunch's automatic conversion: int, then float, then true/false, else the string."""
-    v = text.strip()
-    for conv in (int, float):
-        try:
-            return conv(v)
-        except ValueError:
-            pass
-    if v.lower() in ("true", "false"):
-        return v.lower() == "true"
+    """roslaunch's ``auto`` conversion (``loader.convert_value``): text with a '.' that parses
+    as a float is a float; else text without '_' that parses as an int is an int; else
+    true/false (any case) is a bool; else the text itself ("1e3", "inf" and "1_000" stay
+    strings, as in roslaunch)."""
+    try:
+        if "." in text:
+            return float(text)
+        if "_" not in text:
+            return int(text)
+    except ValueError:
+        pass
+    if text.lower() in ("true", "false"):
+        return text.lower() == "true"
     return text
 
 
@@ -178,3 +213,16 @@ def to_bool(value: str, where: str) -> bool:
     if v in FALSE_WORDS:
         return False
     raise LaunchError(f"{where}: expected true/false (or 1/0), got {value!r}")
+
+
+def strict_bool(value: str, where: str) -> bool:
+    """roslaunch's reading of respawn, required, clear_params, pass_all_args and subst_value:
+    only true or false (any case); 1/0, which if/unless accept, are an error here."""
+    v = value.lower()
+    if v == "true":
+        return True
+    if v == "false":
+        return False
+    if not value:
+        raise LaunchError(f"{where}: a bool value must be non-empty (true or false)")
+    raise LaunchError(f"{where}: invalid bool value {value!r}; roslaunch accepts true or false")

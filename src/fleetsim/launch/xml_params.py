@@ -1,5 +1,17 @@
 """roslaunch XML's parameter elements: ``<param>`` (value, type, textfile, binfile, command)
-and ``<rosparam>`` (load, delete; ``ns``, ``param``, ``subst_value``), as a mixin of the XML loader.
+and ``<rosparam>`` (load, dump, delete; ``ns``, ``param``, ``subst_value``), as a mixin of the
+XML loader, with roslaunch's rules (``xmlloader.py`` and ``loader.py`` of ros_comm):
+
+- ``value`` is stripped and, like ``textfile`` and ``command`` output, converted by ``type``
+  (``auto`` when absent: float if it has a '.', else int, else true/false, else text).
+- Inside a ``<node>`` every ``<param>`` name is the node's private name (a leading ``/`` too,
+  as roslaunch's name joining does); ``<rosparam param="/x">`` stays global.
+- ``~name`` outside a node is kept for every later ``<node>`` in the scope.
+- ``<rosparam>``'s ``ns`` and ``param`` are joined; content that is not a mapping needs one.
+- rosparam's ``!degrees``/``deg()`` and ``!radians``/``rad()`` load as radians.
+
+Every value remembers its file and line (a rosparam file's own line, or the launch file's), so a
+value of the wrong type is reported where it was written.
 
 ``command="$(find xacro)/xacro FILE name:=value"`` (and the older ``xacro.py``) runs the xacro
 processor in process; other commands run as subprocesses, as roslaunch runs them.
@@ -9,6 +21,7 @@ from __future__ import annotations
 
 import shlex
 import subprocess
+from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -16,20 +29,21 @@ import yaml
 
 from fleetsim.errors import FleetsimError, LaunchError
 from fleetsim.launch.model import ParamOp
-from fleetsim.launch.substitutions import auto_value, substitute, to_bool
+from fleetsim.launch.substitutions import auto_value, strict_bool, substitute, to_bool
 from fleetsim.runtime import names
+from fleetsim.runtime.param_yaml import load_yaml_lines
 
 
 def convert_value(value: str, type_: str | None, where: str) -> Any:
-    """roslaunch's value conversion: explicit ``type`` or int, then float, then bool, then str."""
+    """roslaunch's value conversion: explicit ``type`` or ``auto`` (see `auto_value`)."""
     t = (type_ or "auto").strip().lower()
     try:
         if t in ("str", "string"):
             return value
         if t == "int":
-            return int(value.strip())
+            return int(value)
         if t == "double":
-            return float(value.strip())
+            return float(value)
         if t in ("bool", "boolean"):
             return to_bool(value, where)
         if t == "yaml":
@@ -43,18 +57,61 @@ def convert_value(value: str, type_: str | None, where: str) -> Any:
     return auto_value(value)
 
 
+def _ns_join(ns: str, name: str) -> str:
+    """rosgraph's ``ns_join``: a global or private name stays as it is."""
+    if not name or name.startswith(("/", "~")) or not ns:
+        return name or ns
+    return ns.rstrip("/") + "/" + name
+
+
+@cache
+def _lines(path: str) -> list[str]:
+    return Path(path).read_text().splitlines()
+
+
+def _text_line(path: Path, el) -> int:
+    """The line on which an element's text starts: the end of its start tag."""
+    try:
+        lines = _lines(str(path))
+    except OSError:
+        return el.sourceline
+    i = el.sourceline - 1
+    col = lines[i].find("<" + el.tag) if i < len(lines) else -1
+    if col < 0:
+        return el.sourceline
+    quote = ""
+    while i < len(lines):
+        for ch in lines[i][col:]:
+            if quote:
+                quote = "" if ch == quote else quote
+            elif ch in "\"'":
+                quote = ch
+            elif ch == ">":
+                return i + 1
+        i, col = i + 1, 0
+    return el.sourceline
+
+
 class ParamElements:
     """The parameter elements; mixed into `XmlLoader` (which provides plan, _require, ...)."""
 
     def _param_name(self, name: str, scope: Any, where: str) -> str:
         if scope.node is not None:
+            # roslaunch joins every node <param> name onto the node's private namespace
             private = names.join(scope.ns, scope.node.name)
-            if name.startswith("/"):
-                return names.resolve(name, "/", where=f" ({where})")
-            return names.resolve(name.lstrip("~"), private, where=f" ({where})")
-        if name.startswith("~"):
-            raise LaunchError(f"{where}: private parameter '{name}' outside a <node>")
+            return names.resolve(name.lstrip("~/"), private, where=f" ({where})")
         return names.resolve(name, scope.ns, where=f" ({where})")
+
+    def _read(self, kind: str, path: str, where: str, binary: bool = False):
+        from fleetsim.launch.packages import similar_files
+
+        p = Path(path)
+        try:
+            return p.read_bytes() if binary else p.read_text()
+        except OSError as e:
+            raise LaunchError(
+                f"{where}: cannot read {kind} {p}: {e.strerror}{similar_files(p)}"
+            ) from None
 
     def _param(self, el, attrs, scope: Any) -> None:
         self._require(el, attrs, scope, "name")
@@ -65,21 +122,24 @@ class ParamElements:
                 f"{where}: <param name='{attrs['name']}'> needs exactly one of value, textfile, "
                 f"binfile, command (got {sources or 'none'})"
             )
-        kind = sources[0]
+        kind, ptype = sources[0], attrs.get("type")
         if kind == "value":
-            value = convert_value(attrs["value"], attrs.get("type"), where)
-        elif kind in ("textfile", "binfile"):
-            p = Path(attrs[kind])
-            try:
-                value = p.read_text() if kind == "textfile" else p.read_bytes()
-            except OSError as e:
-                raise LaunchError(f"{where}: cannot read {p}: {e.strerror}") from None
+            value = convert_value(attrs["value"].strip(), ptype, where)
+        elif kind == "textfile":
+            value = convert_value(self._read("textfile", attrs[kind], where), ptype, where)
+        elif kind == "binfile":
+            value = self._read("binfile", attrs[kind], where, binary=True)
         else:
-            value = self._command(attrs["command"], where)
-            if attrs.get("type") and attrs["type"] not in ("str", "string"):
-                value = convert_value(value, attrs["type"], where)
-        name = self._param_name(attrs["name"], scope, where)
-        self.plan.params.append(ParamOp("set", name, value, where))
+            value = convert_value(self._command(attrs["command"], where), ptype, where)
+        name = attrs["name"].strip()
+        if scope.node is None and name.startswith("~"):
+            scope.private.append((name, value, where))
+            return
+        op = ParamOp("set", self._param_name(name, scope, where), value, where)
+        if scope.pending is not None:
+            scope.pending.append(op)
+        else:
+            self.plan.params.append(op)
 
     def _command(self, command: str, where: str) -> str:
         try:
@@ -103,6 +163,7 @@ class ParamElements:
 
     def _xacro(self, argv: list[str], where: str) -> str:
         from fleetsim.description.urdf import urdf_text
+        from fleetsim.launch.packages import similar_files
 
         files, xargs = [], {}
         skip = False
@@ -121,6 +182,10 @@ class ParamElements:
                 files.append(a)
         if len(files) != 1:
             raise LaunchError(f"{where}: xacro needs exactly one input file, got {files}")
+        if not Path(files[0]).is_file():
+            raise LaunchError(
+                f"{where}: xacro input {files[0]} does not exist{similar_files(Path(files[0]))}"
+            )
         try:
             text, _ = urdf_text(Path(files[0]), xargs)
         except FleetsimError as e:
@@ -129,57 +194,51 @@ class ParamElements:
 
     def _rosparam(self, el, attrs, scope: Any) -> None:
         where = self._where(scope, el)
-        command = attrs.get("command", "load")
-        base = names.join(scope.ns, scope.node.name) if scope.node is not None else scope.ns
-        ns = self._ns_join(base, attrs.get("ns"), where)
-        target = ns
-        if attrs.get("param"):
-            p = attrs["param"]
-            target = (
-                names.resolve(p, "/", where=f" ({where})")
-                if p.startswith("/")
-                else (names.join(ns, p))
-            )
-        if command == "delete":
-            self.plan.params.append(ParamOp("delete", target, source=where))
-            return
-        if command == "dump":
-            self.plan.notes.append(f"{where}: <rosparam command='dump'> skipped")
-            return
-        if command != "load":
+        command = attrs.get("command") or "load"
+        if command not in ("load", "dump", "delete"):
             raise LaunchError(
                 f"{where}: rosparam command must be load, dump or delete, got {command!r}"
             )
-        if attrs.get("file"):
-            path = Path(attrs["file"])
-            try:
-                text = path.read_text()
-            except OSError as e:
-                raise LaunchError(f"{where}: cannot read {path}: {e.strerror}") from None
-            source = str(path)
+        base = names.join(scope.ns, scope.node.name) if scope.node is not None else scope.ns
+        param = _ns_join(attrs.get("ns") or "", attrs.get("param") or "")
+        if param.startswith("~"):
+            raise LaunchError(
+                f"{where}: a private rosparam name ({param!r}) outside a <node> is not "
+                "supported; put the <rosparam> inside the node"
+            )
+        full = names.resolve(param, base, where=f" ({where})") if param else base
+        file = attrs.get("file")
+        if command == "delete":
+            if file is not None:
+                raise LaunchError(f"{where}: 'file' attribute is invalid with 'delete' command")
+            self.plan.params.append(ParamOp("delete", full, source=where))
+            return
+        if command == "dump":
+            if not file:
+                raise LaunchError(f"{where}: <rosparam command='dump'> needs file=")
+            self.plan.params.append(ParamOp("dump", full, file, source=where))
+            return
+        if file is not None:
+            text = self._read("rosparam file", file, where)
+            source, offset = str(Path(file)), 0
         else:
-            text = el.text or ""
-            source = where
-        if attrs.get("subst_value") and to_bool(attrs["subst_value"], where):
+            text = (el.text or "") + "".join(c.tail or "" for c in el)
+            source, offset = str(scope.file), _text_line(scope.file, el) - 1
+        if self._flag(el, attrs, scope, "subst_value"):
             text = substitute(text, scope.ctx, where) or ""
         try:
-            data = yaml.safe_load(text)
-        except yaml.YAMLError as e:
-            mark = getattr(e, "problem_mark", None)
-            at = f":{mark.line + 1}" if mark is not None else ""
-            problem = getattr(e, "problem", None) or str(e)
-            raise LaunchError(f"{source}{at}: YAML does not parse: {problem} ({where})") from None
+            data, origins = load_yaml_lines(text, source, offset)
+        except FleetsimError as e:
+            raise LaunchError(f"{e} ({where})") from None
         if data is None:
             return
-        if isinstance(data, dict) and not attrs.get("param"):
-            self.plan.params.append(ParamOp("load", ns, data, where))
-        elif attrs.get("param"):
-            if isinstance(data, dict):
-                self.plan.params.append(ParamOp("load", target, data, where))
-            else:
-                self.plan.params.append(ParamOp("set", target, data, where))
-        else:
+        if not param and not isinstance(data, dict):
             raise LaunchError(
                 f"{where}: rosparam content is a {type(data).__name__}, not a mapping; "
                 "name it with param="
             )
+        kind = "load" if isinstance(data, dict) else "set"
+        self.plan.params.append(ParamOp(kind, full, data, where, origins))
+
+
+__all__ = ["ParamElements", "convert_value", "strict_bool"]

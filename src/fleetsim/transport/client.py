@@ -4,12 +4,22 @@ It is a zenoh *client* session connected to the simulation's endpoint, with no r
 own: it reads graph snapshots, subscribes and publishes CDR on topic keys, calls services and
 talks to the parameter server. Opening it fails fast (bounded by ``timeout``) with the one-line
 "no simulation running at ..." error when nothing fleetsim answers there.
+
+A script that forgets ``close()`` still exits. zenoh-python runs a Python callback on a
+non-daemon thread of its own, which Python's exit waits for before it runs any exit handler, so
+a client with a subscription kept its process alive forever. Here each subscription is a zenoh
+channel read by a daemon thread of ours (`_reader`), and the client closes itself when it is
+garbage collected or the interpreter exits (a `weakref.finalize`, which Python runs at exit).
+``with SimulationClient() as c:`` closes it at the end of the block.
 """
 
 from __future__ import annotations
 
 import json
+import logging
+import threading
 import time as _wall
+import weakref
 from collections.abc import Callable
 from typing import Any
 
@@ -27,6 +37,27 @@ from fleetsim.transport.keys import (
 )
 from fleetsim.transport.paramserver import request_param
 from fleetsim.transport.services import call_remote_service
+
+_log = logging.getLogger("fleetsim.transport")
+
+
+def _reader(sub: Any, handle: Callable[[Any], None], name: str) -> threading.Thread:
+    """A daemon thread that hands each sample of subscriber ``sub`` (a zenoh channel) to
+    ``handle``, until the subscriber is undeclared."""
+
+    def run() -> None:
+        try:
+            for sample in sub:  # ends when the subscriber is undeclared
+                try:
+                    handle(sample)
+                except Exception:  # a failing callback must not stop the subscription
+                    _log.exception("callback of the subscription to %s failed", name)
+        except Exception:  # the session closed under the reader (interpreter exit)
+            return
+
+    thread = threading.Thread(target=run, name=f"fleetsim-client {name}", daemon=True)
+    thread.start()
+    return thread
 
 
 class Received:
@@ -53,11 +84,12 @@ class ToolPublisher:
             encoding=zenoh.Encoding(cdr_encoding(msg_type.__msgtype__)),
             reliability=zenoh.Reliability.RELIABLE,
         )
+        client._pubs.add(self)
 
     def wait_for_subscribers(self, timeout: float) -> bool:
         """True once some process subscribes this topic (waits at most ``timeout`` s)."""
         deadline = _wall.monotonic() + timeout
-        while not self._pub.matching_status.matching:
+        while self._pub is not None and not self._pub.matching_status.matching:
             if _wall.monotonic() > deadline:
                 return False
             _wall.sleep(0.01)
@@ -66,12 +98,30 @@ class ToolPublisher:
     def publish(self, msg: Any) -> None:
         from fleetsim.msgs import serialize
 
+        if self._pub is None:
+            raise GraphError(f"publisher of {self.name} is closed")
         if type(msg) is not self.type:
             raise GraphError(f"{self.name} carries {self.type.__msgtype__}, not {type(msg)}")
         self._pub.put(serialize(msg), attachment=self._att)
 
     def close(self) -> None:
-        self._pub.undeclare()
+        """Undeclare the publisher (idempotent)."""
+        if self._pub is not None:
+            self._pub.undeclare()
+            self._pub = None
+
+
+def _close_session(session: Any, subs: list, pubs: weakref.WeakSet) -> None:
+    """Undeclare a client's subscribers and publishers and close its session.
+
+    Holds no reference to the client, so that `weakref.finalize` (which calls it once) can
+    call it at exit."""
+    for pub in list(pubs):
+        pub.close()
+    for sub in subs:
+        sub.undeclare()
+    subs.clear()
+    session.close()
 
 
 class SimulationClient:
@@ -91,13 +141,18 @@ class SimulationClient:
         self.keys = Keys(domain)
         self.timeout = timeout
         self._subs: list = []
+        self._pubs: weakref.WeakSet[ToolPublisher] = weakref.WeakSet()
         self.session = open_session("client", connect=[self.endpoint])
+        # closes the session at garbage collection or interpreter exit if close() was not called
+        self._finalizer = weakref.finalize(
+            self, _close_session, self.session, self._subs, self._pubs
+        )
         self.zid = str(self.session.zid())
         alive = [
             r for r in self.session.liveliness().get(self.keys.alive("*"), timeout=timeout) if r.ok
         ]
         if not alive:
-            self.session.close()
+            self.close()
             raise TransportError(no_simulation(self.endpoint))
 
     # -- graph ------------------------------------------------------------------------------
@@ -140,7 +195,8 @@ class SimulationClient:
     def subscribe(
         self, name: str, callback: Callable[[Received], None], latched: bool = True
     ) -> None:
-        """Call ``callback`` (on a zenoh thread) with every message on ``name``.
+        """Call ``callback`` (on a daemon thread, one per subscription) with every message on
+        ``name``.
 
         With ``latched``, a latched topic's last message is fetched first. Messages whose type is
         unknown here are skipped with one `MessageError` passed to ``callback`` as ``msg``.
@@ -156,12 +212,9 @@ class SimulationClient:
                 msg = e
             callback(Received(name, tname, msg, zid, node))
 
-        self._subs.append(
-            self.session.declare_subscriber(
-                self.keys.topic(name),
-                lambda s: decode(s.payload.to_bytes(), s.encoding, s.attachment),
-            )
-        )
+        sub = self.session.declare_subscriber(self.keys.topic(name))
+        self._subs.append(sub)
+        _reader(sub, lambda s: decode(s.payload.to_bytes(), s.encoding, s.attachment), name)
         if latched:
             for reply in self.session.get(self.keys.latched_any(name), timeout=self.timeout):
                 if reply.ok is not None:
@@ -190,10 +243,12 @@ class SimulationClient:
         return request_param(self.session, self.keys, op, name, value, self.timeout)
 
     def close(self) -> None:
-        for s in self._subs:
-            s.undeclare()
-        self._subs.clear()
-        self.session.close()
+        """Close the connection (idempotent; also done at interpreter exit)."""
+        self._finalizer()
+
+    @property
+    def closed(self) -> bool:
+        return not self._finalizer.alive
 
     def __enter__(self) -> SimulationClient:
         return self

@@ -55,7 +55,7 @@ def similar_files(path: Path, n: int = 3) -> str:
         entries = sorted(p.name for p in base.iterdir() if not p.name.startswith("."))
     except OSError:
         return ""
-    close = difflib.get_close_matches(missing, entries, n=n, cutoff=0.6)
+    close = difflib.get_close_matches(missing, entries, n=n, cutoff=0.75)
     stem = missing.split(".")[0]
     for e in entries:
         if len(close) < n and e not in close and (e.startswith(missing) or e.split(".")[0] == stem):

@@ -105,7 +105,7 @@ def _one(kind: str, words: list[str], ctx: Context, where: str) -> str:
         return ctx.arg(words[0], where)
     if kind in ("find", "find-pkg-share", "find-pkg-prefix"):
         _need(kind, words, 1, where)
-        return str(ctx.find(words[0]))
+        return _find(words[0], ctx, where)
     if kind == "env":
         _need(kind, words, 1, where)
         if words[0] not in os.environ:
@@ -128,6 +128,13 @@ def _one(kind: str, words: list[str], ctx: Context, where: str) -> str:
     )
 
 
+def _find(pkg: str, ctx: Context, where: str) -> str:
+    try:
+        return str(ctx.find(pkg))
+    except LaunchError as e:
+        raise LaunchError(f"{where}: {e}") from None
+
+
 def _need(kind: str, words: list[str], n: int, where: str) -> None:
     if len(words) != n:
         raise LaunchError(f"{where}: $({kind}) takes {n} argument(s), got {len(words)}: {words}")
@@ -141,7 +148,7 @@ def _eval(expr: str, ctx: Context, where: str) -> str:
     functions = {k: v for k, v in vars(math).items() if not k.startswith("_")}
     functions.update(
         arg=lambda n: auto_value(ctx.arg(n, where)),
-        find=lambda p: str(ctx.find(p)),
+        find=lambda p: _find(p, ctx, where),
         env=lambda n: _one("env", [n], ctx, where),
         optenv=lambda n, d="": os.environ.get(n, d),
         anon=ctx.anon_name,

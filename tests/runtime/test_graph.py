@@ -193,3 +193,29 @@ def test_remaps_and_private_params_reach_the_node():
     assert n.get_param("~min_particles") == 10
     assert rt.params.get("/lizi1/amcl/min_particles") == 10
     assert n.tf_prefix == "lizi1"
+
+
+def test_a_subscription_with_publisher_is_told_who_sent_each_message():
+    """Bridges name each message's node: (msg, publisher); plain subscriptions are unchanged."""
+    rt = Runtime()
+    a, b = Node(rt, "a"), Node(rt, "b")
+    pa = a.create_publisher(Num, "/tf_static", latch=True)
+    pb = b.create_publisher(Num, "/tf_static", latch=True)
+    pa.publish(Num(1))
+    pb.publish(Num(2))
+    tagged, plain = [], []
+    sub = rt.graph.subscribe("/tf_static", Num, tagged.append, with_publisher=True)
+    rt.graph.subscribe("/tf_static", Num, plain.append)
+    rt.spin_once()  # a late subscriber gets every latched publisher's message
+    assert [(m.data, p.node.full_name) for m, p in tagged] == [(1, "/a"), (2, "/b")]
+    assert [m.data for m in plain] == [1, 2]
+    pb.publish(Num(3))
+    rt.graph.deliver(sub, Num(4))  # handed in by a bridge: no local publisher
+    rt.spin_once()
+    assert [(m.data, p) for m, p in tagged[2:]] == [(3, pb), (4, None)]
+    assert [m.data for m in plain[2:]] == [3]
+    sub.destroy()
+    assert rt.graph.topics["/tf_static"].with_publisher == 0
+    pa.publish(Num(5))
+    rt.spin_once()
+    assert len(tagged) == 4 and plain[-1].data == 5

@@ -11,7 +11,9 @@ Latched publishers keep their last message and hand it to subscriptions made lat
 
 Topics and services may also have remote ends (the Zenoh bridge): `Graph.listeners` are told of
 every new publisher, subscription and service, and a bridge registers itself as an ordinary
-subscription or service.
+subscription or service. A subscription made ``with_publisher`` receives ``(msg, publisher)``
+instead of ``msg``, so that a bridge can name each message's sending node (as ROS does per
+connection); a topic without one pays a single flag test per publish for this.
 """
 
 from __future__ import annotations
@@ -31,13 +33,14 @@ def _type_name(tp: Any) -> str:
 
 
 class Topic:
-    __slots__ = ("name", "publishers", "subscriptions", "type")
+    __slots__ = ("name", "publishers", "subscriptions", "type", "with_publisher")
 
     def __init__(self, name: str, msg_type: Any) -> None:
         self.name = name
         self.type = msg_type
         self.publishers: list[Publisher] = []
         self.subscriptions: list[Subscription] = []
+        self.with_publisher = 0  # subscriptions that receive (msg, publisher)
 
 
 class Subscription:
@@ -52,9 +55,18 @@ class Subscription:
         "queue",
         "queue_size",
         "topic",
+        "with_publisher",
     )
 
-    def __init__(self, graph: Graph, topic: Topic, callback: Callable, queue_size: int, node):
+    def __init__(
+        self,
+        graph: Graph,
+        topic: Topic,
+        callback: Callable,
+        queue_size: int,
+        node,
+        with_publisher: bool = False,
+    ):
         self.graph = graph
         self.topic = topic
         self.msg_type = topic.type
@@ -63,10 +75,12 @@ class Subscription:
         self.queue: deque = deque(maxlen=queue_size if queue_size > 0 else None)
         self.node = node
         self._pending = graph._pending
+        self.with_publisher = with_publisher
 
     def destroy(self) -> None:
         if self in self.topic.subscriptions:
             self.topic.subscriptions.remove(self)
+            self.topic.with_publisher -= self.with_publisher
             self.queue.clear()
             self.graph._changed("unsubscribe", self.topic.name, self)
 
@@ -97,6 +111,11 @@ class Publisher:
         if self.latch:
             self.last = msg
         pending = self.graph._pending
+        if self.topic.with_publisher:
+            for sub in self.topic.subscriptions:
+                sub.queue.append((msg, self) if sub.with_publisher else msg)
+                pending.append(sub)
+            return
         for sub in self.topic.subscriptions:
             sub.queue.append(msg)
             pending.append(sub)
@@ -173,17 +192,26 @@ class Graph:
         return pub
 
     def subscribe(
-        self, name: str, msg_type: Any, callback: Callable, queue_size: int = 10, node=None
+        self,
+        name: str,
+        msg_type: Any,
+        callback: Callable,
+        queue_size: int = 10,
+        node=None,
+        with_publisher: bool = False,
     ) -> Subscription:
+        """Subscribe ``callback`` to topic ``name``; ``with_publisher``: it is called with
+        ``(msg, publisher)`` (``publisher`` None for a message `deliver` hands in)."""
         if queue_size < 0:
             raise GraphError(f"subscription to {name}: queue_size must be >= 0, got {queue_size}")
         who = f"subscription in {node.full_name}" if node is not None else "a subscription"
         topic = self._topic(name, msg_type, who)
-        sub = Subscription(self, topic, callback, queue_size, node)
+        sub = Subscription(self, topic, callback, queue_size, node, with_publisher)
         topic.subscriptions.append(sub)
+        topic.with_publisher += with_publisher
         for pub in topic.publishers:
             if pub.latch and pub.last is not None:
-                sub.queue.append(pub.last)
+                sub.queue.append((pub.last, pub) if with_publisher else pub.last)
                 self._pending.append(sub)
         self._changed("subscribe", name, sub)
         return sub
@@ -191,7 +219,7 @@ class Graph:
     def deliver(self, sub: Subscription, msg: Any) -> None:
         """Queue ``msg`` for one subscription, as a publish would (bridges use this to hand
         messages from other processes to local subscribers)."""
-        sub.queue.append(msg)
+        sub.queue.append((msg, None) if sub.with_publisher else msg)
         self._pending.append(sub)
 
     def drain(self) -> int:

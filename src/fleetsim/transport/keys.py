@@ -4,7 +4,10 @@ Every fleetsim key lives under ``fleetsim/<domain>/``:
 
 ========================================  ==================================================
 ``topic/<name>``                          one topic's messages, CDR, type in the encoding
-``latched/<zid>/<name>``                  queryable: the last message of a latched topic
+``latched/<zid>/<name>``                  queryable: the last message of each latched
+                                          publisher of a topic, one reply per publisher on
+                                          ``latched/<zid>.<k>/<name>`` (distinct keys, so
+                                          that zenoh does not consolidate them into one)
 ``service/<name>``                        queryable: a service (request and response as CDR)
 ``param``                                 queryable: the parameter server (JSON requests)
 ``graph/<zid>``                           queryable: one process's nodes, topics, services
@@ -14,7 +17,7 @@ Every fleetsim key lives under ``fleetsim/<domain>/``:
 
 ``<name>`` is the resolved ROS name without its leading slash (``lizi1/move_base/goal``).
 A sample's encoding is ``application/cdr;<ROS 2 type>`` and its attachment
-``<origin zid>;<publishing node>`` (the node is empty when several local nodes publish).
+``<origin zid>;<publishing node>``.
 """
 
 from __future__ import annotations
@@ -79,6 +82,10 @@ class Keys:
 
     def latched(self, zid: str, name: str) -> str:
         return f"{self.root}/latched/{zid}/{self.chunk(name)}"
+
+    def latched_reply(self, zid: str, k: int, name: str) -> str:
+        """The key of the ``k``-th latched publisher's reply to a ``latched_any`` query."""
+        return f"{self.root}/latched/{zid}.{k}/{self.chunk(name)}"
 
     def latched_any(self, name: str) -> str:
         return f"{self.root}/latched/*/{self.chunk(name)}"

@@ -1,9 +1,8 @@
 """``fleetsim tf echo`` and ``fleetsim tf tree``: tf_echo and view_frames against a simulation.
 
 `TfListener` fills a local tf `Buffer` from ``/tf`` and ``/tf_static`` received over the bridge
-(zenoh threads, hence the lock). The broadcaster of each frame is the publishing node the
-simulation names in the sample (exact when one node publishes ``/tf`` in that process); when
-several do, the candidates from the graph are listed, as the sample alone cannot tell them apart.
+(reader threads, hence the lock). The broadcaster of each frame is the publishing node the
+simulation names in each sample (and in each latched ``/tf_static`` reply: one per publisher).
 """
 
 from __future__ import annotations
@@ -18,6 +17,9 @@ from typing import Any
 from fleetsim.errors import TransformError, TransportError
 from fleetsim.transport.client import Received, SimulationClient
 
+#: the authority of a transform whose publisher has no node (tf2's default authority)
+UNKNOWN_BROADCASTER = "default_authority"
+
 
 class TfListener:
     """A tf buffer fed from a running simulation."""
@@ -27,11 +29,6 @@ class TfListener:
 
         self.buffer = Buffer(cache_time)
         self.lock = threading.Lock()
-        topics = client.graph()["topics"]
-        self._candidates = {
-            t: " or ".join(topics[t]["publishers"]) if t in topics else ""
-            for t in ("/tf", "/tf_static")
-        }
         self.latest = 0.0
         client.subscribe("/tf", self._on_tf)
         client.subscribe("/tf_static", self._on_tf)
@@ -40,7 +37,7 @@ class TfListener:
         if isinstance(r.msg, Exception):
             return
         static = r.topic == "/tf_static"
-        authority = r.node or self._candidates.get(r.topic, "")
+        authority = r.node or UNKNOWN_BROADCASTER
         with self.lock:
             for t in r.msg.transforms:
                 try:

@@ -2,7 +2,9 @@
 
 Outgoing, per topic with a local publisher: a zenoh publisher with a matching listener; while a
 remote subscriber matches, a forwarding subscription in the local graph puts each message as
-CDR. A latched topic also answers ``latched/<zid>/<name>`` with its last message.
+CDR, its attachment naming the node that published it (the subscription is made
+``with_publisher``). A latched topic also answers ``latched/<zid>/<name>`` with the last
+message of each of its latched publishers, as a late ROS subscriber gets one from each.
 
 Incoming, per topic with a local subscription: a zenoh subscriber for remote origins only (so
 nothing echoes) whose samples go to the inbox; `_deliver` (simulation thread) decodes them into
@@ -34,7 +36,7 @@ class _Outgoing:
         self.listener = listener
         self.forward: Any = None
         self.latched_q: Any = None
-        self.attach = b""
+        self.attach: dict[Any, bytes] = {}  # publisher -> its attachment
 
 
 class TopicBridging:
@@ -57,10 +59,6 @@ class TopicBridging:
             out = self._out[name] = _Outgoing(zpub, listener)
             if zpub.matching_status.matching:
                 self._set_forwarding(name, True)
-        nodes = {
-            p.node.full_name if p.node is not None else "" for p in self._local_publishers(name)
-        }
-        out.attach = attachment(self.zid, nodes.pop() if len(nodes) == 1 else "")
         if pub.latch and out.latched_q is None:
             out.latched_q = self.session.declare_queryable(
                 self.keys.latched(self.zid, name), lambda q, n=name: self._reply_latched(n, q)
@@ -71,7 +69,7 @@ class TopicBridging:
         if out is None:
             return
         if self._local_publishers(name):
-            self._export_topic(name, self._local_publishers(name)[0])  # refresh the attachment
+            out.attach.clear()  # forget the attachments of publishers that are gone
             return
         del self._out[name]
         self._set_forwarding_off(out)
@@ -91,14 +89,20 @@ class TopicBridging:
         topic = self.graph.topics[name]
         zpub = out.zpub
         serialize = self._serialize
+        attach = out.attach
 
-        def forward(msg: Any, out: _Outgoing = out) -> None:
+        def forward(item: tuple[Any, Any]) -> None:
+            msg, pub = item
             data = serialize(name, msg)
-            if data is not None:
-                zpub.put(data, attachment=out.attach)
+            if data is None:
+                return
+            att = attach.get(pub)
+            if att is None:
+                att = attach[pub] = self._attachment_of(pub)
+            zpub.put(data, attachment=att)
 
         with self._own_objects():
-            sub = self.graph.subscribe(name, topic.type, forward, queue_size=0)
+            sub = self.graph.subscribe(name, topic.type, forward, queue_size=0, with_publisher=True)
         sub.queue.clear()  # a latched message reaches remote subscribers through its query
         self._own.add(sub)
         out.forward = sub
@@ -119,23 +123,30 @@ class TopicBridging:
             self._warn_once(f"ser:{name}", "not sending a message on %s: %s", name, e)
             return None
 
+    def _attachment_of(self, pub: Any) -> bytes:
+        """The attachment naming ``pub``'s node (empty for a message handed in by `deliver`)."""
+        node = getattr(pub, "node", None)
+        return attachment(self.zid, node.full_name if node is not None else "")
+
     def _reply_latched(self, name: str, query: Any) -> None:
-        """Answer a latched-topic query (zenoh thread: only reads the publishers' last message)."""
+        """Answer a latched-topic query with each latched publisher's last message, each under
+        its own key and naming its node (zenoh thread: only reads the publishers' messages)."""
         topic = self.graph.topics.get(name)
-        last = None
-        for pub in list(topic.publishers) if topic is not None else ():
-            if pub.latch and pub.last is not None and pub not in self._own:
-                last = pub.last
-        if last is None:
-            return
-        data = self._serialize(name, last)
-        if data is not None:
-            query.reply(
-                self.keys.latched(self.zid, name),
-                data,
-                encoding=self._zenoh.Encoding(cdr_encoding(_type_name(type(last)))),
-                attachment=attachment(self.zid, ""),
-            )
+        latched = [
+            pub
+            for pub in (list(topic.publishers) if topic is not None else ())
+            if pub.latch and pub.last is not None and pub not in self._own
+        ]
+        for k, pub in enumerate(latched):
+            last = pub.last
+            data = self._serialize(name, last)
+            if data is not None:
+                query.reply(
+                    self.keys.latched_reply(self.zid, k, name),
+                    data,
+                    encoding=self._zenoh.Encoding(cdr_encoding(_type_name(type(last)))),
+                    attachment=self._attachment_of(pub),
+                )
 
     def _import_topic(self, name: str, sub: Any) -> None:
         if name not in self._in:

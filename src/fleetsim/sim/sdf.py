@@ -3,8 +3,12 @@
 Supported: ``<world>`` with ``<include><uri>model://NAME</uri>``, ``<model>`` (``<static>``,
 ``<pose>``, links with ``<inertial>``, ``<collision>``/``<visual>`` geometry box, cylinder,
 sphere, plane and mesh, materials by colour, by ``Gazebo/*`` script name or by a texture from an
-OGRE material script), ``<light>``, world ``<plugin>``, ``<gravity>`` and the ``<state>`` block
-(saved model poses override the declared ones, as Gazebo does on load). Built-in models:
+OGRE material script, ``sdf_materials``), ``<light>``, world ``<plugin>``, ``<gravity>`` and the
+``<state>`` block (saved model poses override the declared ones, as Gazebo does on load). Poses
+follow SDFormat (``sdf_poses``): an ``<include>``'s ``<pose>`` (radians) and ``<name>`` replace
+the model's own, ``<placement_frame>`` places a named link there, ``relative_to`` names a frame
+of the same scope, nested ``<model>``/``<include>`` elements are flattened into
+``<nested>::<link>`` links with composed poses. Built-in models:
 ``ground_plane`` and ``sun``; other models are folders holding ``model.config`` + an SDF file,
 found on ``FLEETSIM_MODEL_PATH`` / ``GAZEBO_MODEL_PATH`` and in fleetsim's ``assets/worlds/models``.
 """
@@ -12,15 +16,15 @@ found on ``FLEETSIM_MODEL_PATH`` / ``GAZEBO_MODEL_PATH`` and in fleetsim's ``ass
 from __future__ import annotations
 
 import os
-import re
 import warnings
 from pathlib import Path
 
 from lxml import etree
 
 from fleetsim.errors import SimulationError
+from fleetsim.sim.sdf_materials import GAZEBO_COLOURS, material_of
+from fleetsim.sim.sdf_poses import compose, element_pose, inverse, poses_in_scope
 from fleetsim.sim.world import (
-    ZERO_POSE,
     GeomDesc,
     LightDesc,
     LinkDesc,
@@ -32,22 +36,9 @@ from fleetsim.sim.world import (
     sun,
 )
 
-ASSET_MODELS = Path(__file__).resolve().parent.parent / "assets" / "worlds" / "models"
+__all__ = ["GAZEBO_COLOURS", "load_sdf_model", "load_sdf_world", "model_from_element"]
 
-GAZEBO_COLOURS = {
-    "Gazebo/Grey": (0.7, 0.7, 0.7, 1.0),
-    "Gazebo/DarkGrey": (0.35, 0.35, 0.35, 1.0),
-    "Gazebo/White": (1.0, 1.0, 1.0, 1.0),
-    "Gazebo/Black": (0.05, 0.05, 0.05, 1.0),
-    "Gazebo/Red": (1.0, 0.0, 0.0, 1.0),
-    "Gazebo/Green": (0.0, 1.0, 0.0, 1.0),
-    "Gazebo/Blue": (0.0, 0.0, 1.0, 1.0),
-    "Gazebo/Yellow": (1.0, 1.0, 0.0, 1.0),
-    "Gazebo/Orange": (1.0, 0.5, 0.05, 1.0),
-    "Gazebo/Wood": (0.55, 0.38, 0.2, 1.0),
-    "Gazebo/Purple": (0.5, 0.0, 0.5, 1.0),
-    "Gazebo/Turquoise": (0.0, 0.8, 0.8, 1.0),
-}
+ASSET_MODELS = Path(__file__).resolve().parent.parent / "assets" / "worlds" / "models"
 
 
 def model_path() -> list[Path]:
@@ -108,61 +99,13 @@ def _floats(el, n: int | None, where: str) -> tuple[float, ...]:
 
 
 def _pose(el, where: str) -> Pose:
-    p = el.find("pose")
-    return ZERO_POSE if p is None or not (p.text or "").strip() else _floats(p, 6, where)
+    """An element's own pose numbers (``relative_to`` is resolved by the caller)."""
+    return element_pose(el, where)[0]
 
 
 def _text(el, tag: str, default: str) -> str:
     c = el.find(tag)
     return default if c is None or c.text is None else c.text.strip()
-
-
-def _texture_from_script(script, where: str) -> str | None:
-    """Find the texture image of an OGRE material ``<script><uri>..<name>`` reference."""
-    name = _text(script, "name", "")
-    dirs: list[Path] = []
-    for uri in script.findall("uri"):
-        u = (uri.text or "").strip()
-        if u.startswith("model://"):
-            model, _, rest = u[len("model://") :].partition("/")
-            try:
-                dirs.append(find_model(model, where) / rest)
-            except SimulationError:
-                continue
-        elif u.startswith("file://"):
-            dirs.append(Path(u[len("file://") :]))
-    files = [f for d in dirs if d.is_dir() for f in sorted(d.glob("*.material"))]
-    for f in files:
-        text = f.read_text(errors="replace")
-        m = re.search(r"material\s+" + re.escape(name) + r"\s*\{(.*?)\n\}", text, re.S)
-        if m:
-            t = re.search(r"texture\s+(\S+)", m.group(1))
-            if t:
-                for d in [f.parent, f.parent.parent / "textures", *dirs]:
-                    if (d / t.group(1)).exists():
-                        return str(d / t.group(1))
-    return None
-
-
-def _material(vis, where: str) -> tuple[tuple | None, str | None]:
-    rgba = None
-    texture = None
-    for mat in vis.findall("material"):
-        for tag in ("diffuse", "ambient"):
-            c = mat.find(tag)
-            if c is not None and rgba is None:
-                v = _floats(c, None, where)
-                rgba = (*v[:3], v[3] if len(v) > 3 else 1.0)
-        script = mat.find("script")
-        if script is not None:
-            name = _text(script, "name", "")
-            if rgba is None and name in GAZEBO_COLOURS:
-                rgba = GAZEBO_COLOURS[name]
-            texture = texture or _texture_from_script(script, where)
-        albedo = mat.find("pbr/metal/albedo_map")
-        if albedo is not None and albedo.text:
-            texture = albedo.text.strip()
-    return rgba, texture
 
 
 def _geometry(el, where: str, collide: bool, base: Path) -> GeomDesc | None:
@@ -217,7 +160,7 @@ def _geometry(el, where: str, collide: bool, base: Path) -> GeomDesc | None:
         )
         return None
     if not collide:
-        g.rgba, g.texture = _material(el, where)
+        g.rgba, g.texture = material_of(el, where, _floats, find_model)
     else:
         mu = el.find("surface/friction/ode/mu")
         if mu is not None and mu.text:
@@ -226,18 +169,42 @@ def _geometry(el, where: str, collide: bool, base: Path) -> GeomDesc | None:
 
 
 def model_from_element(el, where: str, base: Path) -> ModelDesc:
-    """A ``ModelDesc`` from an SDF ``<model>`` element."""
+    """A ``ModelDesc`` from an SDF ``<model>`` element.
+
+    Links are placed in the model frame, ``relative_to`` resolved among the model's links,
+    ``<frame>`` elements and nested models; collision and visual poses are expressed in their
+    link (``relative_to`` another frame of the model is converted). Nested ``<model>`` and
+    ``<include>`` elements are flattened: their links become ``<nested>::<link>`` links of this
+    model, placed by the composed poses.
+    """
     name = el.get("name")
     if not name:
         raise SimulationError(f"{where}:{el.sourceline}: <model> without a name attribute")
+    pose, relative_to = element_pose(el, where)
     model = ModelDesc(
         name,
-        _pose(el, where),
+        pose,
         _text(el, "static", "0") in ("1", "true"),
         source=f"{where}:{el.sourceline}",
+        relative_to=relative_to,
     )
+    nested = [model_from_element(sub, where, base) for sub in el.findall("model")]
+    for inc in el.findall("include"):
+        item = _include(inc, where)
+        if isinstance(item, ModelDesc):
+            nested.append(item)
+    frames: dict[str, tuple] = {}
     for link in el.findall("link"):
-        ld = LinkDesc(link.get("name", "link"), _pose(link, where))
+        frames[link.get("name", "link")] = element_pose(link, where)
+    for fr in el.findall("frame"):
+        fpose, rel = element_pose(fr, where)
+        frames[fr.get("name", "")] = (fpose, rel or fr.get("attached_to", ""))
+    for sub in nested:
+        frames[sub.name] = (sub.pose, sub.relative_to)
+    placed = poses_in_scope(frames, where, f"model '{name}'", ("__model__",))
+    for link in el.findall("link"):
+        lname = link.get("name", "link")
+        ld = LinkDesc(lname, placed[lname])
         inertial = link.find("inertial")
         if inertial is not None:
             ld.mass = float(_text(inertial, "mass", "1"))
@@ -247,18 +214,30 @@ def model_from_element(el, where: str, base: Path) -> ModelDesc:
         for tag, collide in (("collision", True), ("visual", False)):
             for c in link.findall(tag):
                 g = _geometry(c, where, collide, base)
-                if g is not None:
-                    ld.geoms.append(g)
+                if g is None:
+                    continue
+                rel = element_pose(c, where)[1]
+                if rel and rel != lname:
+                    if rel not in placed:
+                        raise SimulationError(
+                            f"{where}:{c.sourceline}: <pose relative_to='{rel}'> of {tag} "
+                            f"'{g.name}' names no frame of model '{name}' "
+                            f"(frames there: {', '.join(sorted(placed))})"
+                        )
+                    g.pose = compose(inverse(ld.pose), compose(placed[rel], g.pose))
+                ld.geoms.append(g)
         model.links.append(ld)
+    for sub in nested:
+        for link in sub.links:
+            link.name = f"{sub.name}::{link.name}"
+            link.pose = compose(placed[sub.name], link.pose)
+            model.links.append(link)
+    model.frames = placed
     if el.find("joint") is not None:
         warnings.warn(
             f"{where}:{el.sourceline}: joints of SDF model '{name}' are not "
             "simulated; its links move independently",
             stacklevel=2,
-        )
-    for sub in el.findall("include") + el.findall("model"):
-        warnings.warn(
-            f"{where}:{sub.sourceline}: nested models in '{name}' are not supported", stacklevel=2
         )
     return model
 
@@ -284,8 +263,17 @@ def _include(el, where: str) -> ModelDesc | LightDesc:
             raise SimulationError(f"{file}: no <model> element")
         model = model_from_element(mel, str(file), folder)
     model.name = _text(el, "name", model.name)
-    if pose_el is not None:
-        model.pose = _floats(pose_el, 6, where)
+    if pose_el is not None:  # the include's pose replaces the model's own (Gazebo's rule)
+        model.pose, model.relative_to = element_pose(el, where)
+    placement = _text(el, "placement_frame", "")
+    if placement:  # SDF 1.8: the pose places this frame of the model, not its origin
+        if placement not in model.frames:
+            raise SimulationError(
+                f"{where}:{el.sourceline}: <placement_frame>{placement}</placement_frame> names "
+                f"no link or frame of model '{model.name}' "
+                f"(there: {', '.join(sorted(model.frames))})"
+            )
+        model.pose = compose(model.pose, inverse(model.frames[placement]))
     if el.find("static") is not None:
         model.static = _text(el, "static", "0") in ("1", "true")
     return model
@@ -332,6 +320,13 @@ def load_sdf_world(path: str | Path) -> WorldDesc:
             )
         elif el.tag == "gravity":
             desc.gravity = _floats(el, 3, where)
+    frames = {m.name: (m.pose, m.relative_to) for m in desc.models}
+    for fr in world.findall("frame"):
+        fpose, rel = element_pose(fr, where)
+        frames.setdefault(fr.get("name", ""), (fpose, rel or fr.get("attached_to", "")))
+    placed = poses_in_scope(frames, where, f"world '{desc.name}'", ("world",))
+    for m in desc.models:
+        m.pose, m.relative_to = placed[m.name], ""
     state = world.find("state")
     if state is not None:
         by_name = {m.name: m for m in desc.models}
@@ -358,4 +353,10 @@ def load_sdf_model(text: str, source: str = "<string>") -> ModelDesc:
     if el is None:
         raise SimulationError(f"{source}: no <model> element in the SDF")
     base = Path(source).parent if source != "<string>" else Path.cwd()
-    return model_from_element(el, source, base)
+    model = model_from_element(el, source, base)
+    if model.relative_to not in ("", "world"):
+        raise SimulationError(
+            f"{source}:{el.sourceline}: <pose relative_to='{model.relative_to}'> of a spawned "
+            f"model '{model.name}': a spawned model's pose is in the world frame"
+        )
+    return model

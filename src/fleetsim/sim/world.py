@@ -11,9 +11,8 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from fleetsim.sim.mapworld import OccupancyMap, load_map, wall_boxes
+from fleetsim.sim.sdf_poses import ZERO_POSE, Pose
 
-Pose = tuple[float, float, float, float, float, float]
-ZERO_POSE: Pose = (0.0, 0.0, 0.0, 0.0, 0.0, 0.0)
 #: walls extruded from a map are building walls: taller than any robot's sensors (the lesson
 #: mounts lizi's laser 1 m up)
 WALL_HEIGHT = 2.0
@@ -51,6 +50,9 @@ class ModelDesc:
     static: bool = False
     links: list[LinkDesc] = field(default_factory=list)
     source: str = ""
+    relative_to: str = ""  # frame the pose is expressed in until resolved ("": the parent's)
+    #: poses of the model's links and SDF ``<frame>``s in the model frame (by name)
+    frames: dict[str, Pose] = field(default_factory=dict)
 
 
 @dataclass

@@ -24,7 +24,6 @@ from __future__ import annotations
 import dataclasses
 import logging
 import typing
-import warnings
 from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
@@ -261,15 +260,18 @@ class JointStateReading:
 
 
 def plugin_class(filename: str, where: str = "") -> type[Plugin] | None:
-    """The class registered for a Gazebo filename; None (with a warning) when unknown."""
+    """The class registered for a Gazebo filename; None (with a logged warning) when unknown.
+
+    The warning goes to the log only: it also went through `warnings.warn`, so the command
+    line printed it twice (once by its log handler, once as a Python warning)."""
     cls = REGISTRY.get(filename)
     if cls is None:
-        msg = (
-            f"{where + ': ' if where else ''}unknown plugin filename '{filename}'"
-            f"{did_you_mean(filename, REGISTRY)}; ignored, the model spawns without it"
+        _log.warning(
+            "%sunknown plugin filename '%s'%s; ignored, the model spawns without it",
+            where + ": " if where else "",
+            filename,
+            did_you_mean(filename, REGISTRY),
         )
-        _log.warning("%s", msg)
-        warnings.warn(msg, stacklevel=3)
     return cls
 
 

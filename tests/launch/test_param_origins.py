@@ -130,3 +130,26 @@ def test_param_dicts_dump_as_plain_yaml():
     tree.update("/", {"a": {"b": 1}}, {"a/b": "f.yaml:2"})
     assert yaml.safe_load(yaml.safe_dump(tree.get("/"))) == {"a": {"b": 1}}
     assert yaml.safe_load(yaml.dump(tree.get("/"))) == {"a": {"b": 1}}
+
+
+def test_ros2_yaml_launch_param_files_name_the_line_too(tmp_path):
+    from fleetsim.launch.yaml_frontend import load_yaml
+
+    (tmp_path / "probe.yaml").write_text(
+        "/**:\n  ros__parameters:\n    frame: map\nprobe:\n  ros__parameters:\n    rate: slow\n"
+    )
+    (tmp_path / "plain.yaml").write_text("rate: 1.0\nframe: 3\n")
+    f = tmp_path / "t.launch.yaml"
+    f.write_text(
+        "launch:\n"
+        f"- node: {{pkg: x, exec: y, name: probe, param: [{{from: {tmp_path}/probe.yaml}}]}}\n"
+        f"- node: {{pkg: x, exec: y, name: plain, param: [{{from: {tmp_path}/plain.yaml}}]}}\n"
+    )
+    rt = Runtime()
+    load_yaml(f).apply_params(rt.params)
+    assert rt.params.origin("/probe/frame") == f"{tmp_path}/probe.yaml:3"
+    with pytest.raises(ParameterError, match=rf"'rate' must be float, got str 'slow' \(set at "
+                       rf"{tmp_path}/probe.yaml:6\)"):  # fmt: skip
+        _Probe(rt, "probe")
+    with pytest.raises(ParameterError, match=rf"\(set at {tmp_path}/plain.yaml:2\)"):
+        _Probe(rt, "plain")

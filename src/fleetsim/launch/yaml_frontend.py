@@ -17,10 +17,11 @@ from typing import Any
 
 import yaml
 
-from fleetsim.errors import LaunchError, did_you_mean
+from fleetsim.errors import FleetsimError, LaunchError, did_you_mean
 from fleetsim.launch.model import LaunchPlan, NodeSpec, ParamOp
 from fleetsim.launch.substitutions import Context, substitute, to_bool
 from fleetsim.runtime import names
+from fleetsim.runtime.param_yaml import load_yaml_lines
 
 _KEYS = {
     "arg": {"name", "default", "description", "if", "unless"},
@@ -217,20 +218,33 @@ class YamlLoader:
         if "from" in p:
             path = Path(str(p["from"]))
             try:
-                data = yaml.safe_load(path.read_text())
+                raw, lines = load_yaml_lines(path.read_text(), str(path))
             except OSError as e:
                 raise LaunchError(f"{w}: cannot read {path}: {e.strerror}") from None
-            except yaml.YAMLError as e:
-                raise LaunchError(f"{w}: {path}: YAML does not parse: {e}") from None
-            data = ros2_params(data, node_name)
+            except FleetsimError as e:
+                raise LaunchError(f"{w}: {e}") from None
+            data = ros2_params(raw, node_name)
             if data:
-                self.plan.params.append(ParamOp("load", private, data, w))
+                origins = lines if data is raw else _section_origins(raw, node_name, lines)
+                self.plan.params.append(ParamOp("load", private, data, w, origins))
             return
         if "name" not in p or "value" not in p:
             raise LaunchError(f"{w}: needs name and value (or from)")
         name = str(p["name"]).replace(".", "/")  # ROS 2 dotted names are namespaces here
         full = names.resolve(name, "/") if name.startswith("/") else names.join(private, name)
         self.plan.params.append(ParamOp("set", full, p["value"], w))
+
+
+def _section_origins(data: dict, node_name: str, lines: dict[str, str]) -> dict[str, str]:
+    """The lines of the keys `ros2_params` takes, relative to the node's namespace."""
+    out: dict[str, str] = {}
+    for key in ("**", node_name):
+        for k in data:
+            k = str(k).strip("/")
+            if k == key or k.endswith("/" + key):
+                prefix = f"{k}/ros__parameters/"
+                out.update({p[len(prefix) :]: o for p, o in lines.items() if p.startswith(prefix)})
+    return out
 
 
 def ros2_params(data: Any, node_name: str) -> dict:

@@ -57,3 +57,42 @@ def test_bad_invocations_are_one_line_errors(argv, message, capsys):
     assert main(argv) == 1
     err = capsys.readouterr().err
     assert re.search(message, err.replace("\n", " ")), err
+
+
+def test_until_goals_fails_when_ground_truth_contradicts_a_reported_success(
+    tmp_path, capsys, monkeypatch
+):
+    from fleetsim.cli import launch as launch_cli
+
+    monkeypatch.setattr(launch_cli.console, "width", 200)  # one line per table row
+    robot = Path(__file__).resolve().parents[1] / "sim" / "fixtures" / "diffbot.urdf"
+    launch = tmp_path / "liar.launch"
+    launch.write_text(
+        f"""<launch>
+  <include file="$(find gazebo_ros)/launch/empty_world.launch">
+    <arg name="gui" value="false"/>
+  </include>
+  <group ns="r1">
+    <param name="robot_description" textfile="{robot}"/>
+    <node name="spawn" pkg="gazebo_ros" type="spawn_model"
+          args="-urdf -param robot_description -model r1"/>
+    <node name="move_base" pkg="test" type="lying_move_base:LyingMoveBase"/>
+  </group>
+</launch>
+"""
+    )
+    code = main(["launch", str(launch), "--until-goals", "--duration", "5", "--no-bridge"])
+    err = capsys.readouterr().err
+    assert code == 1
+    row = next(line for line in err.splitlines() if line.startswith("│ /r1 "))
+    cells = [c.strip() for c in row.split("│") if c.strip()]
+    assert cells[1] == "0/1"  # goals reached / sent
+    assert cells[5] == "22.00"  # to goal [m] (truth): the robot never moved
+    assert cells[-1] == "reported reached, 22.0 m away by ground truth"
+
+
+def test_launch_help_says_where_until_goals_gets_its_goals(capsys):
+    main(["launch", "--help"])
+    text = " ".join(capsys.readouterr().out.replace("│", " ").split())
+    for words in ("move_base action goals", "send_goals nodes", "'fleetsim goal'", "user nodes"):
+        assert words in text, words

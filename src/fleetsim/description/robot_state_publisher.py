@@ -68,6 +68,9 @@ class RobotStatePublisher(Node):
         self._xyz, self._quat, self._axes, self._kinds = joint_arrays(joints)
         self._index = {j.name: i for i, j in enumerate(joints)}
         self._joints = joints
+        # tf_prefix is read once, as ROS's robot_state_publisher reads it at start-up: resolving
+        # it for every joint of every joint_states message was half of this node's time
+        self._frames = [(self.frame(j.parent), self.frame(j.child)) for j in joints]
         self._last_stamp: dict[str, int] = {}
         self.tf = TransformBroadcaster(self)
         self.tf_static = StaticTransformBroadcaster(self)
@@ -82,8 +85,7 @@ class RobotStatePublisher(Node):
         )
         return [
             make_transform_stamped(
-                self.frame(self._joints[i].parent),
-                self.frame(self._joints[i].child),
+                *self._frames[i],
                 stamp,
                 tuple(trans[k]),
                 tuple(rot[k]),

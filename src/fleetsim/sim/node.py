@@ -32,6 +32,13 @@ from fleetsim.sim.world import WALL_HEIGHT
 
 EMPTY_WORLDS = ("", "worlds/empty.world", "empty", "empty.world")
 
+#: reading class -> (message type, conversion) of the readings published one message each
+_READING_MESSAGES = {
+    OdometryReading: (nav_msgs.Odometry, conv.odometry_msg),
+    ScanReading: (sensor_msgs.LaserScan, conv.scan_msg),
+    JointStateReading: (sensor_msgs.JointState, conv.joint_state_msg),
+}
+
 
 @dataclass(frozen=True)
 class SimulatorParams:
@@ -72,6 +79,7 @@ class Simulator(Node):
         self.engine.paused = p.paused
         self.offset = runtime.now() - self.engine.time  # sim time = physics time + offset
         self._pubs: dict[tuple[str, type], Any] = {}
+        self._reading_pubs: dict[tuple[type, str, str], Any] = {}  # (reading, topic, ns) -> pub
         self._subs: dict[str, list] = {}
         from fleetsim.tf import TransformBroadcaster
 
@@ -191,22 +199,21 @@ class Simulator(Node):
         ]
         if tfs:
             self.tf.send_transform(tfs)
+        pubs = self._reading_pubs
         for r in readings:
-            ns = r.namespace
-            if isinstance(r, OdometryReading):
-                self._publisher(rnames.resolve(r.topic, ns), nav_msgs.Odometry).publish(
-                    conv.odometry_msg(r)
-                )
-            elif isinstance(r, ScanReading):
-                self._publisher(rnames.resolve(r.topic, ns), sensor_msgs.LaserScan).publish(
-                    conv.scan_msg(r)
-                )
-            elif isinstance(r, JointStateReading):
-                self._publisher(rnames.resolve(r.topic, ns), sensor_msgs.JointState).publish(
-                    conv.joint_state_msg(r)
-                )
-            elif isinstance(r, ImageReading):
-                self._publish_image(r, ns)
+            kind = type(r)
+            if kind is ImageReading:
+                self._publish_image(r, r.namespace)
+                continue
+            spec = _READING_MESSAGES.get(kind)
+            if spec is None:
+                continue
+            key = (kind, r.topic, r.namespace)
+            pub = pubs.get(key)
+            if pub is None:
+                pub = pubs[key] = self._publisher(rnames.resolve(r.topic, r.namespace), spec[0])
+            if pub.topic.subscriptions:  # a message nobody reads is not built
+                pub.publish(spec[1](r))
 
     def _publish_image(self, r: ImageReading, ns: str) -> None:
         img = conv.image_msg(r.stamp, r.frame_id, r.image, r.encoding)

@@ -40,42 +40,18 @@ from fleetsim.msgs import geometry_msgs, get_type, nav_msgs, sensor_msgs, std_ms
 from fleetsim.nav.costmap.footprint import footprint_at
 from fleetsim.nav.costmap.layer import Bounds, Layer
 from fleetsim.nav.costmap.layered_costmap import LayeredCostmap
-from fleetsim.nav.costmap.obstacle_layer import ObstacleLayer, laser_scan_points
+from fleetsim.nav.costmap.obstacle_layer import ObstacleLayer
+from fleetsim.nav.costmap.readings import (
+    points_from_cloud1,
+    points_from_cloud2,
+    points_from_scan,
+)
 from fleetsim.nav.costmap.static_layer import StaticLayer
 from fleetsim.nav.errors import CostmapError, MapError
 from fleetsim.nav.map_server import grid_msg_from_map, map_from_grid_msg
 from fleetsim.tf import resolve_frame_once
 from fleetsim.tf.names import normalize_frame
 from fleetsim.tf.patience import TransformPatience
-
-_CLOUD_DTYPES = {7: "f4", 8: "f8"}  # PointField.FLOAT32, FLOAT64
-
-
-def points_from_cloud2(msg: Any, where: str = "PointCloud2") -> np.ndarray:
-    """The x, y, z of a PointCloud2 (FLOAT32 or FLOAT64 fields), NaN points dropped: (N, 3) m."""
-    fields = {f.name: f for f in msg.fields}
-    missing = [k for k in "xyz" if k not in fields]
-    if missing:
-        raise CostmapError(f"{where}: the cloud has no field(s) {', '.join(missing)}")
-    n = int(msg.width) * int(msg.height)
-    step = int(msg.point_step)
-    raw = np.asarray(msg.data, dtype=np.uint8)
-    row = int(msg.row_step) or step * int(msg.width)
-    if raw.size < row * (int(msg.height) - 1) + step * int(msg.width) or n == 0:
-        return np.zeros((0, 3))
-    endian = ">" if msg.is_bigendian else "<"
-    out = np.empty((n, 3))
-    rows = raw[: row * int(msg.height)].reshape(int(msg.height), row)[:, : step * int(msg.width)]
-    flat = np.ascontiguousarray(rows).reshape(n, step)
-    for i, k in enumerate("xyz"):
-        f = fields[k]
-        kind = _CLOUD_DTYPES.get(int(f.datatype))
-        if kind is None:
-            raise CostmapError(f"{where}: field '{k}' has datatype {f.datatype}; need FLOAT32/64")
-        size = int(kind[1])
-        col = np.ascontiguousarray(flat[:, f.offset : f.offset + size])
-        out[:, i] = col.view(endian + kind).ravel()
-    return out[np.isfinite(out).all(axis=1)]
 
 
 class ExtraBounds(Layer):
@@ -241,14 +217,7 @@ class Costmap2DROS:
 
     @staticmethod
     def _scan_points(msg: Any, sp: Any, where: str) -> np.ndarray:
-        return laser_scan_points(
-            msg.ranges,
-            msg.angle_min,
-            msg.angle_increment,
-            msg.range_min,
-            msg.range_max,
-            sp.inf_is_valid,
-        )
+        return points_from_scan(msg, sp.inf_is_valid)
 
     @staticmethod
     def _cloud2_points(msg: Any, sp: Any, where: str) -> np.ndarray:
@@ -256,7 +225,7 @@ class Costmap2DROS:
 
     @staticmethod
     def _cloud1_points(msg: Any, sp: Any, where: str) -> np.ndarray:
-        return np.array([[p.x, p.y, p.z] for p in msg.points], dtype=np.float64).reshape(-1, 3)
+        return points_from_cloud1(msg)
 
     def _to_global(self, frame: str, stamp: float, where: str):
         """(rotation (3, 3), translation (3,)) of ``frame`` in the global frame, or None."""

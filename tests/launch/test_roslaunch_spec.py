@@ -351,3 +351,9 @@ def test_launch_deprecated_attribute_is_reported(tmp_path):
     p = tmp_path / "old.launch"
     p.write_text('<launch deprecated="use new.launch"><param name="a" value="1"/></launch>')
     assert any("DEPRECATED: use new.launch" in n for n in load_xml(p).notes)
+
+
+def test_find_is_expanded_after_args_as_roslaunch_does(tmp_path):
+    p = write(tmp_path, '<arg name="desc"/><param name="d" value="$(arg desc)/urdf"/>')
+    t = load_xml(p, {"desc": "$(find lizi)"}).param_tree()
+    assert t.get("/d").endswith("robots/lizi/urdf")

@@ -186,10 +186,15 @@ def substitute(text: str | None, ctx: Context, where: str) -> str | None:
     if "$(eval" in text:
         raise LaunchError(f"{where}: $(eval ...) must be the whole attribute value: {text!r}")
 
-    def repl(match: re.Match) -> str:
+    # roslaunch expands in two passes: everything but $(find) first, then $(find), so an arg
+    # whose value is "$(find pkg)/x" (passed as name:=...) is found too
+    def repl(match: re.Match, finds: bool) -> str:
+        if (match.group(1) == "find") != finds:
+            return match.group(0)
         return _one(match.group(1), match.group(2).split(), ctx, where)
 
-    out = _SUBST.sub(repl, text)
+    out = _SUBST.sub(lambda m: repl(m, False), text)
+    out = _SUBST.sub(lambda m: repl(m, True), out)
     if "$(" in out:
         raise LaunchError(f"{where}: substitution does not parse: {text!r}")
     return out

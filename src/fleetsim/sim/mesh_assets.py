@@ -157,10 +157,17 @@ def add_decomposed_mesh(
         if g.friction is not None:
             geom.friction = [g.friction[0], 0.005, 0.0001]
         geom.rgba = [0.6, 0.6, 0.62, 1.0]
-    true_mesh = add_mesh_asset(spec, g, prefix)
-    copies = [(f"{name}:rays", RAY_GROUP)] + ([(f"{name}:shown", VISUAL_GROUP)] if shown else [])
-    for geom_name, group in copies:
-        geom = body.add_geom(name=geom_name, type=G.mjGEOM_MESH, meshname=true_mesh, **kw)
+    # the ray copy: the welded triangles, each once (a double-sided COLLADA mesh holds every
+    # triangle twice, which would double the lasers' work)
+    ray_mesh = f"{base}:rays"
+    if spec.mesh(ray_mesh) is None:
+        wv, wf = decompose.weld(vertices * np.asarray(scale), faces)
+        add_user_mesh(spec, ray_mesh, wv, wf, [1.0, 1.0, 1.0])
+    copies = [(f"{name}:rays", RAY_GROUP, ray_mesh)]
+    if shown:
+        copies.append((f"{name}:shown", VISUAL_GROUP, add_mesh_asset(spec, g, prefix)))
+    for geom_name, group, mesh in copies:
+        geom = body.add_geom(name=geom_name, type=G.mjGEOM_MESH, meshname=mesh, **kw)
         geom.group = group
         geom.contype = geom.conaffinity = 0
         geom.density = 0

@@ -57,7 +57,46 @@ def _bbox(p):
 
 
 @numba.njit(cache=True)
+def _touches(p, x0, y0, x1, y1):
+    """Whether the footprint of primitive ``p`` (a segment, or the xy shadow of a triangle)
+    meets the cell ``[x0, x1] x [y0, y1]``: separating axes (the edge normals; the cell's own
+    axes are covered by the bounding-box loop). Circles always do (their box is tight)."""
+    if p[0] == CIRCLE:
+        return True
+    if p[0] == SEGMENT:
+        px = (p[1], p[3], p[3])
+        py = (p[2], p[4], p[4])
+    else:
+        px = (p[7], p[10], p[13])
+        py = (p[8], p[11], p[14])
+    eps = 1e-9
+    for e in range(3):
+        nx = -(py[(e + 1) % 3] - py[e])
+        ny = px[(e + 1) % 3] - px[e]
+        if nx == 0.0 and ny == 0.0:
+            continue
+        lo = np.inf
+        hi = -np.inf
+        for k in range(3):
+            d = nx * px[k] + ny * py[k]
+            lo = min(lo, d)
+            hi = max(hi, d)
+        clo = np.inf
+        chi = -np.inf
+        for cx, cy in ((x0, y0), (x1, y0), (x0, y1), (x1, y1)):
+            d = nx * cx + ny * cy
+            clo = min(clo, d)
+            chi = max(chi, d)
+        scale = eps * (abs(nx) + abs(ny)) * (1.0 + abs(x0) + abs(y0))
+        if chi < lo - scale or clo > hi + scale:
+            return False
+    return True
+
+
+@numba.njit(cache=True)
 def _cell_lists(prims, x0, y0, cell, nx, ny):
+    """CSR lists of the cells each primitive's footprint meets (a long diagonal wall is put in
+    the cells along it, not in every cell of its bounding box)."""
     n = prims.shape[0]
     counts = np.zeros(nx * ny + 1, np.int64)
     lo = np.empty((n, 2), np.int64)
@@ -70,7 +109,10 @@ def _cell_lists(prims, x0, y0, cell, nx, ny):
         hi[i, 1] = max(0, min(ny - 1, int(np.floor((by1 - y0) / cell))))
         for iy in range(lo[i, 1], hi[i, 1] + 1):
             for ix in range(lo[i, 0], hi[i, 0] + 1):
-                counts[iy * nx + ix + 1] += 1
+                cx = x0 + ix * cell
+                cy = y0 + iy * cell
+                if _touches(prims[i], cx, cy, cx + cell, cy + cell):
+                    counts[iy * nx + ix + 1] += 1
     for k in range(nx * ny):
         counts[k + 1] += counts[k]
     items = np.empty(counts[nx * ny], np.int64)
@@ -78,9 +120,12 @@ def _cell_lists(prims, x0, y0, cell, nx, ny):
     for i in range(n):
         for iy in range(lo[i, 1], hi[i, 1] + 1):
             for ix in range(lo[i, 0], hi[i, 0] + 1):
-                k = iy * nx + ix
-                items[fill[k]] = i
-                fill[k] += 1
+                cx = x0 + ix * cell
+                cy = y0 + iy * cell
+                if _touches(prims[i], cx, cy, cx + cell, cy + cell):
+                    k = iy * nx + ix
+                    items[fill[k]] = i
+                    fill[k] += 1
     return counts, items
 
 

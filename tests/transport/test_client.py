@@ -81,3 +81,30 @@ def test_the_simulation_side_keeps_running_after_a_script_exits(endpoint):
         assert run_script(code).returncode == 0
         with SimulationClient(endpoint) as c:
             assert c.sim_time() >= 0.0
+
+
+def test_a_navigator_used_with_with_closes_its_subscriptions_not_the_client(sim):
+    from fleetsim.nav.navigator import Navigator
+
+    with SimulationClient(sim.endpoint) as c:
+        with Navigator(c, "/lizi1") as nav:
+            assert len(c._subs) == 3  # move_base status, feedback, result
+            assert nav.get_result().name == "UNKNOWN"
+        assert c._subs == [] and not c.closed
+        got = []
+        sub = c.subscribe("/chatter", got.append, latched=False)
+        assert wait_for(lambda: got)
+        sub.close()
+        sub.close()
+        assert c._subs == []
+
+
+def wait_for(condition, timeout: float = 10.0) -> bool:
+    import time
+
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if condition():
+            return True
+        time.sleep(0.02)
+    return False

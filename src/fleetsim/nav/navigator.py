@@ -17,7 +17,8 @@ It works with
   joined to a simulation with ``fleetsim node run``, whose runtime follows the simulation);
 * a `fleetsim.transport.SimulationClient`: a connection to a running simulation in another
   process over Zenoh (see `fleetsim.nav.navigator_remote`); there ``spin_until_complete``
-  waits in wall-clock seconds.
+  waits in wall-clock seconds. ``with Navigator(...) as nav:`` destroys it at the end (its
+  node, or its remote subscriptions; a client left open still closes when Python exits).
 
 ``follow_waypoints`` sends goals one after the other; the task fails at the first waypoint
 that does not succeed. Results map actionlib statuses as Nav2 does: SUCCEEDED; PREEMPTED and
@@ -123,61 +124,6 @@ def initial_pose_msg(x: float, y: float, yaw: float, frame: str, stamp: float) -
     )
 
 
-class _LocalBackend:
-    """Talks to move_base through an in-process ActionClient on a node."""
-
-    def __init__(self, node: Any, action: str, initialpose: str) -> None:
-        from fleetsim.msgs import geometry_msgs, move_base_msgs
-
-        self.node = node
-        self.client = node.create_action_client(move_base_msgs.MoveBase, action)
-        self.action = self.client.name
-        self.initialpose = node.create_publisher(
-            geometry_msgs.PoseWithCovarianceStamped, initialpose
-        )
-        self.handle: Any = None
-
-    def now(self) -> float:
-        return self.node.now()
-
-    def send(self, goal_pose: Any, on_feedback, on_done) -> None:
-        from fleetsim.msgs import move_base_msgs
-
-        if not self.client.wait_for_server():
-            raise ActionError(
-                f"Navigator: no move_base action server at {self.action} (nothing publishes "
-                f"{self.action}/status); start move_base in that namespace or fix the namespace"
-            )
-        self.handle = self.client.send_goal(
-            move_base_msgs.MoveBaseGoal(target_pose=goal_pose),
-            done_cb=lambda h: on_done(h.status, h.text),
-            feedback_cb=lambda h, fb: on_feedback(fb),
-        )
-
-    def status(self) -> tuple[int, str]:
-        h = self.handle
-        return (h.status, h.text) if h is not None else (0, "")
-
-    def cancel(self) -> None:
-        if self.handle is not None and not self.handle.done:
-            self.handle.cancel()
-
-    def publish_initial_pose(self, msg: Any) -> None:
-        self.initialpose.publish(msg)
-
-    def spin(self, timeout: float | None, until) -> None:
-        rt = self.node.runtime
-        if until():
-            return
-        if timeout is None:
-            rt.run(until=until)
-        else:
-            rt.run(duration=timeout, until=until)
-
-    def close(self) -> None:
-        """Nothing to release: the nodes live in the caller's runtime."""
-
-
 class Navigator:
     """Send navigation goals to one robot's move_base and follow them.
 
@@ -212,7 +158,9 @@ class Navigator:
             runtime_or_node = self._own_node
         action_name = names.join(ns, action)
         if isinstance(runtime_or_node, Node):
-            self._backend: Any = _LocalBackend(
+            from fleetsim.nav.navigator_local import LocalBackend
+
+            self._backend: Any = LocalBackend(
                 runtime_or_node, action_name, names.join(ns, "initialpose")
             )
         elif hasattr(runtime_or_node, "session") and hasattr(runtime_or_node, "publisher"):
@@ -378,11 +326,18 @@ class Navigator:
         self._backend.publish_initial_pose(initial_pose_msg(x, y, yaw, frame, self._backend.now()))
 
     def destroy(self) -> None:
-        """Remove the navigator's own node (Runtime) or close its subscriptions (remote)."""
+        """Remove the navigator's own node (Runtime) or close its subscriptions and publishers
+        (remote; the SimulationClient stays open, it belongs to the caller)."""
         self._backend.close()
         if self._own_node is not None:
             self._own_node.destroy()
             self._own_node = None
+
+    def __enter__(self) -> Navigator:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.destroy()
 
 
 _STATUS_NAMES = {

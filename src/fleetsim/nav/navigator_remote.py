@@ -44,8 +44,10 @@ class RemoteBackend:
         self._goal_pub = None
         self._cancel_pub = None
         self._pose_pub = None
-        for part in ("status", "feedback", "result"):
+        self._subs = [
             client.subscribe(f"{action}/{part}", self._dispatch(part), latched=False)
+            for part in ("status", "feedback", "result")
+        ]
 
     def now(self) -> float:
         """Sim time estimated from the last reading plus wall time (no query per call)."""
@@ -144,7 +146,11 @@ class RemoteBackend:
             _wall.sleep(0.02)
 
     def close(self) -> None:
+        """Close the navigator's publishers and subscriptions (the client stays open)."""
         for pub in (self._goal_pub, self._cancel_pub, self._pose_pub):
             if pub is not None:
                 pub.close()
         self._goal_pub = self._cancel_pub = self._pose_pub = None
+        for sub in self._subs:
+            sub.close()
+        self._subs.clear()

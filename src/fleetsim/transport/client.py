@@ -124,6 +124,22 @@ def _close_session(session: Any, subs: list, pubs: weakref.WeakSet) -> None:
     session.close()
 
 
+class ToolSubscription:
+    """One subscription of a tool; ``close()`` ends it (the client's ``close`` ends them all)."""
+
+    def __init__(self, client: SimulationClient, name: str, sub: Any) -> None:
+        self.name = name
+        self._client = client
+        self._sub = sub
+
+    def close(self) -> None:
+        """Undeclare the subscription (idempotent); its reader thread then ends."""
+        subs = self._client._subs
+        if self._sub in subs:
+            subs.remove(self._sub)
+            self._sub.undeclare()
+
+
 class SimulationClient:
     """A connection from a tool to a running simulation.
 
@@ -194,7 +210,7 @@ class SimulationClient:
     # -- topics -----------------------------------------------------------------------------
     def subscribe(
         self, name: str, callback: Callable[[Received], None], latched: bool = True
-    ) -> None:
+    ) -> ToolSubscription:
         """Call ``callback`` (on a daemon thread, one per subscription) with every message on
         ``name``.
 
@@ -220,6 +236,7 @@ class SimulationClient:
                 if reply.ok is not None:
                     ok = reply.ok
                     decode(ok.payload.to_bytes(), ok.encoding, ok.attachment)
+        return ToolSubscription(self, name, sub)
 
     def publisher(self, name: str, msg_type: type) -> ToolPublisher:
         self.check_type(name, msg_type)

@@ -306,21 +306,29 @@ class ParamTree:
         return None
 
     def _forget(self, keys: list[str]) -> None:
+        """Drop the origins at ``keys`` and under it (cheap unless it holds a namespace)."""
         if not self._origins:
             return
-        full = "/" + "/".join(keys)
         if not keys:
             self._origins.clear()
             return
-        for k in [k for k in self._origins if k == full or k.startswith(full + "/")]:
-            del self._origins[k]
+        full = "/" + "/".join(keys)
+        self._origins.pop(full, None)
+        node: Any = self._root
+        for k in keys:
+            node = node.get(k) if isinstance(node, dict) else None
+        if isinstance(node, dict) and node:
+            for k in [k for k in self._origins if k.startswith(full + "/")]:
+                del self._origins[k]
 
-    def _sourced(self, prefix: str, node: dict) -> ParamDict:
+    def _sourced(self, prefix: str, node: dict, inherited: str | None) -> ParamDict:
+        """A ParamDict copy of ``node`` (at ``prefix``) with each key's origin; ``inherited`` is
+        the origin of the nearest namespace above that was set whole."""
         out = ParamDict()
         for k, v in node.items():
             child = f"{prefix}/{k}"
-            out[k] = self._sourced(child, v) if isinstance(v, dict) else copy.deepcopy(v)
-            origin = self.origin(child)
+            origin = self._origins.get(child, inherited) if self._origins else None
+            out[k] = self._sourced(child, v, origin) if isinstance(v, dict) else copy.deepcopy(v)
             if origin:
                 out.origins[str(k)] = origin
         return out
@@ -351,7 +359,8 @@ class ParamTree:
             node = node[k]
         if isinstance(node, dict):
             keys = self._keys(name)
-            return self._sourced("/" + "/".join(keys) if keys else "", node)
+            prefix = "/" + "/".join(keys) if keys else ""
+            return self._sourced(prefix, node, self.origin(name) if keys else None)
         return copy.deepcopy(node) if isinstance(node, list) else node
 
     def set(self, name: str, value: Any, origin: str | None = None) -> None:
@@ -367,10 +376,11 @@ class ParamTree:
             self._root = copy.deepcopy(dict(value))
             return
         node = self._root
-        for k in keys[:-1]:
+        for i, k in enumerate(keys[:-1]):
             nxt = node.get(k)
             if not isinstance(nxt, dict):
                 nxt = node[k] = {}
+                self._origins.pop("/" + "/".join(keys[: i + 1]), None)
             node = nxt
         node[keys[-1]] = copy.deepcopy(value)
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import os
 import warnings
+from contextvars import ContextVar
 from pathlib import Path
 
 from lxml import etree
@@ -41,12 +42,44 @@ __all__ = ["GAZEBO_COLOURS", "load_sdf_model", "load_sdf_world", "model_from_ele
 ASSET_MODELS = Path(__file__).resolve().parent.parent / "assets" / "worlds" / "models"
 
 
+#: the world file being read: its packages' exported model paths join the search
+_reading: ContextVar[Path | None] = ContextVar("sdf_reading", default=None)
+
+
+def exported_model_paths(near: Path | None) -> list[Path]:
+    """``<export><gazebo_ros gazebo_model_path="${prefix}/models"/>`` of the packages around
+    ``near`` and on the package path, as gazebo_ros's launch files add them to Gazebo's path
+    (``rospack plugins --attrib=gazebo_model_path gazebo_ros``)."""
+    from fleetsim.description.packages import env_package_path, packages_above, packages_under
+
+    pkgs: dict[str, Path] = {}
+    if near is not None:
+        pkgs.update(packages_above(near))
+    for root in env_package_path():
+        for name, folder in packages_under(root).items():
+            pkgs.setdefault(name, folder)
+    out: list[Path] = []
+    for folder in pkgs.values():
+        try:
+            root = etree.parse(str(folder / "package.xml")).getroot()
+        except (OSError, etree.XMLSyntaxError):
+            continue
+        for el in root.iterfind("export/gazebo_ros"):
+            value = el.get("gazebo_model_path")
+            if value:
+                for part in value.replace("${prefix}", str(folder)).split(os.pathsep):
+                    if part.strip() and Path(part.strip()) not in out:
+                        out.append(Path(part.strip()))
+    return out
+
+
 def model_path() -> list[Path]:
-    """Folders searched for ``model://NAME``: FLEETSIM_MODEL_PATH, GAZEBO_MODEL_PATH, assets."""
+    """Folders searched for ``model://NAME``: FLEETSIM_MODEL_PATH, GAZEBO_MODEL_PATH, the
+    ``gazebo_model_path`` exports of the world file's package and of the package path, assets."""
     out: list[Path] = []
     for var in ("FLEETSIM_MODEL_PATH", "GAZEBO_MODEL_PATH"):
         out += [Path(p) for p in os.environ.get(var, "").split(os.pathsep) if p]
-    return [*out, ASSET_MODELS]
+    return [*out, *exported_model_paths(_reading.get()), ASSET_MODELS]
 
 
 def find_model(name: str, where: str) -> Path:
@@ -58,7 +91,8 @@ def find_model(name: str, where: str) -> Path:
     roots = ", ".join(str(p) for p in model_path())
     raise SimulationError(
         f"{where}: model://{name} not found in {roots}; add its folder (model.config + "
-        "model.sdf) to FLEETSIM_MODEL_PATH"
+        "model.sdf) to GAZEBO_MODEL_PATH, or export it from your package.xml as "
+        '<export><gazebo_ros gazebo_model_path="${prefix}/models"/></export>'
     )
 
 
@@ -298,6 +332,14 @@ def _plugin_params(el) -> dict[str, str]:
 def load_sdf_world(path: str | Path) -> WorldDesc:
     """Parse an SDF ``.world`` file (``<sdf><world>``) into a ``WorldDesc``."""
     path = Path(path)
+    token = _reading.set(path.resolve())
+    try:
+        return _load_sdf_world(path)
+    finally:
+        _reading.reset(token)
+
+
+def _load_sdf_world(path: Path) -> WorldDesc:
     root = _parse_file(path)
     where = str(path)
     world = root if root.tag == "world" else root.find("world")

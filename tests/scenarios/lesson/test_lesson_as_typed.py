@@ -1,6 +1,7 @@
 """The lesson's package as a student types it (issue 13): runs unchanged, robots reach their goals.
 
-``gazebo_navigation_multi/`` holds the lesson's files with its own names: ``navigation_multi.launch``
+``gazebo_navigation_multi/`` holds the lesson's files with its own names:
+``navigation_multi.launch``
 with ``map_server ... willow-full.png 0.1`` and an ``rviz`` node, ``willowgarage_world.launch``
 including ``gazebo_ros/empty_world.launch`` with ``worlds/willowgarage.world`` (``model://
 willowgarage`` at ``<pose>-3 54 0 0 0 30</pose>``), ``robots.launch`` with three lizis, each

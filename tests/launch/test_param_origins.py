@@ -153,3 +153,12 @@ def test_ros2_yaml_launch_param_files_name_the_line_too(tmp_path):
         _Probe(rt, "probe")
     with pytest.raises(ParameterError, match=rf"\(set at {tmp_path}/plain.yaml:2\)"):
         _Probe(rt, "plain")
+
+
+def test_inline_rosparam_yaml_error_names_the_launch_file_line(tmp_path):
+    from fleetsim.errors import LaunchError
+
+    p = write(tmp_path, '<node pkg="x" type="y" name="a">\n  <rosparam>\n    ok: 1\n'
+                        "    bad: [1, 2\n  </rosparam>\n</node>")  # fmt: skip
+    with pytest.raises(LaunchError, match=rf"{p}:6:\d+: YAML does not parse.*\({p}:3 <rosparam>\)"):
+        load_xml(p)

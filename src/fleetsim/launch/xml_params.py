@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import shlex
 import subprocess
-from functools import cache
 from pathlib import Path
 from typing import Any
 
@@ -64,15 +63,10 @@ def _ns_join(ns: str, name: str) -> str:
     return ns.rstrip("/") + "/" + name
 
 
-@cache
-def _lines(path: str) -> list[str]:
-    return Path(path).read_text().splitlines()
-
-
 def _text_line(path: Path, el) -> int:
     """The line on which an element's text starts: the end of its start tag."""
     try:
-        lines = _lines(str(path))
+        lines = Path(path).read_text().splitlines()
     except OSError:
         return el.sourceline
     i = el.sourceline - 1

@@ -90,3 +90,59 @@ def test_range_limits_and_misses():
 def test_empty_grid_returns_inf():
     grid = raycast.grid_from_primitives(np.zeros((0, 7)))
     assert np.isinf(raycast.cast(grid, np.zeros((2, 3)), np.zeros(2), 0.0, 5.0, -1)).all()
+
+
+def random_triangles(rng, n):
+    """Triangle primitives (kind 2): walls (vertical) and tilted triangles of any size."""
+    corners = rng.uniform(-10, 10, (n, 3, 3))
+    corners[:, :, 2] = rng.uniform(-1, 2, (n, 3))
+    walls = rng.random(n) < 0.5  # a vertical triangle: two corners share x, y
+    corners[walls, 1, :2] = corners[walls, 0, :2]
+    out = np.zeros((n, 16))
+    out[:, 0] = 2
+    out[:, 1:3] = corners[:, :, :2].min(axis=1)
+    out[:, 3:5] = corners[:, :, :2].max(axis=1)
+    out[:, 5] = corners[:, :, 2].min(axis=1)
+    out[:, 6] = corners[:, :, 2].max(axis=1)
+    out[:, 7:] = corners.reshape(n, 9)
+    return out, corners
+
+
+def exact_triangle_range(corners, origin, angle, rmin, rmax):
+    """Moller-Trumbore: the first triangle a horizontal ray meets at t >= rmin."""
+    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
+    e1, e2 = b - a, c - a
+    d = np.array([np.cos(angle), np.sin(angle), 0.0])
+    p = np.cross(d, e2)
+    det = np.einsum("ij,ij->i", e1, p)
+    ok = np.abs(det) > 1e-12
+    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+    s = origin - a
+    u = np.einsum("ij,ij->i", s, p) * inv
+    q = np.cross(s, e1)
+    w = (q @ d) * inv
+    t = np.einsum("ij,ij->i", e2, q) * inv
+    hit = ok & (u >= 0) & (w >= 0) & (u + w <= 1) & (t >= rmin)
+    best = t[hit].min() if hit.any() else np.inf
+    return best if best <= rmax else np.inf
+
+
+@settings(max_examples=30, deadline=None)
+@given(seed=st.integers(0, 10_000), cell=st.sampled_from([0.3, 1.0, 2.5]))
+def test_triangles_on_the_grid_match_exact_ray_triangle_intersection(seed, cell):
+    rng = np.random.default_rng(seed)
+    tris, corners = random_triangles(rng, 30)
+    mixed = np.vstack([np.pad(random_prims(rng, 10), ((0, 0), (0, 9))), tris])
+    grid = raycast.grid_from_primitives(mixed, cell=cell)
+    origins = np.c_[rng.uniform(-12, 12, (60, 2)), rng.uniform(-0.5, 1.5, 60)]
+    angles = rng.uniform(-np.pi, np.pi, 60)
+    got = raycast.cast(grid, origins, angles, 0.05, 15.0, -1)
+    for g, o, a in zip(got, origins, angles):
+        want = min(
+            exact_triangle_range(corners, o, a, 0.05, 15.0),
+            brute_force(mixed[:10, :7], o, a, 0.05, 15.0),
+        )
+        if np.isinf(want):
+            assert np.isinf(g)
+        else:
+            assert abs(g - want) < 1e-6

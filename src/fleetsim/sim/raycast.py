@@ -201,28 +201,31 @@ def _triangle_hit(p, ox, oy, oz, dx, dy, tmin):
     p[7:16]), or inf: the triangle is cut by the plane ``z = oz`` (a corner counts as above when
     its z >= oz, so triangles sharing an edge cut it at the same point) and the cut segment is
     hit as a segment."""
-    px = np.empty(2)
-    py = np.empty(2)
+    x0 = y0 = x1 = y1 = 0.0  # the cut's end points (scalars: no allocation per test)
     n = 0
     for e in range(3):
         a = 7 + 3 * e
         b = 7 + 3 * ((e + 1) % 3)
         za = p[a + 2]
         zb = p[b + 2]
-        if (za >= oz) != (zb >= oz) and n < 2:
+        if (za >= oz) != (zb >= oz):
             s = (oz - za) / (zb - za)
-            px[n] = p[a] + s * (p[b] - p[a])
-            py[n] = p[a + 1] + s * (p[b + 1] - p[a + 1])
+            if n == 0:
+                x0 = p[a] + s * (p[b] - p[a])
+                y0 = p[a + 1] + s * (p[b + 1] - p[a + 1])
+            else:
+                x1 = p[a] + s * (p[b] - p[a])
+                y1 = p[a + 1] + s * (p[b + 1] - p[a + 1])
             n += 1
     if n < 2:
         return np.inf
-    ex = px[1] - px[0]
-    ey = py[1] - py[0]
+    ex = x1 - x0
+    ey = y1 - y0
     den = dx * ey - dy * ex
     if abs(den) < 1e-12:
         return np.inf
-    wx = px[0] - ox
-    wy = py[0] - oy
+    wx = x0 - ox
+    wy = y0 - oy
     t = (wx * ey - wy * ex) / den
     s = (wx * dy - wy * dx) / den
     if t >= tmin and -1e-12 <= s <= 1.0 + 1e-12:

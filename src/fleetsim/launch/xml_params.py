@@ -28,7 +28,7 @@ import yaml
 
 from fleetsim.errors import FleetsimError, LaunchError
 from fleetsim.launch.model import ParamOp
-from fleetsim.launch.substitutions import auto_value, strict_bool, substitute, to_bool
+from fleetsim.launch.substitutions import auto_value, substitute, to_bool
 from fleetsim.runtime import names
 from fleetsim.runtime.param_yaml import load_yaml_lines
 
@@ -233,6 +233,3 @@ class ParamElements:
             )
         kind = "load" if isinstance(data, dict) else "set"
         self.plan.params.append(ParamOp(kind, full, data, where, origins))
-
-
-__all__ = ["ParamElements", "convert_value", "strict_bool"]

@@ -69,6 +69,12 @@ def new_world_spec(timestep: float = 0.002) -> mujoco.MjSpec:
     spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_AUTORESET
     spec.option.integrator = mujoco.mjtIntegrator.mjINT_IMPLICITFAST
     spec.option.cone = mujoco.mjtCone.mjCONE_ELLIPTIC  # pyramidal + early stop jitters at rest
+    # one contact per convex pair (MuJoCo 4 enables multi-point CCD by default): robots that
+    # rub wheel against wheel or body got a pile of near-duplicate elliptic friction contacts
+    # on which the Newton solver did not converge (it hit its iteration cap), and the
+    # unconverged forces flung a lizi at 800 rad/s into a NaN (the willow10_amcl repro).
+    # Wheels on the ground plane use the analytic plane colliders and are not affected.
+    spec.option.disableflags |= mujoco.mjtDisableBit.mjDSBL_MULTICCD
     spec.option.tolerance = 1e-6  # solver stops early; ample for wheeled robots
     spec.option.ls_iterations = 20
     spec.compiler.inertiafromgeom = mujoco.mjtInertiaFromGeom.mjINERTIAFROMGEOM_FALSE

@@ -89,7 +89,7 @@ def physics_error(engine, t: float) -> SimulationError:
         dof = _actuator_dof(m, act)
         owner = _owner(engine, dof) if dof >= 0 else f"actuator '{m.actuator(act).name}'"
         return PhysicsInstability(
-            f"{where}: NaN, infinite or huge command {d.ctrl[act]!r} on actuator "
+            f"{where}: NaN, infinite or huge command {float(d.ctrl[act])} on actuator "
             f"'{m.actuator(act).name}' ({owner}); likely cause: a NaN command from a "
             "controller or plugin; try: find what writes the actuator's control (the drive "
             "plugins ignore non-finite Twists) and guard it"

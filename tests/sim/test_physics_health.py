@@ -1,0 +1,146 @@
+"""Physics that never fails silently (``sim.health``).
+
+Every shipped robot driven at its top speed (wheel joint velocity limit times wheel radius)
+into a wall and into another robot raises no MuJoCo warning; injected instabilities (a NaN
+force, a NaN control, a broken model) raise `PhysicsInstability` naming the robot, body and
+joint; through ``fleetsim launch`` the run stops with a one-line error and a readable recording.
+Each test runs in a temporary directory, where a ``MUJOCO_LOG.TXT`` would show up.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import mujoco
+import numpy as np
+import pytest
+
+from fleetsim.description import load_robot
+from fleetsim.errors import PhysicsInstability
+from fleetsim.sim import Engine
+from fleetsim.sim.plugins.base import DrivePlugin
+from fleetsim.sim.world import GeomDesc, LinkDesc, ModelDesc, WorldDesc, ground_plane
+
+from .conftest import FIXTURES
+
+ROBOTS = Path(__file__).resolve().parents[2] / "src" / "fleetsim" / "assets" / "robots"
+FILES = sorted(ROBOTS.glob("*/urdf/*.urdf.xacro"))
+
+
+@pytest.fixture(autouse=True)
+def in_tmp_dir(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    yield
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+
+
+def drive_of(entry) -> DrivePlugin:
+    return next(p for p in entry.plugins if isinstance(p, DrivePlugin))
+
+
+def top_speed(entry, drive) -> float:
+    """Wheel surface speed at the wheel joints' velocity limit, m/s."""
+    limits = [entry.robot.joints[j].limit for j in drive.left + drive.right]
+    return min(lim.velocity for lim in limits if lim is not None) * drive.radius
+
+
+def run_clean(e: Engine, commands, seconds: float) -> None:
+    """Drive for ``seconds``; no warning counter may trip and accelerations stay sane."""
+    for _ in range(round(seconds / 0.05)):
+        for drive, vx, wz in commands:
+            drive.command(vx, wz, e.time)
+        e.advance(0.05)
+        assert not e.data.warning.number.any()
+        assert np.isfinite(e.data.qacc).all() and np.abs(e.data.qacc).max() < 1e5
+
+
+@pytest.mark.parametrize("path", FILES, ids=[p.parts[-3] for p in FILES])
+def test_robot_at_top_speed_into_a_wall_stays_sane(path):
+    wall = ModelDesc(
+        "wall", (1.2, 0, 0.5, 0, 0, 0), True, [LinkDesc("l", geoms=[GeomDesc("box", (0.1, 6, 1))])]
+    )
+    e = Engine(WorldDesc("w", [ground_plane(), wall]))
+    entry = e.spawn_robot("bot", load_robot(path), (0, 0, 0, 0, 0, 0.4))
+    drive = drive_of(entry)
+    run_clean(e, [(drive, top_speed(entry, drive), 0.0)], 1.5)
+    assert e.model_pose("bot")[0][0] < 1.2  # the wall held
+
+
+@pytest.mark.parametrize("path", FILES, ids=[p.parts[-3] for p in FILES])
+def test_robots_at_top_speed_into_each_other_stay_sane(path):
+    robot = load_robot(path)
+    e = Engine(None)
+    a, b = e.spawn_robots(
+        [("a", robot, (0, 0, 0, 0, 0, 0)), ("b", robot, (1.5, 0.1, 0, 0, 0, math.pi - 0.3))]
+    )
+    da, db = drive_of(a), drive_of(b)
+    v = top_speed(a, da)
+    run_clean(e, [(da, v, 0.0), (db, v, 1.0)], 1.5)
+
+
+def test_nan_force_names_robot_body_and_joint(diffbot):
+    e = Engine(None)
+    e.spawn_robot("bot", diffbot)
+    e.advance(0.05)
+    e.data.xfrc_applied[e.root_body("bot"), 2] = np.nan
+    with pytest.raises(
+        PhysicsInstability,
+        match=r"t = 0\.0\d\d s: NaN, infinite or huge acceleration \(qacc\) at robot 'bot', "
+        r"body 'base_footprint', joint 'free' .*likely cause: NaN or infinite applied force on "
+        r"bot/base_footprint",
+    ):
+        e.advance(0.05)
+    # no auto-reset: the world stays as the failed step left it
+    assert not np.isfinite(e.data.qpos).all()
+
+
+def test_nan_control_is_an_instability(diffbot):
+    e = Engine(None)
+    entry = e.spawn_robot("bot", diffbot)
+    e.advance(0.05)
+    act = mujoco.mj_name2id(e.model, mujoco.mjtObj.mjOBJ_ACTUATOR, entry.actuators[0])
+    e.drives.control = lambda engine, t: None  # the servo would overwrite the control
+    e.data.ctrl[act] = np.nan
+    with pytest.raises(
+        PhysicsInstability,
+        match=rf"huge command nan on actuator '{entry.actuators[0]}' \(robot 'bot', "
+        r"body '\w+_wheel', joint '\w+'.*likely cause: a NaN command",
+    ):
+        e.advance(0.05)
+
+
+def test_broken_model_names_the_light_link():
+    e = Engine(None)
+    e.spawn_robot("bad", load_robot(FIXTURES / "broken_flapper.urdf"))
+    with pytest.raises(
+        PhysicsInstability,
+        match=r"at robot 'bad', body 'flap_link', joint 'flap', DOF 6; likely cause: bad "
+        r"inertia: link 'flap_link' of 1e-06 kg .*try: give link 'flap_link' a realistic",
+    ):
+        e.advance(1.0)
+
+
+def test_launch_that_blows_up_exits_nonzero_with_a_readable_recording(tmp_path, capsys):
+    from fleetsim.cli.main import main
+    from fleetsim.record import BagReader
+
+    launch = tmp_path / "broken.launch"
+    launch.write_text(
+        "<launch>\n"
+        '  <include file="$(find gazebo_ros)/launch/empty_world.launch"/>\n'
+        f'  <param name="robot_description" textfile="{FIXTURES / "broken_flapper.urdf"}"/>\n'
+        '  <node name="spawn" pkg="gazebo_ros" type="spawn_model"\n'
+        '        args="-urdf -param robot_description -model bad"/>\n'
+        "</launch>\n"
+    )
+    bag = tmp_path / "run.mcap"
+    code = main(["launch", str(launch), "--duration", "2", "--record", str(bag), "--no-bridge"])
+    assert code == 1
+    err = capsys.readouterr().err.replace("\n", " ")
+    assert "error: physics instability at t = " in err
+    assert "Traceback" not in err
+    reader = BagReader(bag)
+    assert reader.complete  # finalised: footer and closing magic written
+    assert "/clock" in {t.name for t in reader.info().topics}
+    assert sum(1 for _ in reader.messages(["/clock"])) > 0

@@ -170,3 +170,43 @@ def test_second_build_reads_the_decomposition_from_the_cache(monkeypatch):
     assert files[0].stat().st_mtime_ns == stamp
     assert second.model.ngeom == first.model.ngeom
     np.testing.assert_array_equal(second.model.geom_aabb, first.model.geom_aabb)
+
+
+def test_depth_camera_sees_the_true_walls_through_a_door():
+    from fleetsim.sim.plugins.camera import DepthCameraPlugin
+
+    waffle = load_robot(BURGER.parents[2] / "turtlebot3_waffle/urdf/turtlebot3_waffle.urdf.xacro")
+    e = Engine(WORLD)
+    ent = e.spawn_robot("w", waffle, (3.0, 3.2, 0, 0, 0, np.pi / 2))
+    e.advance(0.1)
+    cam = next(p for p in ent.plugins if isinstance(p, DepthCameraPlugin))
+    depth = cam.render(e, depth=True)
+    origin = e.data.cam_xpos[cam.cam_id].copy()
+    axis = -e.data.cam_xmat[cam.cam_id].reshape(3, 3)[:, 2]  # MuJoCo cameras look along -z
+    h, w = depth.shape
+    for col in (w // 2, w // 8, 7 * w // 8):  # through the door, and the wall beside it
+        ray = np.linalg.inv(cam.K) @ [col + 0.5, h / 2 + 0.5, 1.0]  # optical: x right, y down
+        R = e.data.cam_xmat[cam.cam_id].reshape(3, 3)
+        d = R @ [ray[0], -ray[1], -1.0]
+        d /= np.linalg.norm(d)
+        exact = exact_ranges_3d(origin, d)
+        assert abs(depth[h // 2, col] - exact * (d @ axis)) < 0.02, col
+    assert depth[h // 2, w // 2] > 4.0  # the corridor's far wall, seen through the door
+    no_mujoco_warnings(e)
+
+
+def exact_ranges_3d(origin, d):
+    v, f = triangle_mesh(OBJ)
+    a, b, c = (v[f[:, i]] for i in range(3))
+    e1, e2 = b - a, c - a
+    p = np.cross(d, e2)
+    det = np.einsum("ij,ij->i", e1, p)
+    ok = np.abs(det) > 1e-12
+    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
+    s = origin - a
+    u = np.einsum("ij,ij->i", s, p) * inv
+    q = np.cross(s, e1)
+    w = (q @ d) * inv
+    t = np.einsum("ij,ij->i", e2, q) * inv
+    hit = ok & (u >= 0) & (w >= 0) & (u + w <= 1) & (t > 0)
+    return t[hit].min()

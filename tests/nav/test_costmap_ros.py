@@ -203,3 +203,31 @@ def test_reset_stop_start_and_full_update_after_a_direct_clear():
     assert cm.update() and cm.is_current()
     cm.reset_layers()
     assert cm.update() and cm.costmap.costs[0, 0] == LETHAL_OBSTACLE
+
+
+def count_readings(layer):
+    """Wrap the layer's add_observation to count the readings read into it."""
+    calls = []
+    add = layer.add_observation
+    layer.add_observation = lambda *a, **k: (calls.append(a[-1]), add(*a, **k))
+    return calls
+
+
+@pytest.mark.parametrize("persistence", [0.0, 1.0])
+def test_readings_are_read_at_the_update_unless_they_persist(persistence):
+    extra = room_grid()
+    fill(extra, 2.0, 0.8, 2.2, 1.2)  # a box 1 m ahead, not on the map
+    scan = {**COMMON["scan"], "observation_persistence": persistence}
+    rt, bot, node, cm = world(extra={"scan": scan, "update_frequency": 2.0})
+    bot.set_world(extra)
+    calls = count_readings(cm.layered.layer("obstacle_layer"))
+    rt.run(duration=2.0)  # 20 scans at 10 Hz, 4 updates at 2 Hz
+    if persistence:  # every reading within the window counts: each is read as it comes
+        # (the first, at 0.1 s, before fake_localization's first map -> odom, is dropped)
+        assert calls == pytest.approx([0.1 * k for k in range(2, 21)])
+    else:  # only the newest counts: one read per update, the newest
+        assert len(calls) == 4
+        assert calls[-1] == pytest.approx(rt.now())  # the scan of the same instant, first
+    box = cm.costmap.world_to_map(2.01, 1.0)  # the face the laser sees
+    assert cm.costmap.costs[box[1], box[0]] == LETHAL_OBSTACLE
+    assert cm.is_current()

@@ -100,6 +100,7 @@ def test_a_clearing_recovery_forgets_far_obstacles_at_the_next_update():
     layer = cm.layered.layer("obstacle_layer")
     w.bot.scan_timer.cancel()  # no raytracing to clear the marks below
     layer.buffers["scan"].observations = []
+    cm.sources.drop_unread()  # nor a scan that came since the last update
     near, far = cm.costmap.world_to_map(1.5, 1.0), cm.costmap.world_to_map(3.0, 4.0)
     for mx, my in (near, far):
         layer.grid.costs[my, mx] = 254

@@ -11,7 +11,9 @@ and then, as costmap_2d does:
   ``PointCloud2``; readings are projected (laser_geometry's projectLaser) and moved into the
   costmap's ``global_frame`` with tf at the message's stamp; a reading whose stamp tf cannot
   answer is moved with the newest transform when that is within ``transform_tolerance`` of the
-  stamp, and dropped (with a warning) otherwise;
+  stamp, and dropped otherwise (warned about when tf stays silent past the grace period of
+  `fleetsim.tf.patience`); a source without ``observation_persistence`` is read at the update,
+  its newest reading only (`fleetsim.nav.costmap.sources`);
 * every ``1 / update_frequency`` s the robot pose (``robot_base_frame`` in ``global_frame``,
   newest tf, stale beyond ``transform_tolerance``) drives one layered update, and the robot
   footprint is published on ``~<name>/footprint`` (PolygonStamped);
@@ -35,17 +37,14 @@ from typing import Any
 
 import numpy as np
 
-from fleetsim.errors import FleetsimError, TransformError
-from fleetsim.msgs import geometry_msgs, get_type, nav_msgs, sensor_msgs, std_msgs
+from fleetsim.errors import TransformError
+from fleetsim.msgs import geometry_msgs, nav_msgs, std_msgs
 from fleetsim.nav.costmap.footprint import footprint_at
 from fleetsim.nav.costmap.layer import Bounds, Layer
 from fleetsim.nav.costmap.layered_costmap import LayeredCostmap
 from fleetsim.nav.costmap.obstacle_layer import ObstacleLayer
-from fleetsim.nav.costmap.readings import (
-    points_from_cloud1,
-    points_from_cloud2,
-    points_from_scan,
-)
+from fleetsim.nav.costmap.readings import points_from_cloud2  # noqa: F401 (its old home)
+from fleetsim.nav.costmap.sources import ObservationSources
 from fleetsim.nav.costmap.static_layer import StaticLayer
 from fleetsim.nav.errors import CostmapError, MapError
 from fleetsim.nav.map_server import grid_msg_from_map, map_from_grid_msg
@@ -95,7 +94,7 @@ class Costmap2DROS:
         self.last_pose: tuple[float, float, float] | None = None
         self._warned: dict[str, float] = {}
         self._patience = TransformPatience()  # missing transforms: reported when they last
-        self._last_reading: dict[tuple[str, str], float] = {}
+        self.sources = ObservationSources(self)
         self._subs: list[Any] = []
         self._map_subs: dict[str, Any] = {}
         _ = node.tf_buffer  # listen to /tf from now on
@@ -110,7 +109,7 @@ class Costmap2DROS:
                 self._subscribe_map(layer)
             elif isinstance(layer, ObstacleLayer):
                 for source in layer.buffers:
-                    self._subscribe_source(layer, source)
+                    self._subs.append(self.sources.subscribe(layer, source))
         if p.update_frequency > 0:
             node.create_timer(1.0 / p.update_frequency, self.update)
         if p.publish_frequency > 0:
@@ -168,64 +167,6 @@ class Costmap2DROS:
         sub = self.node.create_subscription(nav_msgs.OccupancyGrid, topic, on_map, 1)
         self._map_subs[layer.name] = sub
         self._subs.append(sub)
-
-    def _subscribe_source(self, layer: ObstacleLayer, source: str) -> None:
-        sp = layer.buffers[source].params
-        where = f"{self.ns}/{layer.name}/{source}"
-        if sp.data_type == "LaserScan":
-            msg_type, convert = sensor_msgs.LaserScan, self._scan_points
-        elif sp.data_type == "PointCloud2":
-            msg_type, convert = sensor_msgs.PointCloud2, self._cloud2_points
-        else:
-            try:
-                msg_type = get_type("sensor_msgs/PointCloud")
-            except FleetsimError:
-                raise CostmapError(
-                    f"{where}: data_type PointCloud (sensor_msgs/PointCloud, ROS 1's old cloud) "
-                    "is not available; publish PointCloud2 and set data_type: PointCloud2, or "
-                    "use data_type: LaserScan"
-                ) from None
-            convert = self._cloud1_points
-        sensor_frame = (
-            resolve_frame_once(self.node.tf_prefix, sp.sensor_frame) if sp.sensor_frame else ""
-        )
-
-        def on_reading(msg: Any) -> None:
-            if self.stopped:
-                return
-            try:
-                points = convert(msg, sp, where)
-            except CostmapError as err:
-                self._warn(f"bad:{where}", f"ignoring a reading: {err}")
-                return
-            frame = normalize_frame(msg.header.frame_id)
-            stamp = msg.header.stamp.to_sec()
-            moved = self._to_global(frame, stamp, where)
-            if moved is None:
-                return
-            rot, trans = moved
-            origin = trans
-            if sensor_frame and sensor_frame != frame:
-                at = self._to_global(sensor_frame, stamp, where)
-                if at is None:
-                    return
-                origin = at[1]
-            layer.add_observation(source, origin, points @ rot.T + trans, stamp)
-            self._last_reading[(layer.name, source)] = self.node.now()
-
-        self._subs.append(self.node.create_subscription(msg_type, sp.topic, on_reading, 1))
-
-    @staticmethod
-    def _scan_points(msg: Any, sp: Any, where: str) -> np.ndarray:
-        return points_from_scan(msg, sp.inf_is_valid)
-
-    @staticmethod
-    def _cloud2_points(msg: Any, sp: Any, where: str) -> np.ndarray:
-        return points_from_cloud2(msg, where)
-
-    @staticmethod
-    def _cloud1_points(msg: Any, sp: Any, where: str) -> np.ndarray:
-        return points_from_cloud1(msg)
 
     def _to_global(self, frame: str, stamp: float, where: str):
         """(rotation (3, 3), translation (3,)) of ``frame`` in the global frame, or None."""
@@ -296,6 +237,7 @@ class Costmap2DROS:
         pose = self.robot_pose()
         if pose is None:
             return False
+        self.sources.read_unread()
         missing = [la.name for la in self._static_layers() if la.map_grid is None]
         if missing:
             self._warn("map", f"waiting for the map on {', '.join(self._map_topics())}")
@@ -335,6 +277,7 @@ class Costmap2DROS:
         if not self.initialized or self.stopped:
             return False
         now = self.node.now()
+        self.sources.read_unread()  # a reading that came since the update counts as heard from
         for layer in self.layered.layers:
             if not isinstance(layer, ObstacleLayer):
                 continue
@@ -342,7 +285,7 @@ class Costmap2DROS:
                 rate = buf.params.expected_update_rate
                 if rate <= 0:
                     continue
-                last = self._last_reading.get((layer.name, source), -math.inf)
+                last = self.sources.last_reading.get((layer.name, source), -math.inf)
                 if now - last > rate:
                     topic = self.node.resolve_name(buf.params.topic)
                     self._warn(
@@ -355,6 +298,7 @@ class Costmap2DROS:
 
     def reset_layers(self) -> None:
         """Forget all sensor data (clear_costmaps); the static map is re-applied next update."""
+        self.sources.drop_unread()
         self.layered.reset_layers()
 
     def mark_full_update(self) -> None:
@@ -371,13 +315,14 @@ class Costmap2DROS:
         """Stop updating and reading sensors (shutdown_costmaps)."""
         self.stopped = True
         self.initialized = False
+        self.sources.drop_unread()
 
     def start(self) -> None:
         """Resume after `stop`; static layers subscribe again (getting the latched map, as
         StaticLayer::activate does); ready again after the next update."""
         if self.stopped:
             self.stopped = False
-            self._last_reading.clear()
+            self.sources.last_reading.clear()
             for layer in self._static_layers():
                 layer.reset()
                 self._subscribe_map(layer)

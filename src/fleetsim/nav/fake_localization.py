@@ -30,21 +30,19 @@ per-robot cost is a fifth of it.
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from dataclasses import dataclass
 from typing import Any
-
-import numpy as np
 
 from fleetsim.errors import ExtrapolationError, TransformError
 from fleetsim.msgs import geometry_msgs, nav_msgs, std_msgs
 from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.runtime import Node, param
 from fleetsim.tf import TransformBroadcaster, make_transform_stamped, resolve_frame_once
+from fleetsim.tf.fastmath import Transform7, compose, invert
 from fleetsim.tf.names import normalize_frame
 from fleetsim.tf.patience import GRACE, TransformPatience
-from fleetsim.tf.quaternions import quaternion_from_yaw, quaternion_normalize
-from fleetsim.tf.transforms import compose_transforms, inverse_transform
 
 #: messages waiting for their odom -> base transform (tf2_ros::MessageFilter's queue size)
 QUEUE_SIZE = 100
@@ -72,17 +70,19 @@ class FakeLocalizationParams:
     )
 
 
-def _pose_arrays(pose: Any) -> tuple[np.ndarray, np.ndarray]:
+def _pose7(pose: Any) -> Transform7:
+    """A Pose as a transform tuple, its quaternion normalised."""
     p, q = pose.position, pose.orientation
-    return np.array([p.x, p.y, p.z]), quaternion_normalize([q.x, q.y, q.z, q.w])
+    n = math.sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w)
+    if not n > 0.0:
+        return (p.x, p.y, p.z, 0.0, 0.0, 0.0, 1.0)
+    return (p.x, p.y, p.z, q.x / n, q.y / n, q.z / n, q.w / n)
 
 
-def _pose_msg(t: np.ndarray, q: np.ndarray) -> geometry_msgs.Pose:
+def _pose_msg(t: Transform7) -> geometry_msgs.Pose:
     return geometry_msgs.Pose(
-        position=geometry_msgs.Point(x=float(t[0]), y=float(t[1]), z=float(t[2])),
-        orientation=geometry_msgs.Quaternion(
-            x=float(q[0]), y=float(q[1]), z=float(q[2]), w=float(q[3])
-        ),
+        position=geometry_msgs.Point(x=t[0], y=t[1], z=t[2]),
+        orientation=geometry_msgs.Quaternion(x=t[3], y=t[4], z=t[5], w=t[6]),
     )
 
 
@@ -101,7 +101,10 @@ class FakeLocalization(Node):
         self.base_frame = resolve_frame_once(prefix, p.base_frame_id)
         self.global_frame = resolve_frame_once(prefix, p.global_frame_id)
         # offset = (-delta_x, -delta_y) translation, -delta_yaw rotation (fake_localization.cpp)
-        self.offset = (np.array([-p.delta_x, -p.delta_y, 0.0]), quaternion_from_yaw(-p.delta_yaw))
+        half = -p.delta_yaw / 2.0
+        self.offset: Transform7 = (
+            -p.delta_x, -p.delta_y, 0.0, 0.0, 0.0, math.sin(half), math.cos(half)
+        )  # fmt: skip
         self._pending: deque[nav_msgs.Odometry] = deque(maxlen=QUEUE_SIZE)
         self._warned: set[str] = set()
         self._patience = TransformPatience()
@@ -170,7 +173,7 @@ class FakeLocalization(Node):
         """Publish tf and pose for one message; False when tf cannot answer yet."""
         stamp = msg.header.stamp
         try:
-            t_ob, q_ob = self.tf_buffer.lookup_arrays(self.odom_frame, self.base_frame, stamp)
+            ob = self.tf_buffer.lookup_tuple(self.odom_frame, self.base_frame, stamp)
         except ExtrapolationError as err:
             newest = self._newest_odom_time()
             if newest is not None and newest > stamp.to_sec():
@@ -188,15 +191,15 @@ class FakeLocalization(Node):
                 )
             return False
         self._patience.found("lookup")
-        t_mb, q_mb = compose_transforms(*self.offset, *_pose_arrays(msg.pose.pose))
-        # map -> odom = (map -> base) * (odom -> base)^-1
-        t_mo, q_mo = compose_transforms(t_mb, q_mb, *inverse_transform(t_ob, q_ob))
+        # one transform in plain floats (tf.fastmath): NumPy's per-call overhead was most of it
+        mb = compose(self.offset, _pose7(msg.pose.pose))
+        mo = compose(mb, invert(ob))  # map -> odom = (map -> base) * (odom -> base)^-1
         future = Time.from_nsec(stamp.to_nsec() + round(self.params.transform_tolerance * 1e9))
         self.tf_pub.send_transform(
-            make_transform_stamped(self.global_frame, self.odom_frame, future, t_mo, q_mo)
+            make_transform_stamped(self.global_frame, self.odom_frame, future, mo[:3], mo[3:])
         )
         header = std_msgs.Header(stamp=stamp, frame_id=self.global_frame)
-        pose = _pose_msg(t_mb, q_mb)
+        pose = _pose_msg(mb)
         self.pose_pub.publish(
             geometry_msgs.PoseWithCovarianceStamped(
                 header=header, pose=geometry_msgs.PoseWithCovariance(pose=pose)
@@ -221,11 +224,8 @@ class FakeLocalization(Node):
                 f"{self.global_frame}"
             )
         try:
-            t_bm, q_bm = self.tf_buffer.lookup_arrays(
-                self.base_frame, self.global_frame, msg.header.stamp
-            )
+            bm = self.tf_buffer.lookup_tuple(self.base_frame, self.global_frame, msg.header.stamp)
         except TransformError as err:
             self.get_logger().warning(f"ignoring initialpose: failed to look up the robot: {err}")
             return
-        delta = compose_transforms(*_pose_arrays(msg.pose.pose), t_bm, q_bm)
-        self.offset = compose_transforms(*delta, *self.offset)
+        self.offset = compose(compose(_pose7(msg.pose.pose), bm), self.offset)

@@ -154,6 +154,21 @@ def test_cameras_render_the_true_mesh_not_the_parts():
     assert faces == {len(f)}  # the visual is the whole mesh, the hull parts are not drawn
     assert np.all(m.geom_group[(m.geom_contype != 0) & (m.geom_type == 7)] == HULL_GROUP)
     assert VISUAL_GROUP not in m.geom_group[hull]
+    assert (m.geom_type[hull] == mujoco.mjtGeom.mjGEOM_BOX).sum() > len(np.flatnonzero(hull)) / 2
+
+
+def test_rectangular_prisms_become_boxes_and_others_do_not():
+    from fleetsim.sim.mesh_assets import box_of
+
+    ring = np.array([[0, 0], [2, 0], [2, 1], [0, 1]], float) @ [[0.6, 0.8], [-0.8, 0.6]] + (5, 1)
+    prism = np.c_[np.vstack([ring, ring]), [0] * 4 + [3] * 4]
+    centre, half, yaw = box_of(prism)
+    assert np.allclose(half, (1, 0.5, 1.5)) and np.isclose(np.tan(yaw), 0.8 / 0.6)
+    assert np.allclose(centre, [*ring.mean(axis=0), 1.5])
+    skew = prism.copy()
+    skew[[1, 5], 0] += 0.3  # a trapezoid
+    assert box_of(skew) is None
+    assert box_of(prism[:6]) is None
 
 
 def test_second_build_reads_the_decomposition_from_the_cache(monkeypatch):

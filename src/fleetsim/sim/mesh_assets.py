@@ -148,10 +148,18 @@ def add_decomposed_mesh(
     base = mesh_asset_name(mesh_file, scale)
     name = f"{prefix}{g.name or 'geom'}#{index}"
     for k, part in enumerate(result.parts):
-        asset = f"{base}:cvx{k}"
-        if spec.mesh(asset) is None:
-            spec.add_mesh(name=asset, uservert=np.ascontiguousarray(part).ravel())
-        geom = body.add_geom(name=f"{name}:cvx{k}", type=G.mjGEOM_MESH, meshname=asset, **kw)
+        box = box_of(part)
+        if box is not None:  # most wall prisms: boxes collide 2x cheaper than meshes
+            centre, half, yaw = box
+            pos, quat = _in_frame(kw, centre, yaw)
+            geom = body.add_geom(
+                name=f"{name}:cvx{k}", type=G.mjGEOM_BOX, size=half, pos=pos, quat=quat
+            )
+        else:
+            asset = f"{base}:cvx{k}"
+            if spec.mesh(asset) is None:
+                spec.add_mesh(name=asset, uservert=np.ascontiguousarray(part).ravel())
+            geom = body.add_geom(name=f"{name}:cvx{k}", type=G.mjGEOM_MESH, meshname=asset, **kw)
         geom.group = HULL_GROUP
         geom.contype, geom.conaffinity = 2, 1
         if g.friction is not None:
@@ -173,3 +181,34 @@ def add_decomposed_mesh(
         geom.density = 0
         geom.rgba = list(g.rgba) if g.rgba else [0.7, 0.7, 0.7, 1.0]
     return True
+
+
+def box_of(part: np.ndarray, tol: float = 1e-6):
+    """An upright rectangular prism's box: centre (3,), half sizes (3,) and yaw (rad) in the
+    part's frame; None for any other part. ``part`` is (8, 3): a 4-vertex ring at two heights,
+    as ``prisms`` writes it."""
+    if part.shape != (8, 3):
+        return None
+    ring, z = part[:4, :2], part[:, 2]
+    if not (np.allclose(part[4:, :2], ring, atol=tol) and np.ptp(z[:4]) <= tol):
+        return None
+    e = np.roll(ring, -1, axis=0) - ring
+    length = np.linalg.norm(e, axis=1)
+    if length.min() <= tol or np.any(
+        np.abs(np.einsum("ij,ij->i", e, np.roll(e, -1, 0))) > tol * length.max() ** 2
+    ):
+        return None
+    centre = np.array([*ring.mean(axis=0), 0.5 * (z[0] + z[4])])
+    half = np.array([length[0] / 2, length[1] / 2, abs(z[4] - z[0]) / 2])
+    if half[2] <= tol:
+        return None
+    return centre, half, float(np.arctan2(e[0, 1], e[0, 0]))
+
+
+def _in_frame(kw: dict, centre: np.ndarray, yaw: float) -> tuple[np.ndarray, np.ndarray]:
+    """Position and orientation in the body of a box given in the geom frame ``kw``."""
+    pos, quat = np.asarray(kw["pos"], float), np.asarray(kw["quat"], float)
+    p, q = np.zeros(3), np.zeros(4)
+    mujoco.mju_rotVecQuat(p, centre, quat)
+    mujoco.mju_mulQuat(q, quat, np.array([np.cos(yaw / 2), 0.0, 0.0, np.sin(yaw / 2)]))
+    return p + pos, q

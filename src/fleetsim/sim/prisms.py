@@ -174,7 +174,22 @@ def _merge_convex(rings: list[np.ndarray]) -> list[np.ndarray]:
         owner.pop((v, u), None)
         polys[i] = merged
         del polys[j]
-    return [np.array(r, dtype=np.float64) for r in polys.values()]
+    return [_without_collinear(np.array(r, dtype=np.float64)) for r in polys.values()]
+
+
+def _without_collinear(ring: np.ndarray, tol: float = 1e-9) -> np.ndarray:
+    """The ring without vertices lying on the line of their neighbours (a rectangle merged
+    from triangles keeps its 4 corners, so it can become a box)."""
+    while len(ring) > 3:
+        e1 = ring - np.roll(ring, 1, axis=0)
+        e2 = np.roll(ring, -1, axis=0) - ring
+        cross = np.abs(e1[:, 0] * e2[:, 1] - e1[:, 1] * e2[:, 0])
+        scale = np.linalg.norm(e1, axis=1) * np.linalg.norm(e2, axis=1)
+        flat = np.flatnonzero(cross <= tol * np.maximum(scale, 1e-30))
+        if not len(flat):
+            break
+        ring = np.delete(ring, flat[0], axis=0)
+    return ring
 
 
 def _joined(ri: list, rj: list, u, v) -> list | None:

@@ -262,3 +262,21 @@ def test_map_topic_first_map_only_throttle_and_no_tf():
     assert 4 <= len(out.clouds) <= 6  # about 1 Hz over 5 s although the filter updated more
     assert len(out.poses) > 8
     assert not rt.tf_buffer.can_transform("map", "odom")  # tf_broadcast false
+
+
+def test_a_scan_ahead_of_its_odometry_waits_for_tf_without_amcl_reading_all_of_tf():
+    rt, robot, amcl, out = robot_world(
+        amcl_params={"initial_pose_x": 1.5, "initial_pose_y": 5.0, "laser_max_beams": 60}
+    )
+    rt.run(duration=0.55)
+    # amcl is told by the tf buffer when tf changes; it does not get every /tf message itself
+    assert all(sub.node is not amcl for sub in rt.graph.topics["/tf"].subscriptions)
+    scan = sensor_msgs.LaserScan(
+        header=std_msgs.Header(stamp=Time.from_sec(0.58), frame_id="lizi1/laser"),
+        angle_min=-np.pi, angle_max=np.pi, angle_increment=2 * np.pi / 360,
+        range_min=0.05, range_max=10.0, ranges=np.full(360, 5.0, np.float32),
+    )  # fmt: skip
+    amcl.on_scan(scan)  # odometry is known up to 0.5 s: the scan waits
+    assert len(amcl._pending_scans) == 1
+    rt.run(duration=0.1)  # the robot's tf at 0.6 s lets it through, before the robot's own scan
+    assert len(amcl._pending_scans) == 0

@@ -337,3 +337,39 @@ def test_bad_time_arguments_are_named():
         buf.lookup_transform("map", "lizi1/odom", math.inf)
     with pytest.raises(TransformError, match=r"tf time 'now' is neither seconds nor"):
         buf.lookup_transform("map", "lizi1/odom", "now")
+
+
+def test_call_after_next_message_fires_once_after_a_message_that_adds_a_transform():
+    from fleetsim.msgs.tf2_msgs import TFMessage
+
+    buf = Buffer()
+    seen = []
+
+    def retry():
+        seen.append(buf.can_transform("odom", "base_link", 1.0))
+
+    buf.call_after_next_message(retry)
+    buf.call_after_next_message(retry)  # the same callback waits once
+    assert buf.add_message(TFMessage(transforms=[])) == 0 and seen == []  # nothing added
+    first = TFMessage(transforms=[msg("odom", "base_link", 1.0, (1.0, 0.0, 0.0))])
+    assert buf.add_message(first) == 1
+    assert seen == [True]  # after the whole message went in
+    buf.add_message(TFMessage(transforms=[msg("odom", "base_link", 2.0, (2.0, 0.0, 0.0))]))
+    assert seen == [True]  # one-shot
+
+
+def test_a_callback_may_wait_again_from_inside_its_call():
+    from fleetsim.msgs.tf2_msgs import TFMessage
+
+    buf = Buffer()
+    calls = []
+
+    def retry():
+        calls.append(len(calls))
+        if len(calls) < 2:
+            buf.call_after_next_message(retry)
+
+    buf.call_after_next_message(retry)
+    for k in range(3):
+        buf.add_message(TFMessage(transforms=[msg("odom", "base_link", k + 1.0, (0, 0, 0))]))
+    assert calls == [0, 1]

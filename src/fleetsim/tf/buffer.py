@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Callable
 from typing import Any
 
 import numpy as np
@@ -31,13 +32,7 @@ from fleetsim.errors import (
 from fleetsim.tf import _msgs
 from fleetsim.tf.cache import FrameCache, checked_value, ns_from_time
 from fleetsim.tf.fastmath import IDENTITY, Transform7, compose, invert, matrix_rows
-from fleetsim.tf.frame_info import (
-    FrameInfo,
-    frame_info_of,
-    frames_as_dot,
-    frames_as_string,
-    frames_as_yaml,
-)
+from fleetsim.tf.frame_info import FrameInfo, TreeIntrospection
 from fleetsim.tf.geometry import TRANSFORMERS
 from fleetsim.tf.names import normalize_frame
 
@@ -49,7 +44,7 @@ _log = logging.getLogger("fleetsim.tf")
 _MAX_LISTED_FRAMES = 12
 
 
-class Buffer:
+class Buffer(TreeIntrospection):
     """Transforms between coordinate frames over time (tf2's ``BufferCore``).
 
     Parameters
@@ -71,6 +66,7 @@ class Buffer:
         self._version = 0  # bumped whenever an edge of the tree appears, moves or disappears
         self._paths: dict[tuple[str, str], tuple[int, list[FrameCache], list[FrameCache]]] = {}
         self._rejected: set[tuple[str, str]] = set()  # (child, authority) already warned about
+        self._waiting: list[Callable[[], Any]] = []  # see call_after_next_message
 
     # ------------------------------------------------------------------ writing
     def add_message(self, msg: Any, authority: str = "", is_static: bool = False) -> int:
@@ -87,7 +83,21 @@ class Buffer:
                 if key not in self._rejected:  # once per frame and publisher, not per message
                     self._rejected.add(key)
                     _log.error("ignoring transform for %r: %s", t.child_frame_id, exc)
+        if added and self._waiting:
+            waiting, self._waiting = self._waiting, []
+            for callback in waiting:
+                callback()
         return added
+
+    def call_after_next_message(self, callback: Callable[[], Any]) -> None:
+        """Call ``callback()`` once, after the next message that adds a transform.
+
+        What tf2's message filters wait on (``BufferCore::addTransformableCallback``): a node
+        holding data whose transform has not arrived retries when tf changes, without each such
+        node receiving every ``/tf`` message itself (N robots' nodes x N robots' transforms).
+        """
+        if callback not in self._waiting:
+            self._waiting.append(callback)
 
     def set_transform(self, transform: Any, authority: str = "", is_static: bool = False) -> bool:
         """Add one ``geometry_msgs/TransformStamped`` to the buffer.
@@ -364,42 +374,3 @@ class Buffer:
             f"{role} {name!r} does not exist in the tf tree{did_you_mean(name, known)}; "
             f"known frames: {listed}"
         )
-
-    # ------------------------------------------------------------------ introspection
-    def all_frames(self) -> list[str]:
-        """Every frame id in the tree (children and roots), sorted."""
-        return sorted(self._frames)
-
-    def parents(self) -> dict[str, str]:
-        """Map each child frame to its parent (the edges of ``tf tree`` / view_frames)."""
-        return {n: f.parent for n, f in sorted(self._frames.items()) if f.parent is not None}
-
-    def frame_info(self, frame: str) -> FrameInfo:
-        """Parent, authority, average rate and time window of one child frame's transform."""
-        name = normalize_frame(frame)
-        f = self._frames.get(name)
-        if f is None:
-            raise self._not_found(name, "frame")
-        if f.parent is None:
-            raise FrameNotFound(f"frame {name!r} is a root of the tf tree and has no parent edge")
-        return frame_info_of(f, self.cache_time)
-
-    def frames_info(self) -> dict[str, FrameInfo]:
-        """:meth:`frame_info` for every child frame, by frame id."""
-        return {
-            n: frame_info_of(f, self.cache_time)
-            for n, f in sorted(self._frames.items())
-            if f.parent is not None
-        }
-
-    def all_frames_as_yaml(self) -> str:
-        """tf2's ``allFramesAsYAML``: one block per child frame, as view_frames reads it."""
-        return frames_as_yaml(self.frames_info())
-
-    def all_frames_as_dot(self, recorded_at: float | None = None) -> str:
-        """The tree as a Graphviz digraph labelled like ``view_frames`` (render with ``dot``)."""
-        return frames_as_dot(self.frames_info(), recorded_at)
-
-    def all_frames_as_string(self) -> str:
-        """tf2's ``allFramesAsString``: ``Frame X exists with parent Y.`` lines."""
-        return frames_as_string(self.parents())

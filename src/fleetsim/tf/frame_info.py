@@ -7,8 +7,12 @@ from typing import Any
 
 import yaml
 
+from fleetsim.errors import FrameNotFound
+from fleetsim.tf.names import normalize_frame
+
 __all__ = [
     "FrameInfo",
+    "TreeIntrospection",
     "frame_info_of",
     "frames_as_dot",
     "frames_as_string",
@@ -120,3 +124,49 @@ def frames_as_dot(infos: dict[str, FrameInfo], recorded_at: float | None = None)
         lines.append(f'label="Recorded at time: {recorded_at:.3f}"; labelloc=t;')
     lines.append("}")
     return "\n".join(lines) + "\n"
+
+
+class TreeIntrospection:
+    """What ``view_frames``, ``tf_monitor`` and ``tf_echo`` ask a `Buffer` about its tree
+    (a base of `Buffer`, which holds ``_frames``, ``cache_time`` and ``_not_found``)."""
+
+    _frames: dict[str, Any]
+    cache_time: float
+
+    def all_frames(self) -> list[str]:
+        """Every frame id in the tree (children and roots), sorted."""
+        return sorted(self._frames)
+
+    def parents(self) -> dict[str, str]:
+        """Map each child frame to its parent (the edges of ``tf tree`` / view_frames)."""
+        return {n: f.parent for n, f in sorted(self._frames.items()) if f.parent is not None}
+
+    def frame_info(self, frame: str) -> FrameInfo:
+        """Parent, authority, average rate and time window of one child frame's transform."""
+        name = normalize_frame(frame)
+        f = self._frames.get(name)
+        if f is None:
+            raise self._not_found(name, "frame")
+        if f.parent is None:
+            raise FrameNotFound(f"frame {name!r} is a root of the tf tree and has no parent edge")
+        return frame_info_of(f, self.cache_time)
+
+    def frames_info(self) -> dict[str, FrameInfo]:
+        """:meth:`frame_info` for every child frame, by frame id."""
+        return {
+            n: frame_info_of(f, self.cache_time)
+            for n, f in sorted(self._frames.items())
+            if f.parent is not None
+        }
+
+    def all_frames_as_yaml(self) -> str:
+        """tf2's ``allFramesAsYAML``: one block per child frame, as view_frames reads it."""
+        return frames_as_yaml(self.frames_info())
+
+    def all_frames_as_dot(self, recorded_at: float | None = None) -> str:
+        """The tree as a Graphviz digraph labelled like ``view_frames`` (render with ``dot``)."""
+        return frames_as_dot(self.frames_info(), recorded_at)
+
+    def all_frames_as_string(self) -> str:
+        """tf2's ``allFramesAsString``: ``Frame X exists with parent Y.`` lines."""
+        return frames_as_string(self.parents())

@@ -27,7 +27,7 @@ from typing import Any
 import numpy as np
 
 from fleetsim.errors import ExtrapolationError, FleetsimError, TransformError
-from fleetsim.msgs import geometry_msgs, nav_msgs, sensor_msgs, std_msgs, std_srvs, tf2_msgs
+from fleetsim.msgs import geometry_msgs, nav_msgs, sensor_msgs, std_msgs, std_srvs
 from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.runtime import Node
 from fleetsim.tf import TransformBroadcaster, make_transform_stamped, resolve_frame_once
@@ -89,7 +89,6 @@ class Amcl(Node):
         self.tf_pub = TransformBroadcaster(self) if p.tf_broadcast else None
         _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now, not at the first scan
         self._pending_scans: deque[sensor_msgs.LaserScan] = deque(maxlen=SCAN_QUEUE_SIZE)
-        self.create_subscription(tf2_msgs.TFMessage, "/tf", self._on_tf, queue_size=100)
         self.create_subscription(sensor_msgs.LaserScan, "scan", self.on_scan, queue_size=1)
         self.create_subscription(
             geometry_msgs.PoseWithCovarianceStamped, "initialpose", self.on_initial_pose, 2
@@ -258,7 +257,7 @@ class Amcl(Node):
 
         As ROS amcl's tf ``MessageFilter``: a scan whose ``odom -> base`` transform at its stamp
         has not arrived yet (the simulator publishes a scan before the tf of the same step) waits
-        for it; a new tf message retries the queue.
+        for it; the next tf message retries the queue.
         """
         if self.filter.grid is None:
             self._warn_once("no_map", "received a scan but no map yet; waiting for the map")
@@ -266,13 +265,11 @@ class Amcl(Node):
         self._pending_scans.append(scan)
         self._drain_scans()
 
-    def _on_tf(self, msg: Any) -> None:
-        if self._pending_scans:
-            self._drain_scans()
-
     def _drain_scans(self) -> None:
         while self._pending_scans:
             if not self._process_scan(self._pending_scans[0]):
+                # retried when tf changes (the buffer calls back, as tf2's message filter is)
+                self.tf_buffer.call_after_next_message(self._drain_scans)
                 return
             self._pending_scans.popleft()
 

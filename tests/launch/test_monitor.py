@@ -157,3 +157,37 @@ def test_the_localization_error_compares_map_to_base_with_ground_truth(robot_ses
     s.runtime.run(duration=0.2)
     r = {r.namespace: r for r in s.monitor.results()}["/lizi1"]
     assert r.localization_error == pytest.approx(0.5, abs=0.01)
+
+
+def test_without_a_simulator_here_ground_truth_comes_from_gazebo_model_states():
+    """A joined session (``launch --connect``) has no engine: /gazebo/model_states is the truth,
+    and the move_base node's own name (move_base_node, as the lesson) finds its tolerance."""
+    from fleetsim.launch.model import LaunchPlan, NodeSpec
+    from fleetsim.launch.monitor import RunMonitor
+    from fleetsim.msgs import gazebo_msgs
+    from fleetsim.runtime import Runtime
+
+    rt = Runtime(seed=1)
+    rt.params.set("/lizi1/move_base_node/TrajectoryPlannerROS/xy_goal_tolerance", 0.3)
+    plan = LaunchPlan(nodes=[NodeSpec("move_base", "move_base", "move_base_node", "/lizi1")])
+    monitor = RunMonitor(rt, plan, {})
+    mb = move_base_msgs.MoveBase
+    sim = Node(rt, "gazebo", "/")
+    states = sim.create_publisher(gazebo_msgs.ModelStates, "/gazebo/model_states")
+    stand_in = Node(rt, "move_base_node", "/lizi1")
+    goal_pub = stand_in.create_publisher(mb.ActionGoal, "move_base/goal", 1)
+    result_pub = stand_in.create_publisher(mb.ActionResult, "move_base/result", 1)
+    pose = geometry_msgs.Pose()
+    pose.position.x, pose.position.y = 5.0, 1.0
+    states.publish(gazebo_msgs.ModelStates(name=["lizi1"], pose=[pose], twist=[]))
+    goal_pub.publish(action_goal("a", 5.5, 1.0))  # 0.5 m: within 0.3 + margin
+    goal_pub.publish(action_goal("b", 9.0, 1.0))  # replaces a; 4 m away
+    rt.spin_once()
+    result_pub.publish(mb.ActionResult(status=status("a", 3)))
+    result_pub.publish(mb.ActionResult(status=status("b", 3)))
+    rt.spin_once()
+    r = monitor.results()[0]
+    assert r.goal_tolerance == pytest.approx(0.3 + GOAL_MARGIN)
+    assert (r.goals_sent, r.goals_reached, r.goals_unconfirmed) == (2, 1, 1)
+    assert r.last_text == "reported reached, 4.0 m away by ground truth"
+    assert r.distance_to_goal == pytest.approx(4.0)

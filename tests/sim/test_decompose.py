@@ -3,6 +3,7 @@ CoACD's quality warning, the disk cache."""
 
 from __future__ import annotations
 
+import itertools
 import warnings
 
 import numpy as np
@@ -188,3 +189,27 @@ def test_stl_binary_ascii_and_obj_read_the_same_triangles(tmp_path):
     (tmp_path / "bad.obj").write_text("v 0 0 0\nf 1 2 3\n")
     with pytest.raises(SimulationError, match="bad.obj.*vertex that does not exist"):
         triangle_mesh(tmp_path / "bad.obj")
+
+
+def test_an_open_mesh_of_single_faces_becomes_sheets():
+    """Three walls of a room drawn as single faces (no thickness, not closed): each becomes a
+    slab SHEET thick around its face, so robots are stopped by it as in Gazebo."""
+    from fleetsim.sim.prisms import SHEET
+
+    corners = [(0, 0), (4, 0), (4, 3), (0, 3)]
+    v, f = [], []
+    for (x0, y0), (x1, y1) in itertools.pairwise(corners):
+        k = len(v)
+        v += [(x0, y0, 0), (x1, y1, 0), (x1, y1, 2), (x0, y0, 2)]
+        f += [(k, k + 1, k + 2), (k, k + 2, k + 3)]
+    v, f = np.array(v, float), np.array(f)
+    assert not decompose.is_closed(decompose.weld(v, f)[1])
+    d = decompose.decompose(v, f)
+    assert d.methods == ["prisms"]
+    volume = sum(ConvexHull(p).volume for p in d.parts)
+    assert volume == pytest.approx((4 + 3 + 4) * 2 * SHEET, rel=0.01)  # corners overlap a bit
+    for x, y in [(2, 0), (4, 1.5), (2, 3)]:  # each wall's middle is inside a part
+        assert any(
+            np.all(p.min(axis=0) <= (x, y, 1)) and np.all(p.max(axis=0) >= (x, y, 1))
+            for p in d.parts
+        )

@@ -47,7 +47,7 @@ from scipy.spatial import ConvexHull, QhullError
 
 from fleetsim.sim import prisms
 
-ALGORITHM_VERSION = "2"  # part of the cache key: bump when the decomposition changes
+ALGORITHM_VERSION = "3"  # part of the cache key: bump when the decomposition changes
 _WELD = 1e-6  # m, vertices closer than this are one
 
 

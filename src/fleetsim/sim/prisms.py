@@ -18,14 +18,15 @@ import shapely
 _HORIZONTAL = 1e-6  # m, a triangle with less height than this is horizontal
 _LEVEL = 1e-5  # m, vertex heights closer than this are one level
 _ROUND = 9  # decimals of 2-D coordinates used as keys (nm)
+SHEET = 0.01  # m, thickness given to faces of an open mesh with empty space on both sides
 
 
 def prisms_of_architecture(
     vertices: np.ndarray, faces: np.ndarray, drift: float
 ) -> list[np.ndarray] | None:
-    """Convex prisms whose union is the solid bounded by a closed mesh of horizontal and
-    (near-)vertical triangles; None when the mesh is not of that kind or its slices do not
-    close into polygons.
+    """Convex prisms whose union is the solid bounded by a mesh of horizontal and
+    (near-)vertical triangles (faces with empty space on both sides, as an open mesh has,
+    become ``SHEET``-thick slabs); None when the mesh is not of that kind.
 
     Parameters
     ----------
@@ -92,14 +93,13 @@ def _layer_polygons(tri, tz, faces, zm) -> list[np.ndarray] | None:
     if len(segments) == 0:
         return []
     lines = shapely.multilinestrings(segments)
-    polys, cuts, dangles, invalid = shapely.polygonize_full(shapely.node(lines).geoms)
-    if not (cuts.is_empty and dangles.is_empty and invalid.is_empty):
-        return None  # the slice does not close: not a solid of this kind
+    polys, _, _, invalid = shapely.polygonize_full(shapely.node(lines).geoms)
+    if not invalid.is_empty:
+        return None  # self-touching rings: not a solid of this kind
+    # segments outside every closed loop (an open mesh's lone faces) become sheets below
     faces_2d = list(polys.geoms)
-    if not faces_2d:
-        return None
     solid = [p for p in faces_2d if _inside(p.representative_point(), segments)]
-    area = shapely.union_all(solid)
+    area = shapely.union_all(solid) if solid else shapely.Polygon()
     out: list[np.ndarray] = []
     for poly in getattr(area, "geoms", [area]):
         if poly.is_empty or poly.area <= 0:
@@ -107,7 +107,26 @@ def _layer_polygons(tri, tz, faces, zm) -> list[np.ndarray] | None:
         tris = shapely.constrained_delaunay_triangles(poly)
         rings = [np.asarray(t.exterior.coords)[:3] for t in tris.geoms]
         out += _merge_convex(rings)
-    return out
+    return out + _sheets(segments, area)
+
+
+def _sheets(segments: np.ndarray, area) -> list[np.ndarray]:
+    """Slabs ``SHEET`` thick centred on the slice segments with empty space on both sides:
+    a mesh that is not closed (a wall drawn as one face) still stops robots, as a triangle
+    mesh does in Gazebo's ODE."""
+    p, q = segments[:, 0], segments[:, 1]
+    d = q - p
+    length = np.linalg.norm(d, axis=1)
+    n = np.column_stack([-d[:, 1], d[:, 0]]) / np.maximum(length, 1e-30)[:, None]
+    mid = 0.5 * (p + q)
+    probe = 1e-4
+    left = shapely.contains_xy(area, *(mid + probe * n).T)
+    right = shapely.contains_xy(area, *(mid - probe * n).T)
+    sheet = ~left & ~right & (length > 0)
+    half = 0.5 * SHEET * n[sheet]
+    a, b = p[sheet], q[sheet]
+    rings = np.stack([a - half, b - half, b + half, a + half], axis=1)
+    return list(rings)
 
 
 def _slice(tri, tz, faces, zm) -> np.ndarray:

@@ -17,6 +17,7 @@ import mujoco
 import numpy as np
 
 from fleetsim.errors import SimulationError
+from fleetsim.sim import textures
 from fleetsim.sim.mesh_assets import (
     HULL_GROUP,
     MESH_FORMATS,
@@ -100,15 +101,7 @@ def new_world_spec(timestep: float = 0.002) -> mujoco.MjSpec:
 def _material_for(spec: mujoco.MjSpec, g: GeomDesc, prefix: str) -> str:
     if not g.texture:
         return ""
-    path = Path(g.texture)
-    if not path.exists():
-        raise SimulationError(f"texture image '{g.texture}' of '{prefix}{g.name}' not found")
-    name = f"{prefix}tex:{path.name}"
-    if spec.texture(name) is None:
-        spec.add_texture(name=name, type=mujoco.mjtTexture.mjTEXTURE_2D, file=str(path))
-        mat = spec.add_material(name=name)
-        mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = name
-    return name
+    return textures.add_texture_material(spec, g.texture, f"'{prefix}{g.name}'")
 
 
 def add_geom(
@@ -146,7 +139,9 @@ def add_geom(
         mujoco.mju_mulQuat(q, fquat, quat)
         pos, quat = p + fpos, q
     kw = {"pos": pos, "quat": quat}
-    if g.kind == "box":
+    if g.kind == "box" and g.texture and not g.collide:  # Gazebo's UVs: the image on each face
+        kw.update(type=G.mjGEOM_MESH, meshname=textures.add_textured_box_mesh(spec, g.size))
+    elif g.kind == "box":
         kw.update(type=G.mjGEOM_BOX, size=[s / 2 for s in g.size])
     elif g.kind == "cylinder":
         kw.update(type=G.mjGEOM_CYLINDER, size=[g.size[0], g.size[1] / 2, 0])

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import re
 from pathlib import Path
 
 from fleetsim.errors import SimulationError
+from fleetsim.sim import textures
 
 GAZEBO_COLOURS = {
     "Gazebo/Grey": (0.7, 0.7, 0.7, 1.0),
@@ -28,8 +28,20 @@ def _text(el, tag: str, default: str) -> str:
     return default if c is None or c.text is None else c.text.strip()
 
 
-def _texture_from_script(script, where: str, find_model) -> str | None:
-    """Find the texture image of an OGRE material ``<script><uri>..<name>`` reference."""
+def _owner(vis, where: str) -> str:
+    """``model '<name>' (<file>)`` of a visual, for error messages."""
+    model = next((m.get("name") for m in vis.iterancestors("model")), None)
+    return f"model '{model}' ({where})" if model else where
+
+
+def _texture_from_script(script, vis, where: str, find_model) -> tuple[str | None, tuple | None]:
+    """Texture image and diffuse colour of an OGRE material ``<script><uri>..<name>``
+    reference (``textures``); (None, None) when no script in the URIs defines the material
+    (Gazebo's own ``Gazebo/*`` materials, coloured by ``GAZEBO_COLOURS``).
+
+    Raises `SimulationError` naming the image, the material and the model when the material
+    names a texture image that is not there.
+    """
     name = _text(script, "name", "")
     dirs: list[Path] = []
     for uri in script.findall("uri"):
@@ -42,17 +54,15 @@ def _texture_from_script(script, where: str, find_model) -> str | None:
                 continue
         elif u.startswith("file://"):
             dirs.append(Path(u[len("file://") :]))
-    files = [f for d in dirs if d.is_dir() for f in sorted(d.glob("*.material"))]
-    for f in files:
-        text = f.read_text(errors="replace")
-        m = re.search(r"material\s+" + re.escape(name) + r"\s*\{(.*?)\n\}", text, re.S)
-        if m:
-            t = re.search(r"texture\s+(\S+)", m.group(1))
-            if t:
-                for d in [f.parent, f.parent.parent / "textures", *dirs]:
-                    if (d / t.group(1)).exists():
-                        return str(d / t.group(1))
-    return None
+        elif u:
+            dirs.append(Path(where).parent / u)
+    material = textures.find_ogre_material(name, dirs)
+    if material is None:
+        return None, None
+    image = None
+    if material.texture is not None:
+        image = str(textures.texture_file(material, dirs, _owner(vis, where)))
+    return image, material.diffuse
 
 
 def material_of(vis, where: str, floats, find_model) -> tuple[tuple | None, str | None]:
@@ -74,8 +84,17 @@ def material_of(vis, where: str, floats, find_model) -> tuple[tuple | None, str 
             name = _text(script, "name", "")
             if rgba is None and name in GAZEBO_COLOURS:
                 rgba = GAZEBO_COLOURS[name]
-            texture = texture or _texture_from_script(script, where, find_model)
+            image, diffuse = _texture_from_script(script, vis, where, find_model)
+            texture = texture or image
+            if rgba is None and diffuse is not None:
+                rgba = diffuse
         albedo = mat.find("pbr/metal/albedo_map")
         if albedo is not None and albedo.text:
             texture = albedo.text.strip()
+            if texture.startswith("model://"):
+                model, _, rest = texture[len("model://") :].partition("/")
+                texture = str(find_model(model, where) / rest)
+            elif not Path(texture).is_absolute():
+                texture = str(Path(where).parent / texture)
+            textures.checked_image(texture, _owner(vis, where))
     return rgba, texture

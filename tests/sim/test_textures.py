@@ -1,0 +1,176 @@
+"""Textures as Gazebo applies them: OGRE scripts, images, the image stretched on each face."""
+
+import mujoco
+import numpy as np
+import pytest
+from PIL import Image
+
+from fleetsim.errors import SimulationError
+from fleetsim.sim import Engine
+from fleetsim.sim.sdf import load_sdf_model
+from fleetsim.sim.textures import box_uv_mesh, materials_of_script, parse_ogre_script
+
+
+@pytest.fixture(autouse=True)
+def in_tmp_dir(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # where MuJoCo would write MUJOCO_LOG.TXT
+    yield
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+
+
+def assert_no_mujoco_warnings(engine):
+    assert {i: w.number for i, w in enumerate(engine.data.warning) if w.number} == {}
+
+
+SCRIPT = """// a comment { with a brace
+material Base
+{
+  technique
+  {
+    pass
+    {
+      diffuse 0.2 0.4 0.6 1.0
+      texture_unit
+      {
+        texture base.png
+        filtering anisotropic
+      }
+    }
+  }
+}
+material Child : Base
+{
+  technique { pass { diffuse 1 0 0 } }
+}
+material Plain { technique { pass { ambient 1 1 1 } } }
+"""
+
+
+def test_ogre_script_blocks_textures_colours_and_inheritance(tmp_path):
+    mats = materials_of_script(SCRIPT, tmp_path / "a.material")
+    assert set(mats) == {"Base", "Child", "Plain"}
+    assert mats["Base"].texture == "base.png" and mats["Base"].diffuse == (0.2, 0.4, 0.6, 1.0)
+    assert mats["Base"].line == 2
+    assert mats["Child"].texture == "base.png" and mats["Child"].diffuse == (1.0, 0.0, 0.0, 1.0)
+    assert mats["Plain"].texture is None and mats["Plain"].diffuse is None
+
+
+def test_ogre_script_errors_name_file_and_line(tmp_path):
+    with pytest.raises(SimulationError, match=r"b.material:1: block 'material M' is never closed"):
+        parse_ogre_script("material M\n{\n pass {\n}\n", tmp_path / "b.material")
+    with pytest.raises(SimulationError, match=r"c.material:2: '\}' closes no block"):
+        parse_ogre_script("material M {}\n}\n", tmp_path / "c.material")
+    with pytest.raises(SimulationError, match=r"d.material:1: 'diffuse' needs numbers"):
+        materials_of_script(
+            "material M { technique { pass { diffuse a b c } } }", tmp_path / "d.material"
+        )
+
+
+def test_box_uv_mesh_puts_the_whole_image_on_each_face():
+    v, f, t = box_uv_mesh((2.0, 4.0, 6.0))
+    assert v.shape == (24, 3) and f.shape == (12, 3) and t.shape == (24, 2)
+    np.testing.assert_allclose(np.abs(v).max(axis=0), [1.0, 2.0, 3.0])
+    for face in range(6):
+        quad = v[4 * face : 4 * face + 4]
+        axis = np.flatnonzero(np.ptp(quad, axis=0) == 0)  # the face's constant coordinate
+        assert len(axis) == 1
+        normal = np.zeros(3)
+        normal[axis[0]] = np.sign(quad[0, axis[0]])
+        for tri in f[2 * face : 2 * face + 2]:  # counter-clockwise seen from outside
+            a, b, c = v[tri]
+            assert np.dot(np.cross(b - a, c - a), normal) > 0
+        uv = t[4 * face : 4 * face + 4]
+        assert sorted(map(tuple, uv)) == [(0, 0), (0, 1), (1, 0), (1, 1)]  # stretched, once
+    # the +x face reads upright from outside: image top (v=0) at +z, image left (u=0) at -y
+    px = v[20:24]
+    top = px[t[20:24, 1] == 0]
+    left = px[t[20:24, 0] == 0]
+    assert np.all(top[:, 2] > 0) and np.all(left[:, 1] < 0)
+
+
+QUADRANTS = """<sdf version="1.6"><model name="sign"><static>true</static><link name="link">
+  <visual name="v"><geometry><box><size>0.01 1.0 0.5</size></box></geometry>
+    <material><script><uri>file://{dir}</uri><name>Sign/Quadrants</name></script></material>
+  </visual></link></model></sdf>"""
+
+
+def quadrant_model(tmp_path, image="quad.png", write=True):
+    if write:
+        img = np.zeros((40, 40, 3), np.uint8)
+        img[:20, :20] = (255, 0, 0)  # top left red
+        img[:20, 20:] = (0, 255, 0)  # top right green
+        img[20:, :20] = (0, 0, 255)  # bottom left blue
+        img[20:, 20:] = 255  # bottom right white
+        Image.fromarray(img).save(tmp_path / image)
+    (tmp_path / "sign.material").write_text(
+        "material Sign/Quadrants\n{\n technique\n {\n  pass\n  {\n   texture_unit\n   {\n"
+        f"    texture {image}\n   }}\n  }}\n }}\n}}\n"
+    )
+    return QUADRANTS.format(dir=tmp_path)
+
+
+def render_from(engine, lookat, azimuth, distance, size=(160, 120)):
+    r = engine.renderer(*size)
+    cam = mujoco.MjvCamera()
+    cam.type = mujoco.mjtCamera.mjCAMERA_FREE
+    cam.lookat[:] = lookat
+    cam.distance, cam.azimuth, cam.elevation = distance, azimuth, 0.0
+    opt = mujoco.MjvOption()
+    opt.geomgroup[3] = 0  # collision shapes hidden, as the camera plugin renders
+    r.update_scene(engine.data, camera=cam, scene_option=opt)
+    return r.render().copy()
+
+
+def test_texture_is_stretched_over_the_face_as_gazebo_draws_it(tmp_path):
+    e = Engine(None)
+    e.spawn_sdf("sign", load_sdf_model(quadrant_model(tmp_path)), (0, 0, 1.0, 0, 0, 0))
+    img = render_from(e, (0, 0, 1.0), 180.0, 1.2)  # from +x, looking back along -x
+    assert_no_mujoco_warnings(e)
+    Image.fromarray(img).save(tmp_path / "sign.png")
+    h, w = img.shape[:2]
+    distance = 1.2 - 0.005  # to the sign's front face
+    px = h / (2 * distance * np.tan(np.radians(e.model.vis.global_.fovy) / 2))  # pixels per m
+    cy, cx = h // 2, w // 2
+    dy, dx = round(0.125 * px), round(0.25 * px)  # quadrant centres of the 1.0 x 0.5 m face
+    samples = {
+        "top left": img[cy - dy, cx - dx],
+        "top right": img[cy - dy, cx + dx],
+        "bottom left": img[cy + dy, cx - dx],
+        "bottom right": img[cy + dy, cx + dx],
+    }
+    dominant = {k: int(np.argmax(v)) if np.ptp(v) > 60 else "white" for k, v in samples.items()}
+    assert dominant == {"top left": 0, "top right": 1, "bottom left": 2, "bottom right": "white"}
+    # stretched once over the face, not repeated by size: along the top row, red gives way to
+    # green once, at the face's middle
+    row = img[cy - dy, cx - round(0.45 * px) : cx + round(0.45 * px)].astype(int)
+    green = row[:, 1] > row[:, 0]
+    switches = np.flatnonzero(np.diff(green.astype(int)))
+    assert len(switches) == 1 and abs(switches[0] - len(row) / 2) <= 2
+
+
+def test_missing_texture_image_names_the_file_the_material_and_the_model(tmp_path):
+    text = quadrant_model(tmp_path, "gone.png", write=False)
+    with pytest.raises(
+        SimulationError,
+        match=r"model 'sign' \(<string>\): texture image 'gone.png' of material "
+        r"'Sign/Quadrants' \(.*sign.material:1\) not found; looked in ",
+    ):
+        load_sdf_model(text)
+
+
+def test_urdf_texture_and_missing_image(tmp_path):
+    from fleetsim.description import parse_urdf
+
+    quadrant_model(tmp_path)
+    urdf = f"""<robot name="r"><link name="base"><visual><geometry><box size="0.1 0.2 0.3"/>
+      </geometry><material name="m"><texture filename="{tmp_path}/quad.png"/></material>
+      </visual></link></robot>"""
+    e = Engine(None)
+    e.spawn_robot("r", parse_urdf(urdf), (0, 0, 1, 0, 0, 0))
+    geom = next(i for i in range(e.model.ngeom) if e.model.geom(i).name.startswith("r/base"))
+    assert e.model.geom_type[geom] == mujoco.mjtGeom.mjGEOM_MESH
+    assert e.model.geom_matid[geom] >= 0 and e.model.ntex >= 1
+    e.advance(0.1)
+    assert_no_mujoco_warnings(e)
+    with pytest.raises(SimulationError, match=r"'r2/base/visual': texture image '.*nope.png' not"):
+        e.spawn_robot("r2", parse_urdf(urdf.replace("quad.png", "nope.png")))

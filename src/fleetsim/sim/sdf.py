@@ -393,7 +393,18 @@ def load_sdf_model(text: str, source: str = "<string>") -> ModelDesc:
         raise SimulationError(f"{source}:{exc.lineno}: SDF does not parse: {exc.msg}") from exc
     el = root if root.tag == "model" else root.find("model")
     if el is None:
-        raise SimulationError(f"{source}: no <model> element in the SDF")
+        # gazebo_ros spawns ``<sdf><world><include><uri>model://NAME</uri></include></world>``
+        # as well (grobot's spawn_marker_on_robot sends this)
+        inc = root.find(".//include")
+        if inc is None:
+            raise SimulationError(
+                f"{source}: no <model> element (nor an <include> of one) in the SDF"
+            )
+        model = _include(inc, source)
+        if not isinstance(model, ModelDesc):
+            raise SimulationError(f"{source}:{inc.sourceline}: the <include> is not a model")
+        model.relative_to = ""
+        return model
     base = Path(source).parent if source != "<string>" else Path.cwd()
     model = model_from_element(el, source, base)
     if model.relative_to not in ("", "world"):

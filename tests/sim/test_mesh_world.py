@@ -225,3 +225,39 @@ def exact_ranges_3d(origin, d):
     t = np.einsum("ij,ij->i", e2, q) * inv
     hit = ok & (u >= 0) & (w >= 0) & (u + w <= 1) & (t > 0)
     return t[hit].min()
+
+
+def test_lasers_see_a_convex_static_mesh_as_its_triangles(tmp_path):
+    """An octagonal pillar (convex): one collision part, and rays hit its faces, not the
+    square bounding box a mesh geom would otherwise be sliced into."""
+    from fleetsim.sim import raycast
+    from fleetsim.sim.sdf import load_sdf_model
+    from fleetsim.sim.world import WorldDesc, ground_plane
+
+    ang = np.arange(8) * np.pi / 4
+    ring = np.c_[np.cos(ang), np.sin(ang)]
+    v = np.r_[np.c_[ring, np.zeros(8)], np.c_[ring, np.full(8, 2.0)]]
+    f = [(k, (k + 1) % 8, 8 + (k + 1) % 8) for k in range(8)]
+    f += [(k, 8 + (k + 1) % 8, 8 + k) for k in range(8)]
+    f += [(0, k + 1, k) for k in range(1, 7)] + [(8, 8 + k, 8 + k + 1) for k in range(1, 7)]
+    obj = tmp_path / "pillar.obj"
+    obj.write_text(
+        "\n".join(
+            [f"v {a} {b} {c}" for a, b, c in v] + [f"f {a + 1} {b + 1} {c + 1}" for a, b, c in f]
+        )
+    )
+    model = load_sdf_model(
+        f"<sdf version='1.6'><model name='pillar'><static>true</static><link name='l'>"
+        f"<collision name='c'><geometry><mesh><uri>{obj}</uri></mesh></geometry></collision>"
+        "</link></model></sdf>",
+        str(tmp_path / "pillar.sdf"),
+    )
+    e = Engine(WorldDesc("w", [ground_plane(), model]))
+    names = [e.model.geom(i).name for i in range(e.model.ngeom)]
+    assert sum(":cvx" in n for n in names) == 1
+    # a ray at a face's middle: 4 - cos(pi/8) to the face (the bounding square: 4 - 1/cos)
+    a = np.pi / 8
+    origin = np.array([[4 * np.cos(a), 4 * np.sin(a), 1.0]])
+    got = raycast.cast(e.lasers.static_grid, origin, np.array([a + np.pi]), 0.0, 10.0, -1)
+    assert got[0] == pytest.approx(4 - np.cos(a), abs=1e-6)
+    no_mujoco_warnings(e)

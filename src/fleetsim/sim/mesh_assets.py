@@ -1,9 +1,9 @@
 """Mesh assets of a spec, and the collision of static non-convex meshes as convex parts.
 
 Mesh assets are added once per spec for each (file, version, scale) and shared by every model
-that uses them. A static collision mesh that is not its own convex hull (a building, Gazebo's
-``model://willowgarage``) is decomposed (``decompose.convex_decomposition``, cached on disk)
-and becomes, at the geom's pose:
+that uses them. A static collision mesh (a building, Gazebo's ``model://willowgarage``) is
+decomposed (``decompose.convex_decomposition``, cached on disk; a convex mesh is its own single
+part) and becomes, at the geom's pose:
 
 - one collision geom per convex part, named ``<prefix><name>#<index>:cvx<k>``, in
   ``HULL_GROUP`` (hidden in renders; lasers skip it);
@@ -125,8 +125,9 @@ def add_decomposed_mesh(
     spec, body, g: GeomDesc, prefix: str, index: int, kw: dict, shown: bool
 ) -> bool:
     """Add a static collision mesh as its convex parts plus a ray-only copy (see the module
-    docstring); False (nothing added) when the mesh is convex, so the caller adds it as one
-    mesh geom. ``kw`` holds the geom's ``pos`` and ``quat`` in ``body``."""
+    docstring); a convex mesh is one part, and lasers still see its triangles (not the
+    bounding box the slicer would make of a mesh geom). ``kw`` holds the geom's ``pos`` and
+    ``quat`` in ``body``. Returns True when the geom was handled."""
     mesh_file = mesh_file_of(g, prefix)
     if mesh_file is None:
         return True  # format not read: warned, nothing to add
@@ -143,8 +144,6 @@ def add_decomposed_mesh(
             "bigger than it is: give it box collisions, or split the mesh into simpler pieces",
             stacklevel=4,
         )
-    if result.convex:
-        return False
     base = mesh_asset_name(mesh_file, scale)
     name = f"{prefix}{g.name or 'geom'}#{index}"
     for k, part in enumerate(result.parts):

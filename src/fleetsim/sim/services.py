@@ -16,6 +16,7 @@ import numpy as np
 
 from fleetsim.errors import FleetsimError
 from fleetsim.msgs import gazebo_msgs, gazebo_ros_link_attacher, std_srvs
+from fleetsim.runtime import names as rnames
 from fleetsim.sim.build import quat_from_rpy, rpy_from_quat
 
 WORLD_FRAMES = ("", "world", "map", "/world", "/map")
@@ -85,7 +86,13 @@ class WorldServices:
     def spawn_sdf(self, req):
         def run():
             self._check_frame(req.reference_frame)
-            self.engine.spawn_sdf(req.model_name, req.model_xml, pose_tuple(req.initial_pose))
+            ns = rnames.validate_namespace(req.robot_namespace or "/")
+            entry = self.engine.spawn_sdf(
+                req.model_name, req.model_xml, pose_tuple(req.initial_pose)
+            )
+            # as gazebo_ros, the namespace the model's plugins would use (grobot spawns each
+            # marker in its robot's namespace); kept on the model for whoever looks it up
+            entry.namespace = ns
 
         return self._answer(gazebo_msgs.SpawnModel.Response(), run)
 

@@ -31,11 +31,13 @@ class LinkAttacher:
             raise SimulationError(f"cannot attach model '{m1}' to itself")
 
     def attach(self, engine, m1: str, l1: str, m2: str, l2: str) -> None:
-        """Queue a fixed joint between ``m1/l1`` and ``m2/l2`` (applied at the next step)."""
+        """Queue a fixed joint between ``m1/l1`` and ``m2/l2`` (applied at the next step); a
+        pair already attached stays as it is (the Gazebo plugin answers ok then too)."""
         self._check(engine, m1, l1, m2, l2)
-        if (m1, l1, m2, l2) in self.joints:
-            raise SimulationError(f"'{m1}/{l1}' and '{m2}/{l2}' are already attached")
-        self.pending.append(("attach", (m1, l1, m2, l2)))
+        key = (m1, l1, m2, l2)
+        if key in self.joints and ("detach", key) not in self.pending:
+            return  # already held: the Gazebo plugin re-attaches its cached joint and says ok
+        self.pending.append(("attach", key))
 
     def detach(self, engine, m1: str, l1: str, m2: str, l2: str) -> None:
         """Queue the release of an attachment made by ``attach``."""
@@ -50,7 +52,8 @@ class LinkAttacher:
         todo, self.pending = self.pending, []
         for op, key in todo:
             if op == "attach":
-                self._add(engine, key)
+                if key not in self.joints:
+                    self._add(engine, key)
             else:
                 eq = engine.spec.equality(_eq_name(*key))
                 if eq is not None:

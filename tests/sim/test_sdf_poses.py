@@ -158,3 +158,17 @@ def test_compose_and_inverse_are_rigid_transforms():
         rb = Rotation.from_euler("xyz", b[3:]).as_matrix()
         assert np.allclose(Rotation.from_euler("xyz", back[3:]).as_matrix(), rb, atol=1e-9)
     assert load_sdf_model(box_model("m", "<pose>1 2 3 0 0 0</pose>")).pose == (1, 2, 3, 0, 0, 0)
+
+
+def test_model_config_picks_the_highest_sdf_version(tmp_path, monkeypatch):
+    folder = tmp_path / "models" / "thing"
+    folder.mkdir(parents=True)
+    (folder / "model.config").write_text(
+        "<model><name>thing</name><sdf version='1.4'>model-1_4.sdf</sdf>"
+        "<sdf version='1.6'>model.sdf</sdf><sdf version='1.5'>model-1_5.sdf</sdf></model>"
+    )
+    for name, x in (("model-1_4.sdf", 4), ("model.sdf", 6), ("model-1_5.sdf", 5)):
+        (folder / name).write_text(box_model("thing", f"<pose>{x} 0 0 0 0 0</pose>"))
+    monkeypatch.setenv("GAZEBO_MODEL_PATH", str(tmp_path / "models"))
+    m = load_sdf_world(world(tmp_path, "<include><uri>model://thing</uri></include>")).models[0]
+    assert m.pose[0] == 6.0

@@ -97,16 +97,29 @@ def find_model(name: str, where: str) -> Path:
 
 
 def _model_sdf_file(folder: Path) -> Path:
+    """The model's SDF file: of the ``<sdf version=...>`` entries of ``model.config`` whose
+    file exists, the one of the highest version (as Gazebo picks it), else ``model.sdf``."""
     cfg = folder / "model.config"
     if cfg.exists():
         try:
             root = etree.parse(str(cfg)).getroot()
-            for el in root.iter("sdf"):
-                if el.text and (folder / el.text.strip()).exists():
-                    return folder / el.text.strip()
+            found = [
+                (_version(el.get("version", "")), i, folder / el.text.strip())
+                for i, el in enumerate(root.iter("sdf"))
+                if el.text and (folder / el.text.strip()).exists()
+            ]
+            if found:
+                return max(found)[2]
         except etree.XMLSyntaxError as exc:
             raise SimulationError(f"{cfg}:{exc.lineno}: model.config does not parse") from exc
     return folder / "model.sdf"
+
+
+def _version(text: str) -> tuple[int, ...]:
+    try:
+        return tuple(int(p) for p in text.strip().split("."))
+    except ValueError:
+        return ()
 
 
 def _parse_file(path: Path) -> etree._Element:

@@ -20,7 +20,12 @@ dropped) and split into connected components. Each component is then, in this or
    ``prism_drift``). Why not CoACD here: its concavity bound is relative to the bounding box
    (a threshold of 0.02 on Willow Garage's 47 m diagonal allows 0.9 m), its voxel preprocessing
    moves 10 cm walls, and it takes 10 s for one 952-triangle wing of Willow Garage (2-core
-   machine); the layered cut holds the walls to the millimetre in well under a second;
+   machine). Measured on the test building (440 triangles, tests/sim/fixtures): 7-8 s for
+   13-18 parts at threshold 0.05, 0.02 or 0.01 (preprocess resolution 50-100), and although
+   90% of rays from the rooms meet the parts within 3 mm of the walls, some meet a part up to
+   5.9 m early (a door or part of a room filled in). The layered cut is exact (Willow Garage:
+   1.5-2.6 s for all 13,348 triangles, rays within 15.5 mm, the error of its 5 mm-leaning
+   walls and of 1 cm slabs for single faces);
 3. **anything else**: CoACD (``coacd``, Wei et al. 2022) with ``DecompositionParams``.
 
 A component that cannot be decomposed well (more than ``max_hulls`` parts, or CoACD's parts

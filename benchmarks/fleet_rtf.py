@@ -75,6 +75,7 @@ def free_cells(yaml_path: Path = WILLOW) -> tuple[np.ndarray, float, tuple]:
 
     m = load_map(yaml_path)
     free = m.data == 0
+    free[[0, -1], :] = free[:, [0, -1]] = False  # the map's edge bounds the free space too
     dist = ndimage.distance_transform_edt(free) * m.resolution
     ok = dist > CLEARANCE
     labels, _ = ndimage.label(ok)

@@ -26,7 +26,7 @@ from fleetsim.sim.plugins.base import (
     OdometryReading,
     ScanReading,
 )
-from fleetsim.sim.plugins.camera import CameraPlugin
+from fleetsim.sim.plugins.camera import CameraPlugin, compressed_image_msg
 from fleetsim.sim.services import WorldServices
 from fleetsim.sim.world import WALL_HEIGHT
 
@@ -130,14 +130,18 @@ class Simulator(Node):
             elif isinstance(p, CameraPlugin):
                 # as gazebo_ros_camera: render only while someone subscribes to the images
                 pp = p.params
-                names = [pp.imageTopicName, pp.cameraInfoTopicName]
+                names = [pp.imageTopicName, f"{pp.imageTopicName}/compressed"]
+                names.append(pp.cameraInfoTopicName)
+                depth = []
                 if p.depth_enabled:
-                    names += [
+                    depth = [
                         pp.depthImageTopicName,
                         pp.depthImageCameraInfoTopicName,
                         pp.pointCloudTopicName,
                     ]
-                topics = [self.topic(entry, p.topic(n)) for n in names]
+                    depth = [self.topic(entry, p.topic(n)) for n in depth]
+                    p.depth_wanted = lambda topics=depth: self._has_subscribers(topics)
+                topics = [self.topic(entry, p.topic(n)) for n in names] + depth
                 p.wanted = lambda topics=topics: self._has_subscribers(topics)
         self._subs[entry.name] = subs
 
@@ -218,6 +222,11 @@ class Simulator(Node):
     def _publish_image(self, r: ImageReading, ns: str) -> None:
         img = conv.image_msg(r.stamp, r.frame_id, r.image, r.encoding)
         self._publisher(rnames.resolve(r.topic, ns), sensor_msgs.Image).publish(img)
+        jpeg = self._publisher(
+            rnames.resolve(f"{r.topic}/compressed", ns), sensor_msgs.CompressedImage
+        )
+        if jpeg.topic.subscriptions:  # encoded only for subscribers, as image_transport does
+            jpeg.publish(compressed_image_msg(img.header.stamp, r.frame_id, r.image))
         info = conv.camera_info_msg(r)
         self._publisher(rnames.resolve(r.info_topic, ns), sensor_msgs.CameraInfo).publish(info)
         if r.depth is not None:

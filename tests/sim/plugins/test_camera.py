@@ -1,5 +1,7 @@
 """Camera and depth camera rendered with MuJoCo's EGL backend."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -110,3 +112,87 @@ def test_texture_reads_correctly_on_the_plus_x_face(tmp_path):
     assert right > left + 150
     top_left = img[7:10, 25:31].mean(axis=(0, 1))
     assert top_left[0] > 150 and top_left[1] < 80
+
+
+WAFFLE = (
+    Path(__file__).resolve().parents[3]
+    / "src/fleetsim/assets/robots/turtlebot3_waffle/urdf/turtlebot3_waffle.urdf.xacro"
+)
+MARKER_XML = (
+    '<sdf version="1.6"><world name="default"><include><uri>model://aruco_marker</uri>'
+    "</include></world></sdf>"
+)
+
+
+def waffle_facing_a_marker(args=None):
+    """A waffle in the root namespace (as the tutorial's follower) 1.5 m behind a marker that
+    faces it; returns the runtime, the simulator node and the waffle's camera plugin."""
+    from fleetsim.description import load_robot
+    from fleetsim.runtime import Runtime
+    from fleetsim.sim.node import Simulator
+    from fleetsim.sim.plugins.camera import DepthCameraPlugin
+    from fleetsim.sim.sdf import load_sdf_model
+
+    rt = Runtime(seed=1)
+    sim = Simulator(rt, "gazebo")
+    entry = sim.spawn_robot("turtlebot3_waffle", load_robot(WAFFLE, args), namespace="/")
+    marker = load_sdf_model(MARKER_XML)
+    marker.static = True  # held in the air, facing the camera
+    sim.engine.spawn_sdf("m", marker, (1.5, -0.05, 0.12, 0, 0, np.pi))
+    cam = next(p for p in entry.plugins if isinstance(p, DepthCameraPlugin))
+    return rt, sim, cam
+
+
+def test_waffle_camera_topics_as_the_tutorial_reads_them(monkeypatch, tmp_path):
+    import cv2
+
+    from fleetsim.msgs import sensor_msgs
+    from fleetsim.sim import node as sim_node
+    from fleetsim.sim.plugins import camera as camera_module
+
+    monkeypatch.chdir(tmp_path)
+    rt, sim, cam = waffle_facing_a_marker()
+    assert (cam.width, cam.height, cam.rate) == (640, 360, 10.0)  # the xacro's defaults
+    depth_renders, encodes = [], []
+    original_render = cam.render
+    cam.render = lambda e, depth=False: depth_renders.append(depth) or original_render(e, depth)
+    original_encode = camera_module.compressed_image_msg
+    monkeypatch.setattr(
+        sim_node,
+        "compressed_image_msg",
+        lambda *a, **k: encodes.append(1) or original_encode(*a, **k),
+    )
+    raw, infos, jpegs = [], [], []
+    rt.graph.subscribe("/camera/rgb/image_raw", sensor_msgs.Image, raw.append)
+    rt.graph.subscribe("/camera/rgb/camera_info", sensor_msgs.CameraInfo, infos.append)
+    rt.run(duration=0.25)
+    assert len(raw) == 3 and encodes == []  # 10 Hz; no JPEG without a compressed subscriber
+    assert not any(depth_renders)  # nor a depth image without a depth subscriber
+    rt.graph.subscribe(
+        "/camera/rgb/image_raw/compressed", sensor_msgs.CompressedImage, jpegs.append
+    )
+    rt.run(duration=0.2)
+    assert len(jpegs) == 2 and len(encodes) == 2
+    msg = jpegs[-1]
+    assert msg.format == "rgb8; jpeg compressed bgr8"
+    assert msg.header.frame_id == "camera_rgb_optical_frame"
+    assert msg.header.stamp == raw[-1].header.stamp == infos[-1].header.stamp
+    bgr = cv2.imdecode(np.asarray(msg.data, np.uint8), cv2.IMREAD_COLOR)
+    rgb = np.asarray(raw[-1].data).reshape(360, 640, 3)
+    assert bgr.shape == (360, 640, 3)
+    assert np.abs(bgr[..., ::-1].astype(int) - rgb).mean() < 4  # JPEG of the same image
+    cv2.imwrite(str(tmp_path / "waffle_view.png"), bgr)
+    detector = cv2.aruco.ArucoDetector(cv2.aruco.getPredefinedDictionary(cv2.aruco.DICT_4X4_50))
+    _, ids, _ = detector.detectMarkers(bgr)
+    assert ids is not None and ids.ravel().tolist() == [0]  # the marker, read through JPEG
+    k = np.asarray(infos[-1].k).reshape(3, 3)
+    assert k[0, 0] == pytest.approx(320 / np.tan(1.3439 / 2))
+    assert {i: w.number for i, w in enumerate(sim.engine.data.warning) if w.number} == {}
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+
+
+def test_waffle_camera_resolution_and_rate_are_xacro_args():
+    _, _, cam = waffle_facing_a_marker(
+        {"camera_width": "1920", "camera_height": "1080", "camera_rate": "30"}
+    )
+    assert (cam.width, cam.height, cam.rate) == (1920, 1080, 30.0)  # the real camera

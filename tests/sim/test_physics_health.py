@@ -144,3 +144,23 @@ def test_launch_that_blows_up_exits_nonzero_with_a_readable_recording(tmp_path, 
     assert reader.complete  # finalised: footer and closing magic written
     assert "/clock" in {t.name for t in reader.info().topics}
     assert sum(1 for _ in reader.messages(["/clock"])) > 0
+
+
+def test_steps_newton_does_not_finish_are_redone_with_cg(skidbot):
+    """With the guard's cap at 0 every Newton step counts as unfinished: each is redone with CG
+    from the state before it, and the run equals one stepped with CG throughout, bit for bit."""
+
+    def run(solver):
+        e = Engine(None)
+        entry = e.spawn_robot("bot", skidbot)
+        e.model.opt.solver = solver
+        e.solver_guard.cap = 0
+        for _ in range(10):
+            drive_of(entry).command(0.4, 0.5, e.time)
+            e.advance(0.02)
+        return e
+
+    newton, cg = run(mujoco.mjtSolver.mjSOL_NEWTON), run(mujoco.mjtSolver.mjSOL_CG)
+    assert newton.solver_guard.redone == 50 and cg.solver_guard.redone == 0
+    assert newton.data.qpos.tobytes() == cg.data.qpos.tobytes()
+    assert newton.data.qvel.tobytes() == cg.data.qvel.tobytes()

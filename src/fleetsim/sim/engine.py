@@ -18,7 +18,7 @@ from fleetsim.errors import SimulationError
 from fleetsim.sim import sdf
 from fleetsim.sim.build import add_sdf_model, spec_from_world
 from fleetsim.sim.drives import DriveBatch
-from fleetsim.sim.health import WarningWatch, physics_error, route_mujoco_warnings
+from fleetsim.sim.health import SolverGuard, WarningWatch, physics_error, route_mujoco_warnings
 from fleetsim.sim.lasers import LaserBatch
 from fleetsim.sim.plugins import base
 from fleetsim.sim.plugins.diff_drive import WheeledDrive
@@ -116,6 +116,7 @@ class Engine(StateQueries):
             raise SimulationError(f"MuJoCo cannot compile the world: {exc}") from exc
         self.drives.sync_back()
         self._warnings = WarningWatch(self.data)
+        self.solver_guard = SolverGuard(self.model, self.data)
         mujoco.mj_forward(self.model, self.data)
         self.layouts.clear()
         self._index()
@@ -287,6 +288,7 @@ class Engine(StateQueries):
     def step(self) -> None:
         """One physics step: plugin controls, link attacher, ``mj_step``.
 
+        A step on which the Newton solver stalled is redone with CG (``health.SolverGuard``).
         Raises `PhysicsInstability` (or `PhysicsBufferFull`) when MuJoCo flags the step
         (``sim.health``); the world is not reset and stays as the failed step left it.
         """
@@ -296,7 +298,9 @@ class Engine(StateQueries):
             p.control(self, t)
         if self.attacher.pending:
             self.attacher.control(self, t)
+        self.solver_guard.save(self.model, self.data)
         mujoco.mj_step(self.model, self.data)
+        self.solver_guard.check(self.model, self.data)
         if self._warnings.tripped():
             raise physics_error(self, t)
 

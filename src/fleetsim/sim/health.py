@@ -9,7 +9,9 @@ run carries on with robots teleported home. fleetsim instead
 - routes MuJoCo's warning text to the ``fleetsim.mujoco`` logger (`route_mujoco_warnings`), so
   no ``MUJOCO_LOG.TXT`` is written,
 - has the engine look at the counters after every physics step (`WarningWatch`, a fraction of a
-  microsecond against ~150 us for a 10-robot step) and raise `physics_error` when one trips.
+  microsecond against ~150 us for a 10-robot step) and raise `physics_error` when one trips,
+- redoes with CG the rare steps on which the Newton solver stalled (`SolverGuard`): an
+  unconverged contact solve is how robots pushing wheel against wheel got flung into NaN.
 
 Every counter is an error. An unstable state (`PhysicsInstability`) names the robot, body and
 joint of the bad degree of freedom, the sim time, the likely cause and what to try. Running out
@@ -63,6 +65,47 @@ class WarningWatch:
     def tripped(self) -> bool:
         # comparing raw bytes costs ~0.2 us, ndarray.any() ~1 us; this runs after every step
         return self.number.tobytes() != self._clear
+
+
+class SolverGuard:
+    """Steps on which MuJoCo's Newton solver stalled, redone with the CG solver.
+
+    Newton with elliptic friction cones can stall on the contacts between two robots' spinning
+    drive wheels (each with its held rotor, ``drives.rotor_armature``): in the willow10_amcl
+    repro it ran to its iteration cap with a gradient of 69, and the unconverged contact forces
+    put 200 N m of roll on a 7.6 kg lizi in one step; the robot spun up to NaN within 50 ms
+    (twice: at 5.3 s and, with multi-point CCD off, at 42 s). CG needs no Hessian and converges
+    on the same contacts (47 iterations, the robots stay on the ground) but costs ~10 % on every
+    step, so it only redoes the steps Newton did not finish: the physics state before each step
+    is kept (~2 us, 1 % of a 10-robot step) and restored for the redo. Normal steps are
+    untouched, bit for bit.
+    """
+
+    SPEC = mujoco.mjtState.mjSTATE_FULLPHYSICS | mujoco.mjtState.mjSTATE_WARMSTART
+
+    def __init__(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
+        self.state = np.empty(mujoco.mj_stateSize(model, self.SPEC))
+        self.niter = data.solver_niter  # per island; zeroed by every step
+        self.cap = int(model.opt.iterations)
+        self.redone = 0  # steps redone with CG
+
+    def save(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
+        mujoco.mj_getState(m, d, self.state, self.SPEC)
+
+    def check(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
+        """Redo the step just taken with CG if Newton ran to its iteration cap."""
+        if self.niter.max() < self.cap or m.opt.solver != mujoco.mjtSolver.mjSOL_NEWTON:
+            return
+        t = float(d.time)
+        mujoco.mj_setState(m, d, self.state, self.SPEC)
+        d.warning.number[:] = 0  # any warning came from the discarded step
+        m.opt.solver = mujoco.mjtSolver.mjSOL_CG
+        try:
+            mujoco.mj_step(m, d)
+        finally:
+            m.opt.solver = mujoco.mjtSolver.mjSOL_NEWTON
+        self.redone += 1
+        _log.debug("t = %.3f s: Newton did not converge; step redone with CG", t)
 
 
 def physics_error(engine, t: float) -> SimulationError:

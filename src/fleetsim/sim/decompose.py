@@ -52,7 +52,7 @@ from scipy.spatial import ConvexHull, QhullError
 
 from fleetsim.sim import prisms
 
-ALGORITHM_VERSION = "3"  # part of the cache key: bump when the decomposition changes
+ALGORITHM_VERSION = "4"  # part of the cache key: bump when the decomposition changes
 _WELD = 1e-6  # m, vertices closer than this are one
 
 
@@ -155,7 +155,19 @@ def decompose(
         if problem:
             out.problems.append(f"{where}: {problem}")
     out.convex = out.methods == ["convex"]
+    out.parts = [p for p in out.parts if is_solid(p)]
     return out
+
+
+def is_solid(part: np.ndarray, thickness: float = 1e-5) -> bool:
+    """Whether a part's hull has volume: its mean thickness (volume over half its area) is at
+    least ``thickness`` m. Slivers (from vertices of neighbouring pieces a fraction of a micron
+    apart) are dropped: they hold nothing and MuJoCo cannot build their hull."""
+    try:
+        hull = ConvexHull(part)
+    except (QhullError, ValueError):
+        return False
+    return bool(hull.volume >= thickness * 0.5 * hull.area)
 
 
 def weld(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -182,25 +182,34 @@ def add_decomposed_mesh(
     return True
 
 
-def box_of(part: np.ndarray, tol: float = 1e-6):
+def box_of(part: np.ndarray, tol: float = 1e-4):
     """An upright rectangular prism's box: centre (3,), half sizes (3,) and yaw (rad) in the
-    part's frame; None for any other part. ``part`` is (8, 3): a 4-vertex ring at two heights,
-    as ``prisms`` writes it."""
+    part's frame; None for any other part. ``part`` is (8, 3) in any order: 4 corners at one
+    height and the same 4 at another."""
     if part.shape != (8, 3):
         return None
-    ring, z = part[:4, :2], part[:, 2]
-    if not (np.allclose(part[4:, :2], ring, atol=tol) and np.ptp(z[:4]) <= tol):
+    part = part[np.argsort(part[:, 2], kind="stable")]
+    bottom, top = part[:4], part[4:]
+    if np.ptp(bottom[:, 2]) > tol or np.ptp(top[:, 2]) > tol:
         return None
-    e = np.roll(ring, -1, axis=0) - ring
+
+    def ring(p):
+        c = p[:, :2].mean(axis=0)
+        return p[np.argsort(np.arctan2(p[:, 1] - c[1], p[:, 0] - c[0])), :2]
+
+    rb, rt = ring(bottom), ring(top)
+    if not np.allclose(rb, rt, atol=tol):
+        return None
+    e = np.roll(rb, -1, axis=0) - rb
     length = np.linalg.norm(e, axis=1)
-    if length.min() <= tol or np.any(
-        np.abs(np.einsum("ij,ij->i", e, np.roll(e, -1, 0))) > tol * length.max() ** 2
-    ):
+    dots = np.abs(np.einsum("ij,ij->i", e, np.roll(e, -1, 0)))
+    if length.min() <= tol or np.any(dots > tol * length.max() ** 2):
         return None
-    centre = np.array([*ring.mean(axis=0), 0.5 * (z[0] + z[4])])
-    half = np.array([length[0] / 2, length[1] / 2, abs(z[4] - z[0]) / 2])
+    z0, z1 = bottom[0, 2], top[0, 2]
+    half = np.array([length[0] / 2, length[1] / 2, (z1 - z0) / 2])
     if half[2] <= tol:
         return None
+    centre = np.array([*rb.mean(axis=0), 0.5 * (z0 + z1)])
     return centre, half, float(np.arctan2(e[0, 1], e[0, 0]))
 
 

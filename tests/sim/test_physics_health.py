@@ -91,8 +91,12 @@ def test_nan_force_names_robot_body_and_joint(diffbot):
         r"bot/base_footprint",
     ):
         e.advance(0.05)
-    # no auto-reset: the world stays as the failed step left it
+    # no auto-reset: the world stays as the failed step left it, until it is reset on purpose
     assert not np.isfinite(e.data.qpos).all()
+    e.data.xfrc_applied[:] = 0.0
+    e.reset_world()
+    e.advance(0.2)
+    assert np.isfinite(e.data.qpos).all() and not e.data.warning.number.any()
 
 
 def test_nan_control_is_an_instability(diffbot):

@@ -195,6 +195,11 @@ class StateQueries:
         for p in self.plugins():
             p.reset()
         self.drives.reload()
+        # a world put back after a blow-up (sim.health) steps again: MuJoCo's warning counters
+        # cleared as mj_resetData clears them, and no NaN left to warm-start the solver with
+        self.data.warning.number[:] = 0
+        if not np.isfinite(self.data.qacc_warmstart).all():
+            self.data.qacc_warmstart[:] = 0.0
         mujoco.mj_forward(self.model, self.data)
 
     def _reset_joints(self) -> None:

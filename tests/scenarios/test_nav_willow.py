@@ -9,7 +9,7 @@ count, never the robots' own estimates.
 Starts: the lesson's (20, 15), (22, 15), (24, 15), each moved to the nearest cell where lizi's
 footprint fits (`nearest_free_start`; (20, 15) is 0.2 m from a wall and moves). Goals are
 >= 15 m away in a straight line and behind openings no wider than a door (`bottleneck_width`),
-one to the north-west, one to the north and one to the east so that the robots do not queue at one
+one to the west, one to the north and one to the east, on routes >= 2 m apart, so that they do not meet at one
 door.
 """
 
@@ -31,6 +31,7 @@ from nav_harness import (
     clearances_from_map,
     lesson_starts,
     nearest_free_start,
+    planned_routes,
     willow_session,
 )
 
@@ -98,6 +99,21 @@ def test_lesson_starts_fit_lizi_and_the_goals_are_far_behind_doors(willow):
         assert clear[int(y / 0.1), int(x / 0.1)] >= radius
         assert math.dist((x, y), goal[:2]) >= 15.0
         assert bottleneck_width(willow, (x, y), goal[:2]) <= 1.2 + 1e-9  # door-wide
+
+
+def test_the_goals_routes_keep_apart(willow):
+    # the lizis cannot see each other (lasers 1 m up): routes must not share a door
+    starts = lesson_starts(willow)
+    routes = planned_routes(willow, starts, GOALS)
+    away = {  # leave out the first 1.2 m, where the starts themselves are 2 m apart
+        r: p[np.hypot(*(p - np.array(s[:2])).T) > 1.2]
+        for (r, p), s in zip(routes.items(), starts, strict=True)
+    }
+    names = list(away)
+    for i, a in enumerate(names):
+        for b in names[i + 1 :]:
+            gap = np.hypot(*(away[a][:, None] - away[b][None]).transpose(2, 0, 1)).min()
+            assert gap >= 2.0, (a, b, gap)
 
 
 # -- the scenarios ----------------------------------------------------------------------------

@@ -126,6 +126,21 @@ def test_full_contact_memory_is_an_error(diffbot, kind):
         e.advance(0.01)
 
 
+def test_flung_robot_is_named_as_a_runaway(diffbot):
+    """A robot spinning far too fast to integrate (as the repro's r9 was, flung 3 m up) ends in
+    NaN in the air; the cause names the motion it already had, not the last step."""
+    e = Engine(None)
+    e.spawn_robot("bot", diffbot, (0, 0, 10, 0, 0, 0))
+    e.data.qvel[3:6] = (300.0, 200.0, 100.0)
+    with pytest.raises(
+        PhysicsInstability,
+        match=r"robot 'bot', body 'base_footprint', joint 'free'.*likely cause: runaway "
+        r"motion: it was already moving at .* (m|rad)/s on joint 'free' \(floating base, "
+        r".* before this step, touching nothing",
+    ):
+        e.advance(1.0)
+
+
 def test_broken_model_names_the_light_link():
     e = Engine(None)
     e.spawn_robot("bad", load_robot(FIXTURES / "broken_flapper.urdf"))

@@ -37,6 +37,8 @@ LIGHT_LINK_SHARE = 1e-3
 HUGE_ACCELERATION = 1e4
 #: contact overlap (m) that counts as a penetration deep enough to blow up the solver
 DEEP_PENETRATION = 0.01
+#: motion per physics step (rad or m) beyond which a body moves too fast to integrate
+RUNAWAY_STEP = 0.5
 _FREE_AXES = ("x", "y", "z", "rotation about x", "rotation about y", "rotation about z")
 _QUANTITY = {
     W.mjWARN_BADQACC: "acceleration (qacc)",
@@ -183,15 +185,21 @@ def _model_of_body(engine, body: int) -> tuple[int, str]:
 
 
 def _owner(engine, dof: int) -> str:
-    """``robot 'r8', body 'base_link', joint 'free' (floating base, rotation about x)``."""
+    """``robot 'r8', body 'base_link', joint 'free' (floating base, rotation about x), DOF 83``."""
     m = engine.model
-    body, jnt = int(m.dof_bodyid[dof]), int(m.dof_jntid[dof])
+    body = int(m.dof_bodyid[dof])
     _, model = _model_of_body(engine, body)
+    parts = [model] if model else []
+    return ", ".join([*parts, f"body '{_local(m.body(body).name)}'", _joint_label(m, dof)])
+
+
+def _joint_label(m: mujoco.MjModel, dof: int) -> str:
+    """``joint 'free' (floating base, rotation about x), DOF 83``."""
+    jnt = int(m.dof_jntid[dof])
     joint = f"joint '{_local(m.joint(jnt).name)}'"
     if m.jnt_type[jnt] == mujoco.mjtJoint.mjJNT_FREE:
         joint += f" (floating base, {_FREE_AXES[dof - m.jnt_dofadr[jnt]]})"
-    parts = [model] if model else []
-    return ", ".join([*parts, f"body '{_local(m.body(body).name)}'", joint, f"DOF {dof}"])
+    return f"{joint}, DOF {dof}"
 
 
 def _qpos_dof(m: mujoco.MjModel, qadr: int) -> int:
@@ -212,7 +220,8 @@ def likely_cause(engine, dof: int) -> tuple[str, str]:
     The step's forward pass (controls, applied forces, contacts, actuator forces) stays valid
     after MuJoCo flags the acceleration; only the integrated positions and velocities are lost.
     The checks run from the most to the least certain: a non-finite control or applied force,
-    a near-massless link under actuator force, a huge actuator force, a deep contact.
+    a near-massless link under actuator force, a huge actuator force, a body already moving
+    too fast before the step, a deep contact.
     """
     m, d = engine.model, engine.data
     model_i, _ = _model_of_body(engine, int(m.dof_bodyid[dof]))
@@ -255,12 +264,40 @@ def likely_cause(engine, dof: int) -> tuple[str, str]:
             f"huge actuator torque: {detail}",
             "lower the joint's effort/torque limit or the controller gains",
         )
+    runaway = _runaway(engine, dofs, model_i)  # before contacts: it makes them deep
+    if runaway is not None:
+        return runaway
     pen = _deepest_contact(engine, model_i)
     if pen is not None:
         return pen
     return (
         "stiff constraint forces (contacts or joint limits) the solver could not resolve",
         "a smaller physics step, or check collision shapes and joint limits of this model",
+    )
+
+
+def _runaway(engine, dofs: np.ndarray, model_i: int) -> tuple[str, str] | None:
+    """A model already moving too fast to integrate before the step (its velocities from the
+    state `SolverGuard` kept): it was flung earlier and the blow-up is only the end of it."""
+    m = engine.model
+    qvel = engine.solver_guard.state[1 + m.nq : 1 + m.nq + m.nv][dofs]
+    per_step = np.abs(np.nan_to_num(qvel, nan=np.inf)) * m.opt.timestep
+    k = int(np.argmax(per_step))
+    if per_step[k] <= RUNAWAY_STEP:
+        return None
+    dof = int(dofs[k])
+    slide = m.jnt_type[m.dof_jntid[dof]] == mujoco.mjtJoint.mjJNT_SLIDE or (
+        m.jnt_type[m.dof_jntid[dof]] == mujoco.mjtJoint.mjJNT_FREE
+        and dof - m.jnt_dofadr[m.dof_jntid[dof]] < 3
+    )
+    unit = "m" if slide else "rad"
+    touching = (engine.geom_model[engine.data.contact.geom[: engine.data.ncon]] == model_i).any()
+    return (
+        f"runaway motion: it was already moving at {abs(qvel[k]):.3g} {unit}/s on "
+        f"{_joint_label(m, dof)} ({per_step[k]:.2g} {unit} per physics step) before this step"
+        f"{'' if touching else ', touching nothing'}; something flung it earlier",
+        "find when it was flung (its ground-truth pose or odometry over the last seconds), "
+        "e.g. a collision or a force; a smaller physics step",
     )
 
 

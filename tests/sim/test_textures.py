@@ -174,3 +174,62 @@ def test_urdf_texture_and_missing_image(tmp_path):
     assert_no_mujoco_warnings(e)
     with pytest.raises(SimulationError, match=r"'r2/base/visual': texture image '.*nope.png' not"):
         e.spawn_robot("r2", parse_urdf(urdf.replace("quad.png", "nope.png")))
+
+
+SIGN_DAE = """<?xml version="1.0"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+<asset><unit meter="1"/><up_axis>Z_UP</up_axis></asset>
+<library_images><image id="img"><init_from>quad.png</init_from></image></library_images>
+<library_effects><effect id="fx"><profile_COMMON>
+ <newparam sid="surf"><surface type="2D"><init_from>img</init_from></surface></newparam>
+ <newparam sid="samp"><sampler2D><source>surf</source></sampler2D></newparam>
+ <technique sid="c"><lambert><diffuse><texture texture="samp" texcoord="UVMap"/></diffuse>
+ </lambert></technique></profile_COMMON></effect></library_effects>
+<library_materials><material id="mat" name="sign"><instance_effect url="#fx"/></material>
+</library_materials>
+<library_geometries><geometry id="quad"><mesh>
+ <source id="pos"><float_array id="pos-a" count="12">0 -0.5 -0.25 0 0.5 -0.25 0 0.5 0.25
+   0 -0.5 0.25</float_array><technique_common><accessor source="#pos-a" count="4" stride="3">
+   <param name="X" type="float"/><param name="Y" type="float"/><param name="Z" type="float"/>
+   </accessor></technique_common></source>
+ <source id="uv"><float_array id="uv-a" count="8">0 0 1 0 1 1 0 1</float_array>
+   <technique_common><accessor source="#uv-a" count="4" stride="2"><param name="S" type="float"/>
+   <param name="T" type="float"/></accessor></technique_common></source>
+ <vertices id="vtx"><input semantic="POSITION" source="#pos"/></vertices>
+ <triangles count="2" material="m"><input semantic="VERTEX" source="#vtx" offset="0"/>
+   <input semantic="TEXCOORD" source="#uv" offset="1" set="0"/><p>0 0 1 1 2 2 0 0 2 2 3 3</p>
+ </triangles></mesh></geometry></library_geometries>
+<library_visual_scenes><visual_scene id="s"><node id="n"><instance_geometry url="#quad">
+ <bind_material><technique_common><instance_material symbol="m" target="#mat"/>
+ </technique_common></bind_material></instance_geometry></node></visual_scene>
+</library_visual_scenes><scene><instance_visual_scene url="#s"/></scene>
+</COLLADA>
+"""
+
+
+def test_collada_texture_is_drawn_by_the_files_uv_coordinates(tmp_path):
+    from fleetsim.sim.meshes import collada_parts
+
+    quadrant_model(tmp_path)  # writes quad.png
+    (tmp_path / "sign.dae").write_text(SIGN_DAE)
+    (part,) = collada_parts(tmp_path / "sign.dae")
+    assert part.image == str(tmp_path / "quad.png") and part.rgba == (1.0, 1.0, 1.0, 1.0)
+    # COLLADA's v grows upwards; stored with v = 0 at the image's top
+    np.testing.assert_allclose(part.texcoords, [[0, 1], [1, 1], [1, 0], [0, 0]])
+    assert part.texcoord_faces.tolist() == [[0, 1, 2], [0, 2, 3]]
+    sdf = f"""<sdf version="1.6"><model name="sign"><static>true</static><link name="link">
+      <visual name="v"><geometry><mesh><uri>{tmp_path}/sign.dae</uri></mesh></geometry></visual>
+      </link></model></sdf>"""
+    e = Engine(None)
+    e.spawn_sdf("sign", load_sdf_model(sdf), (0, 0, 1.0, 0, 0, 0))
+    img = render_from(e, (0, 0, 1.0), 180.0, 1.2)  # from +x
+    Image.fromarray(img).save(tmp_path / "dae_sign.png")
+    assert_no_mujoco_warnings(e)
+    h, w = img.shape[:2]
+    px = h / (2 * 1.2 * np.tan(np.radians(e.model.vis.global_.fovy) / 2))
+    cy, cx = h // 2, w // 2
+    dy, dx = round(0.125 * px), round(0.25 * px)
+    top_left, top_right = img[cy - dy, cx - dx], img[cy - dy, cx + dx]
+    bottom_left, bottom_right = img[cy + dy, cx - dx], img[cy + dy, cx + dx]
+    assert np.argmax(top_left) == 0 and np.argmax(top_right) == 1  # red, green
+    assert np.argmax(bottom_left) == 2 and np.ptp(bottom_right) < 60  # blue, white

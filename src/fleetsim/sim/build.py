@@ -155,7 +155,7 @@ def add_geom(
         if _coloured_by_file(g):
             parts = add_part_mesh_assets(spec, g, prefix)
             if parts:
-                for k, (mesh_name, rgba) in enumerate(parts):
+                for k, (mesh_name, rgba, image) in enumerate(parts):
                     geom = body.add_geom(
                         name=f"{prefix}{g.name or 'geom'}#{index}:{k}",
                         type=G.mjGEOM_MESH,
@@ -164,6 +164,8 @@ def add_geom(
                     )
                     _make_visual(geom)
                     geom.rgba = list(rgba)
+                    if image is not None:  # the COLLADA texture, by the file's UVs
+                        geom.material = textures.add_texture_material(spec, image, geom.name)
                 return
         mesh_name = add_mesh_asset(spec, g, prefix)
         if mesh_name is None:

@@ -64,8 +64,14 @@ def mesh_asset_name(mesh_file: Path, scale: list[float]) -> str:
     return f"mesh:{mesh_file.name}:{hashlib.sha1(key.encode()).hexdigest()[:12]}"
 
 
-def add_user_mesh(spec, name: str, vertices: np.ndarray, faces: np.ndarray, scale) -> None:
+def add_user_mesh(
+    spec, name: str, vertices: np.ndarray, faces: np.ndarray, scale, texcoords=None
+) -> None:
+    """A mesh asset from arrays; ``texcoords`` is ``((T, 2) uv, (F, 3) indices)`` or None."""
     mesh = spec.add_mesh(name=name, uservert=vertices.ravel(), userface=faces.ravel(), scale=scale)
+    if texcoords is not None:  # drawn with a texture: (u, v) per triangle corner
+        mesh.usertexcoord = np.ascontiguousarray(texcoords[0]).ravel()
+        mesh.userfacetexcoord = np.ascontiguousarray(texcoords[1]).ravel()
     # shell inertia: COLLADA visuals are often open surfaces (a floor, a sign) with no volume;
     # bodies carry explicit inertia, so the mesh's own inertia only places its frame
     mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL
@@ -95,11 +101,12 @@ def add_mesh_asset(spec, g: GeomDesc, prefix: str) -> str | None:
     return mesh_name
 
 
-def add_part_mesh_assets(spec, g: GeomDesc, prefix: str) -> list[tuple[str, tuple]] | None:
-    """Mesh assets ``(name, rgba)`` of the material parts of a ``.dae`` geom, added once per
-    spec for each (file, version, scale, part); None when the file has no materials (it is
-    then one plain mesh). Parts without surface (degenerate triangles) are left out; a
-    one-triangle part gets its centroid as an unused fourth vertex, MuJoCo's minimum."""
+def add_part_mesh_assets(spec, g: GeomDesc, prefix: str) -> list[tuple[str, tuple, str]] | None:
+    """Mesh assets ``(name, rgba, image)`` of the material parts of a ``.dae`` geom, added once
+    per spec for each (file, version, scale, part); ``image`` is the texture file drawn by the
+    part's texture coordinates, or None. None when the file has no materials (it is then one
+    plain mesh). Parts without surface (degenerate triangles) are left out; a one-triangle part
+    gets its centroid as an unused fourth vertex, MuJoCo's minimum."""
     mesh_file = mesh_file_of(g, prefix)
     parts = collada_parts(mesh_file)
     if all(not p.name for p in parts):
@@ -116,8 +123,9 @@ def add_part_mesh_assets(spec, g: GeomDesc, prefix: str) -> list[tuple[str, tupl
                 continue
             if len(v) < 4:
                 v = np.vstack([v, v.mean(axis=0)])
-            add_user_mesh(spec, name, v, part.faces, scale)
-        assets.append((name, part.rgba))
+            uv = None if part.image is None else (part.texcoords, part.texcoord_faces)
+            add_user_mesh(spec, name, v, part.faces, scale, uv)
+        assets.append((name, part.rgba, part.image))
     return assets
 
 

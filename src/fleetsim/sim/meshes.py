@@ -10,12 +10,15 @@ without a visual scene contributes its library geometries untransformed.
 
 Materials (``collada_parts``) give one colour per part, as Gazebo draws a DAE whose visual has
 no material of its own: the effect's diffuse colour (an emission-only ``constant`` effect: its
-emission), or for a diffuse texture the image's mean colour (the image looked up next to the
-``.dae`` and in a Gazebo model's ``../materials/textures/``; neutral grey when it is not
-found). Alpha comes from ``<transparent>`` scaled by ``<transparency>`` (``opaque="A_ONE"``:
-alpha times transparency; ``RGB_ZERO``: one minus luminance times transparency); like Gazebo,
-a lone ``<transparency>`` without ``<transparent>`` is ignored, since exporters disagree on
-its direction. Triangles bound to no material are neutral grey.
+emission), or for a diffuse texture the image itself, drawn by the file's texture coordinates
+(``MeshPart.texcoords``, flipped to v = 0 at the image's top as Gazebo's loader does for OGRE;
+the image looked up next to the ``.dae`` and in a Gazebo model's ``../materials/textures/``).
+A texture whose triangles carry no texture coordinates is drawn in the image's mean colour, one
+whose image is not found in neutral grey. Alpha comes from ``<transparent>`` scaled by
+``<transparency>`` (``opaque="A_ONE"``: alpha times transparency; ``RGB_ZERO``: one minus
+luminance times transparency); like Gazebo, a lone ``<transparency>`` without
+``<transparent>`` is ignored, since exporters disagree on its direction. Triangles bound to
+no material are neutral grey.
 
 Parsing is done by ``pycollada``; the arrays are cached per (path, modification time, size), so a
 mesh shared by a hundred robots is read once.
@@ -32,6 +35,7 @@ from urllib.parse import unquote, urlparse
 import numpy as np
 
 from fleetsim.errors import SimulationError
+from fleetsim.sim import textures
 
 _CACHE_SIZE = 128  # distinct mesh files kept parsed
 NEUTRAL_GREY = (0.7, 0.7, 0.7, 1.0)  # RGBA of triangles without a usable material colour
@@ -44,14 +48,23 @@ class MeshPart(NamedTuple):
     vertices : ndarray, shape (V, 3), float64, read-only; positions (m) in the COLLADA root frame,
         only those the part's triangles use.
     faces : ndarray, shape (F, 3), int32, read-only; indices into ``vertices``, outward winding.
-    rgba : (r, g, b, a) in [0, 1]; the material's colour (``NEUTRAL_GREY`` without one).
+    rgba : (r, g, b, a) in [0, 1]; the material's colour (``NEUTRAL_GREY`` without one; white
+        when ``image`` is drawn).
     name : the material's name (its id when unnamed); ``""`` for triangles without material.
+    texcoords : ndarray, shape (T, 2), float64, read-only, or None; (u, v) with v = 0 at the
+        image's top, present when ``image`` is.
+    texcoord_faces : ndarray, shape (F, 3), int32, read-only, or None; each triangle's indices
+        into ``texcoords``.
+    image : the texture image file drawn on the part, or None.
     """
 
     vertices: np.ndarray
     faces: np.ndarray
     rgba: tuple[float, float, float, float]
     name: str
+    texcoords: np.ndarray | None = None
+    texcoord_faces: np.ndarray | None = None
+    image: str | None = None
 
 
 class _Material(NamedTuple):
@@ -69,6 +82,8 @@ class _Collada(NamedTuple):
     faces: tuple[np.ndarray, ...]
     material: tuple[int, ...]
     materials: tuple[_Material, ...]
+    #: per triangle set: (u, v) coordinates (n, 2) and (t, 3) indices into them, or None
+    texcoords: tuple[tuple[np.ndarray, np.ndarray] | None, ...] = ()
 
 
 def triangle_mesh_from_collada(path: str | Path) -> tuple[np.ndarray, np.ndarray]:
@@ -160,9 +175,20 @@ def _cached_parts(path: str, mtime_ns: int, size: int) -> tuple[MeshPart, ...]:
         faces.flags.writeable = False
         if m < 0:
             parts.append(MeshPart(vertices, faces, NEUTRAL_GREY, ""))
-        else:
-            mat = sets.materials[m]
+            continue
+        mat = sets.materials[m]
+        uv = (
+            textures.joined_texcoords([sets.texcoords[i] for i in members])
+            if sets.texcoords
+            else None
+        )
+        image = _texture_file(mat.image, Path(path).parent) if mat.image and uv else None
+        if image is None:
             parts.append(MeshPart(vertices, faces, _rgba_of(mat, path), mat.name))
+        else:
+            parts.append(
+                MeshPart(vertices, faces, (1.0, 1.0, 1.0, mat.alpha), mat.name, *uv, str(image))
+            )
     return tuple(parts)
 
 
@@ -254,7 +280,7 @@ def _parse(path: str) -> _Collada:
                 f"COLLADA mesh '{path}': <unit meter='{unit}'> must be a positive number"
             )
     try:
-        verts, faces, mats = _triangles_of_scene(dae)
+        verts, faces, mats, uvs = _triangles_of_scene(dae)
         used = list(dict.fromkeys(m for m in mats if m is not None))  # first-use order
         slots = {id(m): i for i, m in enumerate(used)}
         materials = tuple(_material_of(m) for m in used)
@@ -281,12 +307,12 @@ def _parse(path: str) -> _Collada:
     if not all(np.all(np.isfinite(v)) for v in vertices):
         raise SimulationError(f"COLLADA mesh '{path}' has non-finite vertex coordinates")
     material = tuple(-1 if m is None else slots[id(m)] for m in mats)
-    return _Collada(vertices, tuple(faces), material, materials)
+    return _Collada(vertices, tuple(faces), material, materials, tuple(uvs))
 
 
-def _triangles_of_scene(dae) -> tuple[list[np.ndarray], list[np.ndarray], list]:
-    """Per triangle set: (n, 3) transformed vertices, (t, 3) local indices and the pycollada
-    ``Material`` it is bound to (None: unbound)."""
+def _triangles_of_scene(dae) -> tuple[list[np.ndarray], list[np.ndarray], list, list]:
+    """Per triangle set: (n, 3) transformed vertices, (t, 3) local indices, the pycollada
+    ``Material`` it is bound to (None: unbound) and its texture coordinates (or None)."""
     from collada.polylist import BoundPolylist
     from collada.triangleset import BoundTriangleSet
 
@@ -294,7 +320,7 @@ def _triangles_of_scene(dae) -> tuple[list[np.ndarray], list[np.ndarray], list]:
         bound = list(dae.scene.objects("geometry"))
     else:
         bound = [g.bind(np.identity(4), {}) for g in dae.geometries]
-    verts, faces, mats = [], [], []
+    verts, faces, mats, uvs = [], [], [], []
     for geom in bound:
         mirrored = np.linalg.det(np.asarray(geom.matrix, float)[:3, :3]) < 0
         for prim in geom.primitives():
@@ -311,12 +337,15 @@ def _triangles_of_scene(dae) -> tuple[list[np.ndarray], list[np.ndarray], list]:
                     f"COLLADA mesh '{dae.filename}': geometry '{geom.original.id}' has triangle "
                     f"indices {int(idx.min())}..{int(idx.max())} for {len(v)} vertices"
                 )
+            uv = textures.texcoords_of_triangle_set(prim, len(idx))
             if mirrored:
                 idx = idx[:, ::-1]
+                uv = uv if uv is None else (uv[0], uv[1][:, ::-1])
             verts.append(v)
             faces.append(idx)
             mats.append(_bound_material(dae, prim))
-    return verts, faces, mats
+            uvs.append(uv)
+    return verts, faces, mats, uvs
 
 
 def _bound_material(dae, prim):

@@ -265,3 +265,44 @@ def add_texture_material(spec: mujoco.MjSpec, image: str | Path, owner: str) -> 
         mat = spec.add_material(name=name)
         mat.textures[mujoco.mjtTextureRole.mjTEXROLE_RGB] = name
     return name
+
+
+def texcoords_of_triangle_set(prim, n_triangles: int) -> tuple[np.ndarray, np.ndarray] | None:
+    """The first texture coordinate set of a pycollada triangle set: (n, 2+) values and (t, 3)
+    indices into them; None when it has none or they do not fit its ``n_triangles``."""
+    sets = getattr(prim, "texcoordset", None) or ()
+    index_sets = getattr(prim, "texcoord_indexset", None) or ()
+    if not sets or not index_sets:
+        return None
+    uv = np.asarray(sets[0], dtype=np.float64)
+    uv = uv.reshape(-1, uv.shape[-1] if uv.ndim > 1 else 2)
+    ti = np.asarray(index_sets[0], dtype=np.int64).reshape(-1, 3)
+    if len(ti) != n_triangles or len(uv) == 0 or ti.min() < 0 or ti.max() >= len(uv):
+        return None
+    return uv, ti
+
+
+def joined_texcoords(sets) -> tuple[np.ndarray, np.ndarray] | None:
+    """One texture coordinate array for triangle sets drawn as one mesh.
+
+    Parameters
+    ----------
+    sets : list of ``((n, 2+) uv, (t, 3) indices)`` per triangle set (COLLADA convention, v
+        growing upwards), or None entries for sets without coordinates.
+
+    Returns
+    -------
+    (T, 2) float64 uv with v = 0 at the image's top (Gazebo's loader flips COLLADA's v for
+    OGRE; MuJoCo reads v the same way) and (F, 3) int32 indices, both read-only; None unless
+    every set has coordinates.
+    """
+    if not sets or any(s is None for s in sets):
+        return None
+    offsets = np.cumsum([0] + [len(s[0]) for s in sets[:-1]])
+    uv = np.concatenate([s[0][:, :2] for s in sets]).astype(np.float64)
+    uv[:, 1] = 1.0 - uv[:, 1]
+    faces = np.concatenate([s[1] + o for s, o in zip(sets, offsets, strict=True)]).astype(np.int32)
+    uv, faces = np.ascontiguousarray(uv), np.ascontiguousarray(faces)
+    uv.flags.writeable = False
+    faces.flags.writeable = False
+    return uv, faces

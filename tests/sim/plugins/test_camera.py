@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from fleetsim.description import parse_urdf
+from fleetsim.errors import SimulationError
 from fleetsim.sim import Engine
 from fleetsim.sim.plugins.base import ImageReading
 from fleetsim.sim.world import GeomDesc, LinkDesc, ModelDesc, WorldDesc, ground_plane
@@ -196,3 +197,32 @@ def test_waffle_camera_resolution_and_rate_are_xacro_args():
         {"camera_width": "1920", "camera_height": "1080", "camera_rate": "30"}
     )
     assert (cam.width, cam.height, cam.rate) == (1920, 1080, 30.0)  # the real camera
+
+
+def test_gaussian_image_noise_as_the_sensor_declares_it():
+    noisy_cam = CAMERA.replace(
+        "<clip>", "<noise><type>gaussian</type><mean>0.0</mean><stddev>0.02</stddev></noise><clip>"
+    )
+
+    def robot(template):
+        text = robot_text("diffbot.urdf").replace(
+            "</robot>", template.format(kind="camera", filename="libgazebo_ros_camera.so")
+        )
+        return parse_urdf(text)
+
+    images = []
+    for _ in range(2):  # same seed, same noise
+        e = Engine(red_wall_world(), rng=np.random.default_rng(7))
+        ent = e.spawn_robot("r", robot(noisy_cam))
+        cam = next(p for p in ent.plugins if p.name == "cam_plugin")
+        (reading,) = [x for x in e.advance(0.1) if isinstance(x, ImageReading)]
+        images.append(reading.image)
+        clean = cam.render(e).astype(float)
+    np.testing.assert_array_equal(images[0], images[1])
+    diff = images[0].astype(float) - clean
+    inside = (clean > 20) & (clean < 235)  # not clipped at 0 or 255
+    assert diff[inside].std() == pytest.approx(0.02 * 255, rel=0.15)
+    assert abs(diff[inside].mean()) < 0.5
+    bad = CAMERA.replace("<clip>", "<noise><type>gaussian</type><stddev>-1</stddev></noise><clip>")
+    with pytest.raises(SimulationError, match=r"camera noise stddev must be >= 0, got -1.0"):
+        Engine(red_wall_world()).spawn_robot("r", robot(bad))

@@ -1,11 +1,13 @@
 """Cameras: RGB (``libgazebo_ros_camera.so``) and depth (``libgazebo_ros_openni_kinect.so``,
 ``libgazebo_ros_depth_camera.so``), rendered headless by MuJoCo (EGL).
 
-The sensor's ``<camera>`` gives ``horizontal_fov``, ``image`` width/height/format and ``clip``
-near/far. Gazebo cameras look along their link's +x with +z up; the MuJoCo camera is rotated to
-match. Images are (H, W, 3) uint8 RGB; depth is (H, W) float32 metres, NaN outside the point
-cloud cutoffs (as the Kinect plugin reports); depth cameras also publish an organised XYZRGB
-point cloud in the optical convention of ``frameName`` (z along the view, x right, y down).
+The sensor's ``<camera>`` gives ``horizontal_fov``, ``image`` width/height/format, ``clip``
+near/far and Gaussian ``noise`` (mean, stddev in units of full intensity, per pixel and
+channel, drawn from the engine's seeded generator). Gazebo cameras look along their link's +x
+with +z up; the MuJoCo camera is rotated to match. Images are (H, W, 3) uint8 RGB; depth is
+(H, W) float32 metres, NaN outside the point cloud cutoffs (as the Kinect plugin reports);
+depth cameras also publish an organised XYZRGB point cloud in the optical convention of
+``frameName`` (z along the view, x right, y down).
 
 Beside ``<imageTopicName>`` the simulator node publishes ``<imageTopicName>/compressed`` as
 image_transport's ``compressed`` plugin does (``compressed_image_msg``), so a node reading
@@ -97,8 +99,13 @@ class CameraPlugin(SensorPlugin):
             self.height = int(_get(cam, "image/height", 240))
             self.near = float(_get(cam, "clip/near", 0.1))
             self.far = float(_get(cam, "clip/far", 100.0))
+            noise = _get(cam, "noise/type", "none")
+            self.noise_mean = float(_get(cam, "noise/mean", 0.0)) if noise == "gaussian" else 0.0
+            self.noise_std = float(_get(cam, "noise/stddev", 0.0)) if noise == "gaussian" else 0.0
         except (TypeError, ValueError) as exc:
             raise SimulationError(f"{w}: camera fields must be numbers ({exc})") from None
+        if self.noise_std < 0:
+            raise SimulationError(f"{w}: camera noise stddev must be >= 0, got {self.noise_std}")
         if not (0 < self.hfov < math.pi) or self.width < 1 or self.height < 1:
             raise SimulationError(
                 f"{w}: needs 0 < horizontal_fov < pi and a positive image "
@@ -151,6 +158,17 @@ class CameraPlugin(SensorPlugin):
             return img
         return r.render().copy()
 
+    def noisy(self, image: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+        """``image`` with the sensor's ``<noise>``: Gaussian, per pixel and channel, in units of
+        full intensity (as Gazebo's camera noise model), rounded and clipped to 0..255."""
+        if self.noise_std == 0 and self.noise_mean == 0:
+            return image
+        n = rng.standard_normal(image.shape, dtype=np.float32)
+        n *= 255.0 * self.noise_std
+        n += image
+        n += 255.0 * self.noise_mean
+        return np.clip(np.rint(n), 0, 255).astype(np.uint8)
+
     def measure(self, engine, t: float) -> ImageReading | None:
         if self.wanted is not None and not self.wanted():
             return None  # nobody looks: skip the (software) rendering
@@ -161,7 +179,7 @@ class CameraPlugin(SensorPlugin):
             self.topic(p.cameraInfoTopicName),
             self.frame_id,
             "rgb8",
-            self.render(engine),
+            self.noisy(self.render(engine), engine.rng),
             self.K,
         )
         if self.depth_enabled and (self.depth_wanted is None or self.depth_wanted()):

@@ -9,6 +9,7 @@ Each test runs in a temporary directory, where a ``MUJOCO_LOG.TXT`` would show u
 
 from __future__ import annotations
 
+import logging
 import math
 from pathlib import Path
 
@@ -79,7 +80,8 @@ def test_robots_at_top_speed_into_each_other_stay_sane(path):
     run_clean(e, [(da, v, 0.0), (db, v, 1.0)], 1.5)
 
 
-def test_nan_force_names_robot_body_and_joint(diffbot):
+def test_nan_force_names_robot_body_and_joint(diffbot, caplog):
+    caplog.set_level(logging.DEBUG, logger="fleetsim.mujoco")
     e = Engine(None)
     e.spawn_robot("bot", diffbot)
     e.advance(0.05)
@@ -91,6 +93,11 @@ def test_nan_force_names_robot_body_and_joint(diffbot):
         r"bot/base_footprint",
     ):
         e.advance(0.05)
+    # MuJoCo's own text went to fleetsim's log (at debug level: the error says more), not to
+    # MUJOCO_LOG.TXT
+    texts = [r for r in caplog.records if r.getMessage().startswith("MuJoCo: ")]
+    assert texts and {r.levelno for r in texts} == {logging.DEBUG}
+    assert "Nan, Inf or huge value in QACC at DOF 0" in texts[0].getMessage()
     # no auto-reset: the world stays as the failed step left it, until it is reset on purpose
     assert not np.isfinite(e.data.qpos).all()
     e.data.xfrc_applied[:] = 0.0

@@ -47,8 +47,15 @@ _QUANTITY = {
 }
 
 
+#: the first words of MuJoCo's text for each counted warning (``mju_warningText``)
+_COUNTED = tuple(mujoco.mju_warningText(w, 0)[:20] for w in range(int(W.mjNWARNING)))
+
+
 def _log_mujoco_warning(text: str) -> None:
-    _log.warning("MuJoCo: %s", text)
+    # a counted warning becomes the engine's error, which says more (robot, body, cause): its
+    # bare text only at debug level, so a run that stops prints one line, not two
+    level = logging.DEBUG if text.startswith(_COUNTED) else logging.WARNING
+    _log.log(level, "MuJoCo: %s", text)
 
 
 def route_mujoco_warnings() -> None:

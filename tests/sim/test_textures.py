@@ -233,3 +233,50 @@ def test_collada_texture_is_drawn_by_the_files_uv_coordinates(tmp_path):
     bottom_left, bottom_right = img[cy + dy, cx - dx], img[cy + dy, cx + dx]
     assert np.argmax(top_left) == 0 and np.argmax(top_right) == 1  # red, green
     assert np.argmax(bottom_left) == 2 and np.ptp(bottom_right) < 60  # blue, white
+
+
+def test_cylinder_and_sphere_carry_gazebos_texture_coordinates():
+    from fleetsim.sim.textures import cylinder_uv_mesh, sphere_uv_mesh
+
+    for v, f, t, tf in (cylinder_uv_mesh(0.2, 1.0), sphere_uv_mesh(0.3)):
+        a, b, c = (v[f[:, i]] for i in range(3))
+        outward = np.einsum("ij,ij->i", np.cross(b - a, c - a), a + b + c)
+        assert np.all(outward > 0) and f.shape == tf.shape
+        assert t.min() >= 0 and t.max() <= 1
+    v, f, t, tf = cylinder_uv_mesh(0.2, 1.0)
+    side = np.abs(v[f[:, 0], 2] - v[f[:, 1], 2]) + np.abs(v[f[:, 1], 2] - v[f[:, 2], 2]) > 0
+    corners, uv = v[f[side]].reshape(-1, 3), t[tf[side]].reshape(-1, 2)
+    # u follows the angle from +y towards +x (Gazebo's x = r sin, y = r cos); v = 0 at the bottom
+    angle = np.mod(np.arctan2(corners[:, 0], corners[:, 1]), 2 * np.pi)
+    seam = uv[:, 0] == 1.0
+    np.testing.assert_allclose(np.where(seam, 2 * np.pi, angle), uv[:, 0] * 2 * np.pi, atol=1e-9)
+    np.testing.assert_allclose(uv[:, 1], (corners[:, 2] + 0.5) / 1.0)
+    v, f, t, tf = sphere_uv_mesh(0.3)
+    corners, uv = v[f].reshape(-1, 3), t[tf].reshape(-1, 2)
+    np.testing.assert_allclose(uv[:, 1], np.arccos(np.clip(corners[:, 1] / 0.3, -1, 1)) / np.pi)
+
+
+def test_textured_cylinder_and_sphere_show_the_image(tmp_path):
+    quadrant_model(tmp_path)
+    sdf = """<sdf version="1.6"><model name="shapes"><static>true</static><link name="link">
+      <visual name="c"><pose>0 -0.4 0 0 0 0</pose><geometry><cylinder><radius>0.2</radius>
+        <length>0.6</length></cylinder></geometry>{mat}</visual>
+      <visual name="s"><pose>0 0.4 0 0 0 0</pose><geometry><sphere><radius>0.25</radius>
+        </sphere></geometry>{mat}</visual></link></model></sdf>"""
+    mat = (
+        f"<material><script><uri>file://{tmp_path}</uri><name>Sign/Quadrants</name></script>"
+        "</material>"
+    )
+    e = Engine(None)
+    e.spawn_sdf("shapes", load_sdf_model(sdf.format(mat=mat)), (0, 0, 1.0, 0, 0, 0))
+    img = render_from(e, (0, 0, 1.0), 180.0, 1.6, (320, 240))
+    Image.fromarray(img).save(tmp_path / "shapes.png")
+    assert_no_mujoco_warnings(e)
+    for half in (img[:, :160], img[:, 160:]):  # the cylinder (left of the view), the sphere
+        px = half.reshape(-1, 3).astype(int)
+        shown = {
+            "red": np.any((px[:, 0] > 150) & (px[:, 1] < 60) & (px[:, 2] < 60)),
+            "green": np.any((px[:, 1] > 150) & (px[:, 0] < 60) & (px[:, 2] < 60)),
+            "blue": np.any((px[:, 2] > 150) & (px[:, 0] < 60) & (px[:, 1] < 60)),
+        }
+        assert sum(shown.values()) >= 2, shown  # the image's colours, not their mean

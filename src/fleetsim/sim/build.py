@@ -139,8 +139,8 @@ def add_geom(
         mujoco.mju_mulQuat(q, fquat, quat)
         pos, quat = p + fpos, q
     kw = {"pos": pos, "quat": quat}
-    if g.kind == "box" and g.texture and not g.collide:  # Gazebo's UVs: the image on each face
-        kw.update(type=G.mjGEOM_MESH, meshname=textures.add_textured_box_mesh(spec, g.size))
+    if g.texture and not g.collide and g.kind in textures.TEXTURED_SHAPES:  # Gazebo's UVs
+        kw.update(type=G.mjGEOM_MESH, meshname=textures.add_textured_mesh(spec, g.kind, g.size))
     elif g.kind == "box":
         kw.update(type=G.mjGEOM_BOX, size=[s / 2 for s in g.size])
     elif g.kind == "cylinder":

@@ -3,8 +3,9 @@
 Gazebo draws a texture by the UV coordinates of the shape's mesh: every face of a box carries
 the whole image, stretched over it (``common::MeshManager::CreateBox``), so a long wall shows
 long, blurry bricks and a 0.15 m marker face shows the whole marker. MuJoCo's own mapping of a
-2D texture onto a primitive box repeats it by size instead, so a textured box visual becomes a
-24-vertex mesh with Gazebo's UVs (``box_uv_mesh``) and a 2D texture (``add_texture_material``).
+2D texture onto a primitive box repeats it by size instead, so a textured box, cylinder or
+sphere visual becomes a mesh with the texture coordinates Gazebo's meshes have (``box_uv_mesh``,
+``cylinder_uv_mesh``, ``sphere_uv_mesh``) and a 2D texture (``add_texture_material``).
 MuJoCo reads texture coordinates with v = 0 at the image's top row, as OGRE does, so Gazebo's
 UVs are used unchanged.
 
@@ -238,17 +239,97 @@ def box_uv_mesh(size) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return vertices, faces, texcoords
 
 
-def add_textured_box_mesh(spec: mujoco.MjSpec, size) -> str:
-    """The mesh asset of a textured box of ``size`` (one per size in a spec)."""
-    name = "texbox:" + "x".join(f"{float(s):.6g}" for s in size)
+def cylinder_uv_mesh(radius: float, length: float, segments: int = 32):
+    """A cylinder (axis z) as Gazebo's renderer meshes it (``CreateCylinder``, one ring of
+    ``segments``): the image wrapped once round the side (u with the angle from +y towards +x,
+    v = 0 at the bottom rim, 1 at the top), each cap's rim at v = 1 (top) or 0 (bottom) with
+    its centre at (0, 0).
+
+    Returns vertices (V, 3) m, faces (F, 3) int32 counter-clockwise from outside, and per-face
+    texture coordinates: texcoords (T, 2) and texcoord faces (F, 3) int32 (positions are welded
+    where Gazebo repeats them for the texture seam, the coordinates are not).
+    """
+    n = segments + 1
+    a = np.arange(n) * (2 * np.pi / segments)
+    ring = np.stack([radius * np.sin(a), radius * np.cos(a)], axis=1)  # Gazebo: x sin, y cos
+    u = np.arange(n) / segments
+    h = length / 2
+    # vertex blocks (positions and texcoords in step): bottom ring, top ring (the side), then
+    # each cap's rim and centre
+    pos = [np.c_[ring, np.full(n, -h)], np.c_[ring, np.full(n, h)]]
+    uv = [np.c_[u, np.zeros(n)], np.c_[u, np.ones(n)]]
+    tri = []
+    for k in range(segments):
+        tri += [[k, k + 1, n + k + 1], [k, n + k + 1, n + k]]
+    for z, v, first in ((h, 1.0, 2 * n), (-h, 0.0, 3 * n + 1)):
+        pos += [np.c_[ring, np.full(n, z)], np.array([[0.0, 0.0, z]])]
+        uv += [np.c_[u, np.full(n, v)], np.zeros((1, 2))]
+        tri += [[first + n, first + k, first + k + 1] for k in range(segments)]
+    tri = np.array(tri)
+    return _welded(np.concatenate(pos), tri, np.concatenate(uv), tri.copy())
+
+
+def sphere_uv_mesh(radius: float, rings: int = 32, segments: int = 32):
+    """A sphere as Gazebo's renderer meshes it (``CreateSphere``): poles on the y axis, u with
+    the angle about y, v = 0 at the +y pole and 1 at the -y pole. Returns as
+    ``cylinder_uv_mesh``; the triangles that collapse at the poles are left out."""
+    ring_a = np.arange(rings + 1) * (np.pi / rings)
+    seg_a = np.arange(segments + 1) * (2 * np.pi / segments)
+    r0 = radius * np.sin(ring_a)[:, None]
+    y = radius * np.cos(ring_a)[:, None] * np.ones((1, segments + 1))
+    vertices = np.stack([r0 * np.sin(seg_a), y, r0 * np.cos(seg_a)], axis=-1).reshape(-1, 3)
+    u, v = np.meshgrid(np.arange(segments + 1) / segments, np.arange(rings + 1) / rings)
+    texcoords = np.stack([u.ravel(), v.ravel()], axis=1)
+    n = segments + 1
+    tri = []
+    for r in range(rings):
+        for k in range(segments):
+            a, b, c, d = r * n + k, r * n + k + 1, (r + 1) * n + k + 1, (r + 1) * n + k
+            tri += [[a, c, b], [a, d, c]]
+    tri = np.array(tri)
+    return _welded(vertices, tri, texcoords, tri.copy())
+
+
+def _welded(vertices, faces, texcoords, texcoord_faces):
+    """Merge repeated positions (texture seams, poles) and drop the triangles that collapse;
+    faces are turned to point away from the centroid (all shapes here are convex)."""
+    key = np.round(vertices, 9)
+    unique, inverse = np.unique(key, axis=0, return_inverse=True)
+    f = inverse.reshape(-1)[faces]
+    keep = (f[:, 0] != f[:, 1]) & (f[:, 1] != f[:, 2]) & (f[:, 0] != f[:, 2])
+    f, tf = f[keep], texcoord_faces[keep]
+    a, b, c = (unique[f[:, i]] for i in range(3))
+    outward = np.einsum("ij,ij->i", np.cross(b - a, c - a), a + b + c - 3 * unique.mean(0)) > 0
+    f[~outward] = f[~outward][:, ::-1]
+    tf[~outward] = tf[~outward][:, ::-1]
+    return unique, f.astype(np.int32), texcoords, tf.astype(np.int32)
+
+
+TEXTURED_SHAPES = ("box", "cylinder", "sphere")
+
+
+def add_textured_mesh(spec: mujoco.MjSpec, kind: str, size) -> str:
+    """The mesh asset (one per kind and size in a spec) of a textured ``box`` (full sizes),
+    ``cylinder`` (radius, length) or ``sphere`` (radius,) with Gazebo's texture coordinates."""
+    name = f"tex{kind}:" + "x".join(f"{float(s):.6g}" for s in size)
     if spec.mesh(name) is None:
-        v, f, t = box_uv_mesh(size)
+        if kind == "box":
+            v, f, t = box_uv_mesh(size)
+            tf = f
+        elif kind == "cylinder":
+            v, f, t, tf = cylinder_uv_mesh(*size[:2])
+        elif kind == "sphere":
+            v, f, t, tf = sphere_uv_mesh(size[0])
+        else:
+            raise SimulationError(
+                f"no texture coordinates for a {kind}; textured: {TEXTURED_SHAPES}"
+            )
         mesh = spec.add_mesh(
             name=name,
             uservert=v.ravel(),
             userface=f.ravel(),
             usertexcoord=t.ravel(),
-            userfacetexcoord=f.ravel(),
+            userfacetexcoord=tf.ravel(),
         )
         # a visual has no mass; a marker's 0.1 mm thick face is too thin for a volume inertia
         mesh.inertia = mujoco.mjtMeshInertia.mjMESH_INERTIA_SHELL

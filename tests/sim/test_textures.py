@@ -8,7 +8,7 @@ from PIL import Image
 from fleetsim.errors import SimulationError
 from fleetsim.sim import Engine
 from fleetsim.sim.sdf import load_sdf_model
-from fleetsim.sim.textures import box_uv_mesh, materials_of_script, parse_ogre_script
+from fleetsim.sim.textures import box_uv_mesh
 
 
 @pytest.fixture(autouse=True)
@@ -20,50 +20,6 @@ def in_tmp_dir(tmp_path, monkeypatch):
 
 def assert_no_mujoco_warnings(engine):
     assert {i: w.number for i, w in enumerate(engine.data.warning) if w.number} == {}
-
-
-SCRIPT = """// a comment { with a brace
-material Base
-{
-  technique
-  {
-    pass
-    {
-      diffuse 0.2 0.4 0.6 1.0
-      texture_unit
-      {
-        texture base.png
-        filtering anisotropic
-      }
-    }
-  }
-}
-material Child : Base
-{
-  technique { pass { diffuse 1 0 0 } }
-}
-material Plain { technique { pass { ambient 1 1 1 } } }
-"""
-
-
-def test_ogre_script_blocks_textures_colours_and_inheritance(tmp_path):
-    mats = materials_of_script(SCRIPT, tmp_path / "a.material")
-    assert set(mats) == {"Base", "Child", "Plain"}
-    assert mats["Base"].texture == "base.png" and mats["Base"].diffuse == (0.2, 0.4, 0.6, 1.0)
-    assert mats["Base"].line == 2
-    assert mats["Child"].texture == "base.png" and mats["Child"].diffuse == (1.0, 0.0, 0.0, 1.0)
-    assert mats["Plain"].texture is None and mats["Plain"].diffuse is None
-
-
-def test_ogre_script_errors_name_file_and_line(tmp_path):
-    with pytest.raises(SimulationError, match=r"b.material:1: block 'material M' is never closed"):
-        parse_ogre_script("material M\n{\n pass {\n}\n", tmp_path / "b.material")
-    with pytest.raises(SimulationError, match=r"c.material:2: '\}' closes no block"):
-        parse_ogre_script("material M {}\n}\n", tmp_path / "c.material")
-    with pytest.raises(SimulationError, match=r"d.material:1: 'diffuse' needs numbers"):
-        materials_of_script(
-            "material M { technique { pass { diffuse a b c } } }", tmp_path / "d.material"
-        )
 
 
 def test_box_uv_mesh_puts_the_whole_image_on_each_face():

@@ -5,7 +5,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from fleetsim.errors import SimulationError
-from fleetsim.sim import textures
+from fleetsim.sim import ogre_scripts, textures
 
 GAZEBO_COLOURS = {
     "Gazebo/Grey": (0.7, 0.7, 0.7, 1.0),
@@ -56,12 +56,12 @@ def _texture_from_script(script, vis, where: str, find_model) -> tuple[str | Non
             dirs.append(Path(u[len("file://") :]))
         elif u:
             dirs.append(Path(where).parent / u)
-    material = textures.find_ogre_material(name, dirs)
+    material = ogre_scripts.find_ogre_material(name, dirs)
     if material is None:
         return None, None
     image = None
     if material.texture is not None:
-        image = str(textures.texture_file(material, dirs, _owner(vis, where)))
+        image = str(ogre_scripts.texture_file(material, dirs, _owner(vis, where)))
     return image, material.diffuse
 
 

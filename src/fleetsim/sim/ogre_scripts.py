@@ -138,12 +138,17 @@ def _first_texture_and_colour(block: OgreBlock, source: Path):
     return texture, diffuse
 
 
-def find_ogre_material(name: str, folders: list[Path]) -> OgreMaterial | None:
-    """The material ``name`` from the ``.material`` scripts in ``folders`` (None if absent)."""
-    for folder in folders:
-        if not folder.is_dir():
+def find_ogre_material(name: str, locations: list[Path]) -> OgreMaterial | None:
+    """The material ``name`` from the ``.material`` scripts at ``locations`` (folders, whose
+    scripts are all read, or script files); None if none defines it."""
+    for loc in locations:
+        if loc.is_file() and loc.suffix == ".material":
+            files = [loc]
+        elif loc.is_dir():
+            files = sorted(loc.glob("*.material"))
+        else:
             continue
-        for f in sorted(folder.glob("*.material")):
+        for f in files:
             found = materials_of_script(f.read_text(errors="replace"), f).get(name)
             if found is not None:
                 return found
@@ -159,6 +164,7 @@ def texture_file(material: OgreMaterial, folders: list[Path], owner: str) -> Pat
     """
     assert material.texture is not None
     here = material.source.parent
+    folders = [f.parent if f.suffix == ".material" else f for f in folders]
     candidates = [*folders, here, here.parent / "textures"]
     for folder in dict.fromkeys(candidates):
         f = folder / material.texture

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 from fleetsim.errors import SimulationError
@@ -34,10 +35,27 @@ def _owner(vis, where: str) -> str:
     return f"model '{model}' ({where})" if model else where
 
 
+#: fleetsim's stand-in for Gazebo's media folder (``file://media/materials/scripts/...``): the
+#: textured ``Gazebo/*`` materials it draws (``Gazebo/Bricks``)
+MEDIA_ROOT = Path(__file__).resolve().parent.parent / "assets" / "worlds"
+GAZEBO_MATERIALS = MEDIA_ROOT / "media" / "materials" / "scripts" / "gazebo.material"
+
+
+def _resource_roots() -> list[Path]:
+    """Where a relative ``file://`` URI is looked up: GAZEBO_RESOURCE_PATH, then fleetsim's
+    media (as Gazebo finds ``file://media/...`` under its share folder)."""
+    env = os.environ.get("GAZEBO_RESOURCE_PATH", "")
+    return [Path(p) for p in env.split(os.pathsep) if p] + [MEDIA_ROOT]
+
+
 def _texture_from_script(script, vis, where: str, find_model) -> tuple[str | None, tuple | None]:
     """Texture image and diffuse colour of an OGRE material ``<script><uri>..<name>``
-    reference (``textures``); (None, None) when no script in the URIs defines the material
-    (Gazebo's own ``Gazebo/*`` materials, coloured by ``GAZEBO_COLOURS``).
+    reference (``ogre_scripts``); (None, None) when no script defines the material (Gazebo's
+    plain ``Gazebo/*`` colours are in ``GAZEBO_COLOURS``).
+
+    The URIs name script folders or files: ``model://`` (the model path), ``file://`` (absolute,
+    or relative to GAZEBO_RESOURCE_PATH and fleetsim's media), or a path relative to the SDF
+    file. As in Gazebo, ``Gazebo/*`` materials are found without a URI too.
 
     Raises `SimulationError` naming the image, the material and the model when the material
     names a texture image that is not there.
@@ -53,9 +71,12 @@ def _texture_from_script(script, vis, where: str, find_model) -> tuple[str | Non
             except SimulationError:
                 continue
         elif u.startswith("file://"):
-            dirs.append(Path(u[len("file://") :]))
+            path = Path(u[len("file://") :])
+            dirs += [path] if path.is_absolute() else [r / path for r in _resource_roots()]
         elif u:
             dirs.append(Path(where).parent / u)
+    if name.startswith("Gazebo/"):
+        dirs.append(GAZEBO_MATERIALS)
     material = ogre_scripts.find_ogre_material(name, dirs)
     if material is None:
         return None, None

@@ -5,14 +5,15 @@ grobot's ``example.world`` is a 12 x 12 m walled building (``model://building``:
 an oak tree, a cinder block, two cardboard boxes and two jersey barriers, at the poses the
 tutorial's world file gives them. The database models are not shipped with fleetsim, so the
 obstacles here are plain shapes of about their size at the same poses (all static: nothing in
-the tutorial pushes them), and the walls carry a brick texture drawn here, stretched over each
-wall as Gazebo stretches ``Gazebo/Bricks``.
+the tutorial pushes them). The walls are ``Gazebo/Bricks`` as in the tutorial, from fleetsim's
+stand-in for Gazebo's media folder (``worlds/media``, a brick texture drawn here), stretched
+over each wall as Gazebo stretches it.
 
 One description (``BUILDING``, ``OBSTACLES``) gives both outputs, so the world and the map
 agree by construction:
 
-- ``worlds/example.world`` with ``worlds/models/example_building/`` (model.config, model.sdf,
-  brick material script and texture);
+- ``worlds/example.world`` with ``worlds/models/example_building/`` (model.config, model.sdf);
+- ``worlds/media/materials/`` (``gazebo.material`` with ``Gazebo/Bricks``, ``bricks.png``);
 - ``maps/example_world.pgm`` + ``.yaml`` with the tutorial map's layout (0.05 m cells, 384 x
   384, origin (-10, -10)): inside the building free (254), walls and the obstacles' footprints
   at laser height occupied (0), outside unknown (205), as map_saver writes a gmapping map.
@@ -180,9 +181,8 @@ def world_sdf() -> str:
 def building_sdf() -> str:
     size = f"{_f(WALL_LENGTH)} {_f(WALL_THICKNESS)} {_f(WALL_HEIGHT)}"
     material = (
-        "<material><script><uri>model://example_building/materials/scripts</uri>"
-        "<uri>model://example_building/materials/textures</uri><name>Example/Bricks</name>"
-        "</script></material>"
+        "<material><script><uri>file://media/materials/scripts/gazebo.material</uri>"
+        "<name>Gazebo/Bricks</name></script></material>"
     )
     links = []
     for name, (x, y, yaw) in WALLS:
@@ -214,7 +214,9 @@ BUILDING_CONFIG = """<?xml version="1.0"?>
 </model>
 """
 
-BRICKS_MATERIAL = """material Example/Bricks
+BRICKS_MATERIAL = """// fleetsim's stand-in for Gazebo's textured media materials (written by
+// ../../../make_example_world.py); plain Gazebo/* colours are built into fleetsim
+material Gazebo/Bricks
 {
   technique
   {
@@ -313,14 +315,15 @@ def write(assets: Path = ASSETS) -> list[Path]:
     from PIL import Image
 
     model = assets / "worlds/models/example_building"
-    (model / "materials/scripts").mkdir(parents=True, exist_ok=True)
-    (model / "materials/textures").mkdir(parents=True, exist_ok=True)
+    media = assets / "worlds/media/materials"
+    for folder in (model, media / "scripts", media / "textures"):
+        folder.mkdir(parents=True, exist_ok=True)
     (assets / "maps").mkdir(parents=True, exist_ok=True)
     files = {
         assets / "worlds/example.world": world_sdf(),
         model / "model.sdf": building_sdf(),
         model / "model.config": BUILDING_CONFIG,
-        model / "materials/scripts/bricks.material": BRICKS_MATERIAL,
+        media / "scripts/gazebo.material": BRICKS_MATERIAL,
         assets / "maps/example_world.yaml": (
             "# fleetsim's copy of the tutorial's example_world map, drawn by "
             "../worlds/make_example_world.py\n"
@@ -331,7 +334,7 @@ def write(assets: Path = ASSETS) -> list[Path]:
     }
     for path, text in files.items():
         path.write_text(text)
-    bricks = model / "materials/textures/bricks.png"
+    bricks = media / "textures/bricks.png"
     Image.fromarray(bricks_image()).save(bricks)
     img = map_image()
     pgm = assets / "maps/example_world.pgm"

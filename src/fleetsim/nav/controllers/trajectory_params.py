@@ -15,8 +15,12 @@ class TrajectoryPlannerParams:
     # robot configuration
     acc_lim_x: float = param(2.5, unit="m/s^2", range=(0.0, None), help="x acceleration limit")
     acc_lim_y: float = param(2.5, unit="m/s^2", range=(0.0, None), help="y acceleration limit")
-    acc_lim_theta: float = param(
-        3.2, unit="rad/s^2", range=(0.0, None), help="rotational acceleration limit"
+    acc_lim_theta: float = param(  # acc_lim_th: the name of older releases and their tutorials
+        3.2,
+        unit="rad/s^2",
+        range=(0.0, None),
+        aliases=("acc_lim_th",),
+        help="rotational acceleration limit",
     )
     max_vel_x: float = param(0.5, unit="m/s", help="maximum forward velocity")
     min_vel_x: float = param(0.1, unit="m/s", help="minimum forward velocity")

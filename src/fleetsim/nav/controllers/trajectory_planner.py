@@ -21,6 +21,7 @@ max_vel_x]`` (likewise theta), with T = ``sim_time``, or the control period when
 
 from __future__ import annotations
 
+import logging
 import math
 from typing import Any
 
@@ -52,6 +53,26 @@ def _wrap(a: float) -> float:
 
 def _sign(v: float) -> float:
     return 1.0 if v > 0 else (-1.0 if v < 0 else 0.0)
+
+
+def circling_hint(p: TrajectoryPlannerParams) -> str:
+    """A warning when no forward rollout can end near the goal, else "".
+
+    The slowest forward rollout covers ``min_vel_x * sim_time``. Closer to the goal than half
+    of that, every forward rollout ends farther from it than the robot already is, so rotating
+    in place scores best; when ``xy_goal_tolerance`` is smaller than that band the robot turns
+    on the spot short of its goal and never arrives (ROS's base_local_planner does the same).
+    """
+    reach = p.min_vel_x * p.sim_time
+    if reach / 2 <= p.xy_goal_tolerance:
+        return ""
+    return (
+        f"min_vel_x {p.min_vel_x:g} m/s over sim_time {p.sim_time:g} s rolls out "
+        f"{reach:.2f} m, more than twice xy_goal_tolerance {p.xy_goal_tolerance:g} m: near the "
+        f"goal every forward rollout overshoots it, so the robot may turn in place about "
+        f"{reach / 2:.2f} m short of its goal and never arrive; set xy_goal_tolerance >= "
+        f"{reach / 2:.2f} or lower min_vel_x or sim_time"
+    )
 
 
 class TrajectoryPlanner(LocalPlanner):
@@ -96,7 +117,11 @@ class TrajectoryPlanner(LocalPlanner):
         ns: dict[str, Any] | None,
         where: str = "TrajectoryPlannerROS",
     ) -> TrajectoryPlanner:
-        return cls(costmap, footprint, load_params(TrajectoryPlannerParams, ns, where))
+        params = load_params(TrajectoryPlannerParams, ns, where)
+        hint = circling_hint(params)
+        if hint:
+            logging.getLogger("fleetsim.nav").warning("%s: %s", where, hint)
+        return cls(costmap, footprint, params)
 
     def _reset_oscillation_flags(self) -> None:
         self.rotating_left = self.rotating_right = False

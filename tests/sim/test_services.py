@@ -6,6 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from fleetsim.description import load_robot
 from fleetsim.description.urdf import urdf_text
 from fleetsim.msgs import gazebo_msgs, gazebo_ros_link_attacher, geometry_msgs, std_srvs
 from fleetsim.runtime import Node, Runtime
@@ -149,3 +150,35 @@ def test_spawn_sdf_model_errors_are_answered_with_the_reason():
         gazebo_msgs.SpawnModel.Request(model_name="m2", model_xml=MARKER_XML, robot_namespace="a b")
     )
     assert not bad_ns.success and "a b" in bad_ns.status_message
+
+
+def test_spawn_relative_to_a_model_or_a_link_as_gazebo_ros_composes_it():
+    rt = Runtime(seed=1)
+    sim = Simulator(rt, "gazebo")
+    sim.spawn_robot("karl", load_robot(BURGER), (1.0, 2.0, 0.0, 0.0, 0.0, np.pi / 2), "/karl")
+    probe = Node(rt, "probe")
+    spawn = probe.create_client(gazebo_msgs.SpawnModel, "/gazebo/spawn_sdf_model")
+    for name, frame in (("m1", "karl"), ("m2", "karl::base_footprint")):
+        resp = spawn.call(
+            gazebo_msgs.SpawnModel.Request(
+                model_name=name,
+                model_xml=MARKER_XML,
+                initial_pose=pose_msg(-0.05, 0.0, 0.3, np.pi),
+                reference_frame=frame,
+            )
+        )
+        assert resp.success, resp.status_message
+        pos, quat = sim.engine.model_pose(name)
+        # 5 cm behind a robot facing +y is 5 cm towards -y; facing back is yaw -pi/2
+        np.testing.assert_allclose(pos, [1.0, 1.95, 0.3], atol=1e-3)
+        yaw = np.arctan2(
+            2 * (quat[0] * quat[3] + quat[1] * quat[2]), 1 - 2 * (quat[2] ** 2 + quat[3] ** 2)
+        )
+        assert abs(np.angle(np.exp(1j * (yaw + np.pi / 2)))) < 1e-3
+    bad = spawn.call(
+        gazebo_msgs.SpawnModel.Request(
+            model_name="m3", model_xml=MARKER_XML, reference_frame="hank"
+        )
+    )
+    assert not bad.success
+    assert "reference_frame 'hank' is not the world, a model or 'model::link'" in bad.status_message

@@ -12,9 +12,10 @@ from __future__ import annotations
 
 from typing import Any
 
+import mujoco
 import numpy as np
 
-from fleetsim.errors import FleetsimError
+from fleetsim.errors import FleetsimError, SimulationError
 from fleetsim.msgs import gazebo_msgs, gazebo_ros_link_attacher, std_srvs
 from fleetsim.runtime import names as rnames
 from fleetsim.sim.build import quat_from_rpy, rpy_from_quat
@@ -71,25 +72,46 @@ class WorldServices:
                 f"reference frame '{frame}' is not supported; use 'world' (= 'map')"
             )
 
+    def _spawn_pose(self, req) -> tuple[float, ...]:
+        """The world pose of a spawn request: ``initial_pose`` in ``reference_frame`` (the
+        world, a model, or ``model::link``), as gazebo_ros composes it."""
+        frame = req.reference_frame
+        if frame in WORLD_FRAMES:
+            return pose_tuple(req.initial_pose)
+        model, _, link = frame.partition("::")
+        try:
+            if link:
+                b = self.engine.link_id(model, link)
+                fpos, fquat = self.engine.data.xpos[b], self.engine.data.xquat[b]
+            else:
+                fpos, fquat = self.engine.model_pose(model)
+        except SimulationError as exc:
+            raise SimulationError(
+                f"reference_frame '{frame}' is not the world, a model or 'model::link': {exc}"
+            ) from None
+        p, o = req.initial_pose.position, req.initial_pose.orientation
+        q = np.array([o.w, o.x, o.y, o.z], float)
+        q = q / np.linalg.norm(q) if np.linalg.norm(q) > 0 else np.array([1.0, 0, 0, 0])
+        pos, quat = np.zeros(3), np.zeros(4)
+        mujoco.mju_rotVecQuat(pos, np.array([p.x, p.y, p.z], float), fquat)
+        mujoco.mju_mulQuat(quat, fquat, q)
+        return (*(pos + fpos), *rpy_from_quat(quat))
+
     def spawn_urdf(self, req):
         from fleetsim.description import parse_urdf
 
         def run():
-            self._check_frame(req.reference_frame)
+            pose = self._spawn_pose(req)
             robot = parse_urdf(req.model_xml, source=f"<spawn_urdf_model {req.model_name}>")
-            self.node.spawn_robot(
-                req.model_name, robot, pose_tuple(req.initial_pose), req.robot_namespace or None
-            )
+            self.node.spawn_robot(req.model_name, robot, pose, req.robot_namespace or None)
 
         return self._answer(gazebo_msgs.SpawnModel.Response(), run)
 
     def spawn_sdf(self, req):
         def run():
-            self._check_frame(req.reference_frame)
+            pose = self._spawn_pose(req)
             ns = rnames.validate_namespace(req.robot_namespace or "/")
-            entry = self.engine.spawn_sdf(
-                req.model_name, req.model_xml, pose_tuple(req.initial_pose)
-            )
+            entry = self.engine.spawn_sdf(req.model_name, req.model_xml, pose)
             # as gazebo_ros, the namespace the model's plugins would use (grobot spawns each
             # marker in its robot's namespace); kept on the model for whoever looks it up
             entry.namespace = ns
@@ -111,8 +133,6 @@ class WorldServices:
             if ref not in WORLD_FRAMES:
                 rpos, rquat = self.engine.model_pose(ref)
                 qi = np.array([rquat[0], -rquat[1], -rquat[2], -rquat[3]])
-                import mujoco
-
                 for v in (pos, lin, ang):
                     out = np.zeros(3)
                     mujoco.mju_rotVecQuat(out, v - (rpos if v is pos else 0), qi)

@@ -15,7 +15,8 @@ frame, empty when nothing was seen), as grobot's ``MarkerFollower`` is. For each
    x, y and yaw, publish that on ``move_base_simple/goal``, broadcast ``map -> target`` and count
    it as an update.
 
-A tf failure is a warning and no update. Every 5 s ``move_base/clear_costmaps`` is called (the
+A tf failure means no update (and a warning once it has lasted tf's grace period).
+Every 5 s ``move_base/clear_costmaps`` is called (the
 moving target's stale obstacle marks). Unlike the original, which constructs its errors without
 throwing them, wrong parameters are `ParameterError`s naming the parameter; every parameter
 has the tutorial's launch value as its default (the original has none).
@@ -35,6 +36,7 @@ from fleetsim.msgs import fiducial_msgs, geometry_msgs, std_srvs
 from fleetsim.runtime import Node, param
 from fleetsim.runtime.params import load_params
 from fleetsim.tf import TransformBroadcaster, make_transform_stamped
+from fleetsim.tf.patience import TransformPatience
 from fleetsim.tf.quaternions import quaternion_from_euler, quaternion_from_yaw, yaw_from_quaternion
 from fleetsim.tf.transforms import compose_transforms
 
@@ -91,6 +93,7 @@ class FollowMarker(Node):
         self.last_update: float = 0.0  # image time of the last update (ros::Time(0) at start)
         self.goals_sent = 0
         self._warned: set[str] = set()
+        self._patience = TransformPatience()  # tf failures are reported once they last
         self.goal_pub = self.create_publisher(geometry_msgs.PoseStamped, "move_base_simple/goal")
         self.tf_pub = TransformBroadcaster(self)
         _ = self.tf_buffer  # listen to /tf from now on
@@ -104,6 +107,18 @@ class FollowMarker(Node):
         if key not in self._warned:
             self._warned.add(key)
             self.get_logger().warning(text)
+
+    def _lookup(self, key: str, target: str, source: str, stamp: Any):
+        """``target <- source`` at ``stamp``, or None (warned about once the failure has lasted
+        tf's grace period: localization starts a little after the first images)."""
+        try:
+            found = self.tf_buffer.lookup_arrays(target, source, stamp)
+        except TransformError as err:
+            if self._patience.missing_too_long(key, self.now()):
+                self._warn_once(key, f"cannot place the marker in {target}: {err}")
+            return None
+        self._patience.found(key)
+        return found
 
     def clear_costmaps(self) -> None:
         """Call move_base/clear_costmaps and ignore the result, as the original does."""
@@ -128,23 +143,17 @@ class FollowMarker(Node):
             np.array([tr.x, tr.y, tr.z]), np.array([q.x, q.y, q.z, q.w]), *MARKER_TO_MARKER
         )
         camera = msg.header.frame_id
-        try:
-            in_base = compose_transforms(
-                *self.tf_buffer.lookup_arrays(self.base_frame, camera, msg.header.stamp), *marker
-            )
-        except TransformError as err:
-            self._warn_once("base", f"cannot place the marker in {self.base_frame}: {err}")
+        base_camera = self._lookup("base", self.base_frame, camera, msg.header.stamp)
+        if base_camera is None:
             return
+        in_base = compose_transforms(*base_camera, *marker)
         if 0.5 * np.hypot(in_base[0][0], in_base[0][1]) < np.hypot(*self.offset[:2]):
             self.last_update = stamp  # too close: move_base finishes the last goal
             return
-        try:
-            in_map = compose_transforms(
-                *self.tf_buffer.lookup_arrays(self.map_frame, camera, msg.header.stamp), *marker
-            )
-        except TransformError as err:
-            self._warn_once("map", f"cannot place the marker in {self.map_frame}: {err}")
+        map_camera = self._lookup("map", self.map_frame, camera, msg.header.stamp)
+        if map_camera is None:
             return
+        in_map = compose_transforms(*map_camera, *marker)
         t, q_t = compose_transforms(*in_map, self.offset, np.array([0.0, 0.0, 0.0, 1.0]))
         t = np.array([t[0], t[1], 0.0])
         q_t = quaternion_from_yaw(yaw_from_quaternion(q_t))

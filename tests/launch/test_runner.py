@@ -56,3 +56,19 @@ def test_node_errors_name_the_node(tmp_path: Path):
 def test_missing_file():
     with pytest.raises(LaunchError, match="does not exist"):
         load_plan("/nope/x.launch")
+
+
+def test_the_error_that_ended_a_run_is_not_hidden_by_shutdown_errors(tmp_path: Path, caplog):
+    f = tmp_path / "robots.launch"
+    f.write_text(ROBOTS)
+
+    def broken_hook():
+        raise RuntimeError("hook broke")
+
+    with (
+        pytest.raises(LaunchError, match="the run's own error"),
+        LaunchSession(load_plan(f)) as s,
+    ):
+        s.runtime.on_shutdown(broken_hook)
+        raise LaunchError("the run's own error")
+    assert "while shutting down after 'the run's own error': hook broke" in caplog.text

@@ -197,5 +197,11 @@ class LaunchSession:
     def __enter__(self) -> LaunchSession:
         return self
 
-    def __exit__(self, *exc: object) -> None:
-        self.close()
+    def __exit__(self, exc_type, exc, tb) -> None:
+        try:
+            self.close()
+        except Exception as e:
+            if exc is None:
+                raise
+            # the error that ended the run (e.g. a physics instability) is the one to report
+            _log.error(f"while shutting down after '{exc}': {e}")

@@ -26,7 +26,7 @@ from fleetsim.sim.plugins.base import (
     OdometryReading,
     ScanReading,
 )
-from fleetsim.sim.plugins.camera import CameraPlugin, compressed_image_msg
+from fleetsim.sim.plugins.camera import CameraPlugin
 from fleetsim.sim.services import WorldServices
 from fleetsim.sim.world import WALL_HEIGHT
 
@@ -226,7 +226,9 @@ class Simulator(Node):
             rnames.resolve(f"{r.topic}/compressed", ns), sensor_msgs.CompressedImage
         )
         if jpeg.topic.subscriptions:  # encoded only for subscribers, as image_transport does
-            jpeg.publish(compressed_image_msg(img.header.stamp, r.frame_id, r.image))
+            from fleetsim.vision.image_transport import compress_image  # cv2 only then
+
+            jpeg.publish(compress_image(img))
         info = conv.camera_info_msg(r)
         self._publisher(rnames.resolve(r.info_topic, ns), sensor_msgs.CameraInfo).publish(info)
         if r.depth is not None:

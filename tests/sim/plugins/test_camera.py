@@ -148,8 +148,7 @@ def test_waffle_camera_topics_as_the_tutorial_reads_them(monkeypatch, tmp_path):
     import cv2
 
     from fleetsim.msgs import sensor_msgs
-    from fleetsim.sim import node as sim_node
-    from fleetsim.sim.plugins import camera as camera_module
+    from fleetsim.vision import image_transport
 
     monkeypatch.chdir(tmp_path)
     rt, sim, cam = waffle_facing_a_marker()
@@ -157,10 +156,10 @@ def test_waffle_camera_topics_as_the_tutorial_reads_them(monkeypatch, tmp_path):
     depth_renders, encodes = [], []
     original_render = cam.render
     cam.render = lambda e, depth=False: depth_renders.append(depth) or original_render(e, depth)
-    original_encode = camera_module.compressed_image_msg
+    original_encode = image_transport.compress_image
     monkeypatch.setattr(
-        sim_node,
-        "compressed_image_msg",
+        image_transport,
+        "compress_image",
         lambda *a, **k: encodes.append(1) or original_encode(*a, **k),
     )
     raw, infos, jpegs = [], [], []

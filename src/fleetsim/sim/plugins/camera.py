@@ -10,11 +10,12 @@ depth cameras also publish an organised XYZRGB point cloud in the optical conven
 ``frameName`` (z along the view, x right, y down).
 
 Beside ``<imageTopicName>`` the simulator node publishes ``<imageTopicName>/compressed`` as
-image_transport's ``compressed`` plugin does (``compressed_image_msg``), so a node reading
-``camera/rgb/image_raw/compressed`` (aruco_detect with ``image_transport: compressed``) works as
-on a ROS system. Nothing is rendered or encoded for topics nobody subscribes to: the RGB image
-only while one of the camera's topics has a subscriber, the depth image only while a depth or
-point cloud topic has one, the JPEG only while the compressed topic has one.
+image_transport's ``compressed`` plugin does (``vision.image_transport.compress_image``), so a
+node reading ``camera/rgb/image_raw/compressed`` (aruco_detect with ``image_transport:
+compressed``) works as on a ROS system. Nothing is rendered or encoded for topics nobody
+subscribes to: the RGB image only while one of the camera's topics has a subscriber, the depth
+image only while a depth or point cloud topic has one, the JPEG only while the compressed topic
+has one.
 """
 
 from __future__ import annotations
@@ -29,10 +30,6 @@ from fleetsim.errors import SimulationError
 from fleetsim.runtime.params import param
 from fleetsim.sim.build import COLLISION_GROUP, quat_from_rpy
 from fleetsim.sim.plugins.base import ImageReading, SensorPlugin, register, require_link
-
-#: what compressed_image_transport writes in ``format`` for an rgb8 image sent as JPEG
-COMPRESSED_FORMAT = "rgb8; jpeg compressed bgr8"
-JPEG_QUALITY = 80  # compressed_image_transport's default ``jpeg_quality``
 
 # MuJoCo camera axes (x right, y up, looking along -z) expressed in a Gazebo camera link frame
 _CAM_FROM_LINK = np.array([[0.0, 0.0, -1.0], [-1.0, 0.0, 0.0], [0.0, 1.0, 0.0]])
@@ -196,32 +193,3 @@ class CameraPlugin(SensorPlugin):
 class DepthCameraPlugin(CameraPlugin):
     Params = DepthCameraParams
     depth_enabled = True
-
-
-def compressed_image_msg(stamp, frame_id: str, image: np.ndarray, quality: int = JPEG_QUALITY):
-    """An rgb8 image as image_transport's ``compressed`` plugin publishes it: a
-    ``sensor_msgs/CompressedImage`` holding the JPEG of the image in BGR order, ``format``
-    ``"rgb8; jpeg compressed bgr8"``.
-
-    Parameters
-    ----------
-    stamp : builtin_interfaces Time of the image.
-    frame_id : the optical frame.
-    image : ndarray, shape (H, W, 3), uint8, RGB.
-    quality : JPEG quality, 1..100.
-    """
-    import cv2  # only cameras with compressed subscribers pay for the import
-
-    from fleetsim.msgs import sensor_msgs
-
-    ok, jpeg = cv2.imencode(
-        ".jpg", cv2.cvtColor(image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, int(quality)]
-    )
-    if not ok:
-        raise SimulationError(f"camera image of frame '{frame_id}' could not be JPEG-encoded")
-    msg = sensor_msgs.CompressedImage()
-    msg.header.stamp = stamp
-    msg.header.frame_id = frame_id
-    msg.format = COMPRESSED_FORMAT
-    msg.data = jpeg.reshape(-1)
-    return msg

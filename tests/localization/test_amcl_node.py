@@ -183,7 +183,9 @@ def test_bad_input_is_logged_not_raised(caplog):
     with caplog.at_level(logging.WARNING):
         amcl = Amcl(rt, "amcl")  # no map server yet
         rt.run(duration=0.5)
-        assert "waiting for the map: no service /static_map" in caplog.text
+        assert "no service" not in caplog.text  # map_server may start a moment later
+        rt.run(duration=0.7)
+        assert "waiting for the map: no service /static_map; start map_server" in caplog.text
         assert "received a scan but no map yet" in caplog.text
         FakeMapServer(rt)
         rt.run(duration=1.5)
@@ -280,3 +282,17 @@ def test_a_scan_ahead_of_its_odometry_waits_for_tf_without_amcl_reading_all_of_t
     assert len(amcl._pending_scans) == 1
     rt.run(duration=0.1)  # the robot's tf at 0.6 s lets it through, before the robot's own scan
     assert len(amcl._pending_scans) == 0
+
+
+def test_an_amcl_in_a_namespace_is_told_to_remap_static_map(caplog):
+    # the lesson's amcl_node.xml in <group ns="lizi1"> asks for /lizi1/static_map
+    rt = Runtime()
+    FakeMapServer(rt)
+    with caplog.at_level(logging.WARNING):
+        amcl = Amcl(rt, "amcl", "/lizi1")
+        rt.run(duration=1.5)
+    assert not amcl.map_received
+    assert (
+        "no service /lizi1/static_map, but /static_map is there; add "
+        '<remap from="static_map" to="/static_map"/>' in caplog.text
+    )

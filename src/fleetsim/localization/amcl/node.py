@@ -42,6 +42,9 @@ from .scan import beams_from_scan
 MAP_RETRY_PERIOD = 1.0  # s of sim time between static_map attempts
 SCAN_QUEUE_SIZE = 100  # scans waiting for their odometry in tf (amcl's laser_scan_filter_)
 
+#: s of sim time before a missing map service is reported (nodes start in any order)
+MAP_GRACE = 1.0
+
 
 def _yaw_of(q: Any) -> float:
     return math.atan2(2.0 * (q.w * q.z + q.x * q.y), 1.0 - 2.0 * (q.y * q.y + q.z * q.z))
@@ -117,11 +120,8 @@ class Amcl(Node):
             return
         client = self._map_client
         if not client.service_is_ready():
-            self._warn_once(
-                "static_map",
-                f"waiting for the map: no service {client.name}; start map_server, or set "
-                "use_map_topic",
-            )
+            if self.now() >= MAP_GRACE:  # map_server may come up a moment later
+                self._warn_once("static_map", self._no_map_service_text(client.name))
             return
         try:
             resp = client.call(nav_msgs.GetMap.Request())
@@ -131,6 +131,19 @@ class Amcl(Node):
         self.on_map(resp.map)
         if self.map_received:
             self._map_timer.cancel()
+
+    def _no_map_service_text(self, name: str) -> str:
+        """What to do when ``static_map`` is not there: name a map service elsewhere in the
+        graph (map_server's global ``/static_map`` for an amcl in a robot's namespace)."""
+        base = name.rsplit("/", 1)[-1]
+        others = sorted(s for s in self.runtime.graph.services if s.rsplit("/", 1)[-1] == base)
+        if others:
+            return (
+                f"waiting for the map: no service {name}, but {others[0]} is there; add "
+                f'<remap from="{base}" to="{others[0]}"/> to the amcl node, or set '
+                "use_map_topic with the map topic remapped"
+            )
+        return f"waiting for the map: no service {name}; start map_server, or set use_map_topic"
 
     def on_map(self, msg: nav_msgs.OccupancyGrid) -> None:
         """Use a new map (amcl's handleMapMessage); ``first_map_only`` keeps the first."""

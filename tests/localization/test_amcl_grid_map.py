@@ -92,3 +92,20 @@ def test_bad_maps_raise():
     full = AmclMap.from_occupancy(np.full(4, 100), 2, 2, 0.1)
     with pytest.raises(LocalizationError, match="no free cell"):
         full.random_free_poses(3, np.random.default_rng(0))
+
+
+def test_amcls_given_the_same_map_message_share_one_map():
+    from fleetsim.msgs import nav_msgs
+
+    info = nav_msgs.MapMetaData(resolution=0.5, width=3, height=2)
+    msg = nav_msgs.OccupancyGrid(info=info, data=np.array([0, 100, 0, -1, 0, 0], np.int8))
+    a = AmclMap.shared_from_grid_msg(msg)
+    assert AmclMap.shared_from_grid_msg(msg) is a  # the latched map, as each amcl gets it
+    assert a.distance_field(1.0) is AmclMap.shared_from_grid_msg(msg).distance_field(1.0)
+    assert not a.free_cells.flags.writeable
+    other = nav_msgs.OccupancyGrid(info=info, data=msg.data.copy())  # equal, not the same
+    b = AmclMap.shared_from_grid_msg(other)
+    assert b is not a and np.array_equal(b.occ_state, a.occ_state)
+    moved = nav_msgs.OccupancyGrid(info=nav_msgs.MapMetaData(resolution=0.25, width=3, height=2))
+    moved.data = msg.data  # same cells, another geometry
+    assert AmclMap.shared_from_grid_msg(moved).resolution == 0.25

@@ -48,6 +48,11 @@ def distances_to_obstacles(occupied: np.ndarray, resolution: float, max_dist: fl
     return np.minimum(dist, max_dist)
 
 
+#: maps shared by amcl nodes: id(message data) -> (data, geometry, AmclMap); a few, oldest out
+_SHARED: dict[int, tuple[Any, tuple, Any]] = {}
+_SHARED_KEPT = 4
+
+
 @dataclass(frozen=True, eq=False)
 class AmclMap:
     """An occupancy map in amcl's three states, with cached derived fields.
@@ -124,6 +129,27 @@ class AmclMap:
             msg.data, info.width, info.height, info.resolution, (pos.x, pos.y, yaw), source
         )
 
+    @classmethod
+    def shared_from_grid_msg(cls, msg: Any, source: str = "map") -> AmclMap:
+        """`from_grid_msg`, shared by every amcl in the process that gets the same message
+        (the latched map, or map_server's static_map answer: one data array): an AmclMap is
+        read only, so N robots' amcls hold one map and one likelihood field, not N."""
+        data = msg.data
+        hit = _SHARED.get(id(data))
+        if hit is not None and hit[0] is data:
+            info, origin = msg.info, msg.info.origin
+            if hit[1] == (info.width, info.height, info.resolution, origin):
+                return hit[2]
+        grid = cls.from_grid_msg(msg, source)
+        if len(_SHARED) >= _SHARED_KEPT:
+            _SHARED.pop(next(iter(_SHARED)))
+        _SHARED[id(data)] = (
+            data,
+            (msg.info.width, msg.info.height, msg.info.resolution, msg.info.origin),
+            grid,
+        )
+        return grid
+
     @property
     def height(self) -> int:
         return int(self.occ_state.shape[0])
@@ -161,7 +187,9 @@ class AmclMap:
         """(F, 2) int64 ``(i, j)`` indices of free cells (cached)."""
         if "free" not in self._cache:
             j, i = np.nonzero(self.occ_state == FREE)
-            self._cache["free"] = np.stack([i, j], axis=1).astype(np.int64)
+            free = np.stack([i, j], axis=1).astype(np.int64)
+            free.setflags(write=False)  # shared by the amcls of one map
+            self._cache["free"] = free
         return self._cache["free"]
 
     def cells_from_points(self, xy: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -159,7 +159,7 @@ class Amcl(Node):
 
     def _grid_from(self, msg: nav_msgs.OccupancyGrid) -> AmclMap | None:
         try:
-            return AmclMap.from_grid_msg(msg, source=f"{self.full_name} map")
+            return AmclMap.shared_from_grid_msg(msg, source=f"{self.full_name} map")
         except LocalizationError as err:
             self.get_logger().error(f"ignoring map: {err}")
             return None

@@ -148,7 +148,8 @@ class ArucoDetect(Node):
 
     def on_compressed(self, msg: sensor_msgs.CompressedImage) -> None:
         if self.enabled:
-            if self.images_pub is not None:  # one decode to colour serves both
+            if self.images_pub is not None and self.images_pub.get_num_connections():
+                # one decode to colour serves both (only when someone looks at the images)
                 bgr = decompressed_array(msg, self.image_topic)
                 gray = cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY)
                 self.process(gray, msg.header.stamp, lambda: bgr)

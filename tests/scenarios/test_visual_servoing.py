@@ -16,8 +16,10 @@ import numpy as np
 import pytest
 
 from fleetsim.cli.launch import resolve_launch_file, scenarios
+from fleetsim.cli.main import main
 from fleetsim.launch.runner import LaunchSession, load_plan
 from fleetsim.msgs import fiducial_msgs, geometry_msgs, move_base_msgs
+from fleetsim.record.reader import read_messages
 from fleetsim.tf.quaternions import yaw_from_quaternion
 
 pytestmark = pytest.mark.scenario
@@ -152,3 +154,16 @@ def test_visual_servoing_move_to_target_follows_loses_goes_to_the_vantage_point_
         _, x, y, yaw = ev.explorations[0]
         assert (x, y) == (1.0, 0.0) and math.remainder(yaw - 3.1416, math.tau) == pytest.approx(0)
         no_mujoco_warnings(s)
+
+
+def test_cli_runs_it_and_records_the_fiducial_transforms(tmp_path, capsys):
+    bag = tmp_path / "vs.mcap"
+    argv = ["launch", "visual_servoing", "exploration_strategy:=rotate"]
+    argv += [f"{k}:={v}" for k, v in BEHIND_KARL.items()]
+    argv += ["--duration", "2", "--record", str(bag), "--no-bridge"]
+    assert main(argv) == 0
+    msgs = list(read_messages(bag, ["/fiducial_transforms"]))
+    assert len(msgs) >= 15  # 10 Hz camera, from the first frame
+    seen = [m for m in msgs if m.msg.transforms]
+    assert seen and seen[-1].msg.transforms[0].fiducial_id == 0
+    assert seen[-1].msg.header.frame_id == "camera_rgb_optical_frame"

@@ -7,6 +7,8 @@ fixed seeds.
 import numpy as np
 import pytest
 from amcl_world import ROUTE, drive, scan, world_map
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from fleetsim.localization.amcl import (
     AmclParams,
@@ -196,3 +198,18 @@ def test_same_seed_same_result():
         return pf.particles
 
     np.testing.assert_array_equal(once(), once())
+
+
+@given(st.tuples(st.floats(-1, 1), st.floats(-1, 1), st.floats(-3, 3)))
+@settings(max_examples=40, deadline=None)
+def test_needs_update_says_what_update_will_do(odom):
+    """The node reads a scan only when needs_update says the filter will use it."""
+    params = AmclParams(initial_pose_x=5.0, initial_pose_y=5.0, laser_max_beams=20)
+    pf = ParticleFilter(params, np.random.default_rng(0), GRID)
+    b = beams_at([5.0, 5.0, 0.0], n=20)
+    assert pf.needs_update(np.zeros(3))  # the first scan always
+    pf.update(np.zeros(3), b)
+    pose = np.array(odom)
+    assert pf.needs_update(pose) == pf.update(pose, b).updated
+    pf.request_nomotion_update()
+    assert pf.needs_update(pf.odom_pose)

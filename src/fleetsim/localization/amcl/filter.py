@@ -175,27 +175,31 @@ class ParticleFilter:
             )
         return self.grid
 
+    def needs_update(self, odom_pose: np.ndarray) -> bool:
+        """Whether a scan at ``odom_pose`` would update the filter: the first one, a move of
+        more than ``update_min_d`` / ``update_min_a`` since the last update, or a forced one
+        (amcl's ``update_min_*`` rule; amcl reads no more of a scan otherwise)."""
+        if self.odom_pose is None or self.force_update:
+            return True
+        p = self.params
+        d = odometry_delta(self.odom_pose, np.asarray(odom_pose, dtype=np.float64).reshape(3))
+        return bool(
+            abs(d[0]) > p.update_min_d or abs(d[1]) > p.update_min_d or abs(d[2]) > p.update_min_a
+        )
+
     def update(self, odom_pose: np.ndarray, beams: ScanBeams) -> UpdateResult:
         """Process one scan taken at odometry pose ``odom_pose`` (3,) ``(x, y, yaw)``."""
         grid = self._require_map()
-        p = self.params
         pose = np.asarray(odom_pose, dtype=np.float64).reshape(3)
         if not np.all(np.isfinite(pose)):
             raise LocalizationError(f"amcl: odometry pose {pose} is not finite")
         first = self.odom_pose is None
-        if first:
-            do_update = True
-        else:
-            d = odometry_delta(self.odom_pose, pose)
-            do_update = bool(
-                abs(d[0]) > p.update_min_d
-                or abs(d[1]) > p.update_min_d
-                or abs(d[2]) > p.update_min_a
-                or self.force_update
-            )
+        do_update = self.needs_update(pose)
+        if not first:
             self.force_update = False
         if not do_update:
             return UpdateResult(False, False, False)
+        p = self.params
         if first:
             self.resample_count = 0
         else:

@@ -311,6 +311,9 @@ class Amcl(Node):
             return True
         if self.filter.grid is None:
             return True
+        if not self.filter.needs_update(odom_pose):  # not moved enough: the scan is not read
+            self._send_map_to_odom_if_known(stamp)
+            return True
         p = self.params
         try:
             beams = beams_from_scan(
@@ -333,9 +336,12 @@ class Amcl(Node):
             self._publish_cloud(scan.header.stamp)
         if result.estimate_changed:
             self._publish_pose(scan.header.stamp, odom_pose)
+        self._send_map_to_odom_if_known(stamp)
+        return True
+
+    def _send_map_to_odom_if_known(self, stamp: float) -> None:
         if self._map_to_odom is not None and self.tf_pub is not None:
             self._send_map_to_odom(stamp)
-        return True
 
     # ----- outputs -----
     def _publish_cloud(self, stamp: Time) -> None:

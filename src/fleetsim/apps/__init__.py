@@ -1,10 +1,14 @@
 """Application nodes from the seeds, above the simulator and the navigation stack.
 
 The visual servoing tutorial's (grobot's) nodes: ``patrol_server`` / ``patrol_client`` drive a
-robot round a circle through the ``Patrol`` action. sim/ and nav/ never import this package.
+robot round a circle through the ``Patrol`` action; ``spawn_marker_on_robot`` puts an ArUco marker
+on a robot's back; ``follow_marker`` follows it with move_base goals. sim/ and nav/ never import
+this package.
 """
 
+from fleetsim.apps.follow_marker import FollowMarker
 from fleetsim.apps.patrol_client import PatrolClient
 from fleetsim.apps.patrol_server import PatrolServer
+from fleetsim.apps.spawn_marker_on_robot import SpawnMarkerOnRobot
 
-__all__ = ["PatrolClient", "PatrolServer"]
+__all__ = ["FollowMarker", "PatrolClient", "PatrolServer", "SpawnMarkerOnRobot"]

@@ -46,14 +46,24 @@ def top_speed(entry, drive) -> float:
     return min(lim.velocity for lim in limits if lim is not None) * drive.radius
 
 
-def run_clean(e: Engine, commands, seconds: float) -> None:
-    """Drive for ``seconds``; no warning counter may trip and accelerations stay sane."""
+def tilt(e: Engine, name: str) -> float:
+    """Angle (rad) between the model root's z axis and the world's."""
+    w, x, y, _ = e.model_pose(name)[1]
+    return math.acos(max(-1.0, min(1.0, 1.0 - 2.0 * (x * x + y * y))))
+
+
+def run_clean(e: Engine, commands, seconds: float) -> float:
+    """Drive for ``seconds``; no warning counter may trip and accelerations stay sane.
+    Returns the largest tilt (rad) any driven robot reached."""
+    most = 0.0
     for _ in range(round(seconds / 0.05)):
         for drive, vx, wz in commands:
             drive.command(vx, wz, e.time)
         e.advance(0.05)
         assert not e.data.warning.number.any()
         assert np.isfinite(e.data.qacc).all() and np.abs(e.data.qacc).max() < 1e5
+        most = max([most, *(tilt(e, d.ctx.model) for d, _, _ in commands)])
+    return most
 
 
 @pytest.mark.parametrize("path", FILES, ids=[p.parts[-3] for p in FILES])
@@ -78,6 +88,26 @@ def test_robots_at_top_speed_into_each_other_stay_sane(path):
     da, db = drive_of(a), drive_of(b)
     v = top_speed(a, da)
     run_clean(e, [(da, v, 0.0), (db, v, 1.0)], 1.5)
+
+
+@pytest.mark.parametrize("path", FILES, ids=[p.parts[-3] for p in FILES])
+def test_at_navigation_speed_robots_push_walls_and_robots_without_climbing(path):
+    # 0.5 m/s, the shipped move_base limit; at top speed four-wheel drives may ride up (real
+    # ones do), but at this speed a wall or another robot stops them flat on the ground
+    wall = ModelDesc(
+        "wall", (1.2, 0, 0.5, 0, 0, 0), True, [LinkDesc("l", geoms=[GeomDesc("box", (0.1, 6, 1))])]
+    )
+    robot = load_robot(path)
+    e = Engine(WorldDesc("w", [ground_plane(), wall]))
+    entry = e.spawn_robot("bot", robot, (0, 0, 0, 0, 0, 0.4))
+    drive = drive_of(entry)
+    v = min(0.5, top_speed(entry, drive))
+    assert run_clean(e, [(drive, v, 0.0)], 2.0) < 0.15
+    e = Engine(None)
+    a, b = e.spawn_robots(
+        [("a", robot, (0, 0, 0, 0, 0, 0)), ("b", robot, (1.5, 0.1, 0, 0, 0, math.pi - 0.3))]
+    )
+    assert run_clean(e, [(drive_of(a), v, 0.0), (drive_of(b), v, 1.0)], 2.0) < 0.15
 
 
 def test_nan_force_names_robot_body_and_joint(diffbot, caplog):

@@ -3,7 +3,8 @@ circle with markers that stay on their backs) and visual_servoing.launch with ea
 strategy (the waffle sees karl's marker, follows it, loses it, explores, finds it again).
 
 The follower starts 1.8 m behind karl (launch args x, y, yaw) instead of across the building, so
-the cycle happens within a minute of sim time; the camera is the launch's 640x360 at 10 Hz.
+the cycle happens within a minute of sim time (each run stops once the marker is found again);
+the camera is the launch's 640x360 at 10 Hz.
 """
 
 from __future__ import annotations
@@ -113,6 +114,13 @@ class Events:
         yaw = yaw_from_quaternion([q.x, q.y, q.z, q.w])
         self.explorations.append((m.header.stamp.to_sec(), p.position.x, p.position.y, yaw))
 
+    def found_again(self) -> bool:
+        """True once the marker was seen after an exploration had started."""
+        if not self.explorations:
+            return False
+        start = self.explorations[0][0]
+        return any(seen and t > start for t, seen in self.seen[-5:])
+
     def cycle(self) -> tuple[float, float, float]:
         """(first seen, first exploration, seen again after it); asserts each happened."""
         times = [t for t, seen in self.seen if seen]
@@ -131,7 +139,8 @@ class Events:
 def test_visual_servoing_rotate_follows_loses_rotates_finds_again():
     with session("visual_servoing", exploration_strategy="rotate", **BEHIND_KARL) as s:
         ev = Events(s)
-        s.runtime.run(duration=20.0)
+        s.runtime.run(duration=90.0, until=ev.found_again)  # typically ~20 s
+        s.runtime.run(duration=1.0)  # and follows again
         first, explore, again = ev.cycle()
         assert first < 1.0  # karl's marker is in view from the start
         assert any(g > again for g in ev.goals)  # following again
@@ -148,7 +157,7 @@ def test_visual_servoing_rotate_follows_loses_rotates_finds_again():
 def test_visual_servoing_move_to_target_follows_loses_goes_to_the_vantage_point_finds_again():
     with session("visual_servoing", exploration_strategy="move_to_target", **BEHIND_KARL) as s:
         ev = Events(s)
-        s.runtime.run(duration=42.0)
+        s.runtime.run(duration=120.0, until=ev.found_again)  # typically ~40 s
         first, explore, again = ev.cycle()
         assert first < 1.0
         _, x, y, yaw = ev.explorations[0]

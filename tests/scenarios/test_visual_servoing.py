@@ -19,8 +19,9 @@ import pytest
 from fleetsim.cli.launch import resolve_launch_file, scenarios
 from fleetsim.cli.main import main
 from fleetsim.launch.runner import LaunchSession, load_plan
-from fleetsim.msgs import fiducial_msgs, geometry_msgs, move_base_msgs
+from fleetsim.msgs import fiducial_msgs, geometry_msgs, move_base_msgs, sensor_msgs
 from fleetsim.record.reader import read_messages
+from fleetsim.tf.patience import GRACE
 from fleetsim.tf.quaternions import yaw_from_quaternion
 
 pytestmark = pytest.mark.scenario
@@ -176,3 +177,17 @@ def test_cli_runs_it_and_records_the_fiducial_transforms(tmp_path, capsys):
     seen = [m for m in msgs if m.msg.transforms]
     assert seen and seen[-1].msg.transforms[0].fiducial_id == 0
     assert seen[-1].msg.header.frame_id == "camera_rgb_optical_frame"
+
+
+def test_navigation_localizes_the_waffle_and_publishes_its_camera():
+    with session("navigation") as s:
+        images = []
+        s.runtime.graph.subscribe(
+            "/camera/rgb/image_raw/compressed", sensor_msgs.CompressedImage, images.append, 0
+        )
+        s.run(duration=GRACE + 1.0)
+        t, _ = s.runtime.tf_buffer.lookup_arrays("map", "base_footprint", 0.0)
+        assert t[:2] == pytest.approx([4.95, 1.10], abs=0.1)  # amcl from the initial pose
+        assert len(images) >= 50 and images[-1].header.frame_id == "camera_rgb_optical_frame"
+        assert "/move_base/clear_costmaps" in s.runtime.graph.services
+        no_mujoco_warnings(s)

@@ -62,6 +62,14 @@ class SimulationError(FleetsimError):
     """A world or simulator setup that cannot be built."""
 
 
+class ControlError(FleetsimError):
+    """ros_control: a controller that cannot be loaded, switched or commanded."""
+
+
+class PlanningError(FleetsimError):
+    """move_group: a bad planning request (group, target, limits) or a failed plan."""
+
+
 class LaunchError(FleetsimError):
     """A launch file that cannot be read or run."""
 

@@ -169,8 +169,13 @@ def test_hunter_srdf_and_controller_config(robots):
     cfg = ASSET_ROBOTS / "hunter" / "config"
     srdf = load_srdf(cfg / "robocluedo_robot.srdf", r)
     arm = [f"arm_joint_0{i}" for i in range(1, 5)]
-    assert srdf.group_joints("arm_group", r) == arm
-    assert srdf.group_states[("arm_group", "home")] == dict.fromkeys(arm, 0.0)
+    # the chain starts at base_link, so it holds the fixed arm_base_to_base too (as MoveIt's
+    # joint model group does; its active joints are the four arm joints)
+    assert srdf.group_joints("arm_group", r) == ["arm_base_to_base", *arm]
+    assert srdf.group_states[("arm_group", "home")] == dict(
+        zip(arm, [-1.57, 0.1293, -0.4276, 0.3481], strict=True)
+    )
+    assert len([k for k in srdf.group_states if k[0] == "arm_group"]) == 9
     ctrl = yaml.safe_load((cfg / "ros_controllers.yaml").read_text())
     c = ctrl["arm_group_controller"]
     assert c["type"] == "effort_controllers/JointTrajectoryController"

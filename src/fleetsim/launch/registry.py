@@ -33,6 +33,7 @@ NODES: dict[tuple[str, str], str] = {
     ("aruco_detect", "aruco_detect"): "fleetsim.vision.aruco_detect:ArucoDetect",
     ("grobot_utilities", "spawn_marker_on_robot"): "fleetsim.apps.spawn_marker_on_robot:SpawnMarkerOnRobot",
     ("grobot_navigation", "follow_marker"): "fleetsim.apps.follow_marker:FollowMarker",
+    ("controller_manager", "spawner"): "fleetsim.control.spawner:Spawner",
 }  # fmt: skip
 
 

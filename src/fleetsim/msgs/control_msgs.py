@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import ClassVar
 
 from fleetsim.msgs.builtin_interfaces import Duration
-from fleetsim.msgs.fields import Seq, float64, int32, string
+from fleetsim.msgs.fields import Seq, bool_, float64, int32, string
 from fleetsim.msgs.interfaces import make_action_type
 from fleetsim.msgs.registry import message
 from fleetsim.msgs.std_msgs import Header
@@ -63,3 +63,32 @@ FollowJointTrajectoryActionGoal = FollowJointTrajectory.ActionGoal
 FollowJointTrajectoryActionResult = FollowJointTrajectory.ActionResult
 FollowJointTrajectoryActionFeedback = FollowJointTrajectory.ActionFeedback
 FollowJointTrajectoryAction = FollowJointTrajectory.Action
+
+
+@message("control_msgs/msg/JointTrajectoryControllerState")
+class JointTrajectoryControllerState:
+    """A JointTrajectoryController's ``state`` topic: desired, actual and error per joint."""
+
+    header: Header
+    joint_names: Seq[string]
+    desired: JointTrajectoryPoint
+    actual: JointTrajectoryPoint
+    error: JointTrajectoryPoint
+
+
+@message("control_msgs/msg/JointControllerState")
+class JointControllerState:
+    """A single-joint controller's ``state`` topic (JointPositionController)."""
+
+    header: Header
+    set_point: float64
+    process_value: float64
+    process_value_dot: float64
+    error: float64
+    time_step: float64
+    command: float64
+    p: float64
+    i: float64
+    d: float64
+    i_clamp: float64
+    antiwindup: bool_

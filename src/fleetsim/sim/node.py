@@ -27,6 +27,7 @@ from fleetsim.sim.plugins.base import (
     ScanReading,
 )
 from fleetsim.sim.plugins.camera import CameraPlugin
+from fleetsim.sim.plugins.ros_control import start_controller_managers
 from fleetsim.sim.services import WorldServices
 from fleetsim.sim.world import WALL_HEIGHT
 
@@ -143,6 +144,8 @@ class Simulator(Node):
                     p.depth_wanted = lambda topics=depth: self._has_subscribers(topics)
                 topics = [self.topic(entry, p.topic(n)) for n in names] + depth
                 p.wanted = lambda topics=topics: self._has_subscribers(topics)
+        # gazebo_ros_control: the robot's controller_manager, destroyed with the model
+        subs.extend(start_controller_managers(self, entry))
         self._subs[entry.name] = subs
 
     def _has_subscribers(self, topics: list[str]) -> bool:

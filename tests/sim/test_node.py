@@ -170,3 +170,44 @@ def test_world_services(sim):
     assert "bot" not in s.engine.models
     probe.create_client(std_srvs.Empty, "/gazebo/reset_simulation").call(empty)
     assert s.engine.time == 0.0
+
+
+def test_messages_nobody_subscribes_to_are_not_built(sim, monkeypatch):
+    from fleetsim.msgs import nav_msgs
+    from fleetsim.sim import messages as conv
+
+    rt, s, probe = sim
+    assert spawn(probe, "bot", (22.0, 15.0), ns="/lizi1").success
+    built = {"odom": 0, "states": 0}
+
+    def counting(name, fn):
+        def wrapped(*a, **k):
+            built[name] += 1
+            return fn(*a, **k)
+
+        return wrapped
+
+    monkeypatch.setattr(conv, "odometry_msg", counting("odom", conv.odometry_msg))
+    monkeypatch.setattr(conv, "model_states_msg", counting("states", conv.model_states_msg))
+    monkeypatch.setattr(
+        s.engine, "contacts", counting("contacts", s.engine.contacts), raising=False
+    )
+    built["contacts"] = 0
+    import fleetsim.sim.node as node_module
+
+    monkeypatch.setitem(
+        node_module._READING_MESSAGES,
+        node_module.OdometryReading,
+        (nav_msgs.Odometry, conv.odometry_msg),
+    )
+    buf = rt.tf_buffer  # listening from now on
+    rt.run(duration=0.3)
+    assert built == {"odom": 0, "states": 0, "contacts": 0}  # tf still goes out:
+    assert "lizi1/odom" in buf.all_frames(), buf.all_frames()
+    odoms, states, contacts = [], [], []
+    collect(probe, nav_msgs.Odometry, "/lizi1/odom", odoms)
+    collect(probe, gazebo_msgs.ModelStates, "/gazebo/model_states", states)
+    collect(probe, gazebo_msgs.ContactsState, "/gazebo/robot_contacts", contacts)
+    rt.run(duration=0.3)
+    assert odoms and states and built["odom"] >= len(odoms) and built["states"] == len(states)
+    assert built["contacts"] > 0  # looked for at every update now (the bot touches nothing)

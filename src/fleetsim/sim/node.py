@@ -186,8 +186,13 @@ class Simulator(Node):
             and self.now() - self._last_states >= 1 / p.model_states_rate - 1e-9
         ):
             self._last_states = self.now()
-            self.states_pub.publish(conv.model_states_msg(self.engine))
-        if p.publish_contacts and not self.engine.paused:
+            if self.states_pub.get_num_connections():  # built only for someone to read
+                self.states_pub.publish(conv.model_states_msg(self.engine))
+        if (
+            p.publish_contacts
+            and not self.engine.paused
+            and self.contacts_pub.get_num_connections()
+        ):
             contacts = self.engine.contacts()
             if contacts:
                 self.contacts_pub.publish(conv.contacts_msg(self.now(), contacts))

@@ -9,8 +9,8 @@ count, never the robots' own estimates.
 Starts: the lesson's (20, 15), (22, 15), (24, 15), each moved to the nearest cell where lizi's
 footprint fits (`nearest_free_start`; (20, 15) is 0.2 m from a wall and moves). Goals are
 >= 15 m away in a straight line and behind openings no wider than a door (`bottleneck_width`),
-one to the west, one to the north and one to the east, on routes >= 2 m apart, so that they do not meet at one
-door.
+one to the south-west, one to the north and one to the east, on routes >= 2 m apart, so that
+they do not meet at one door.
 """
 
 import math

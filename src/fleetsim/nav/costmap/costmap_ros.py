@@ -277,7 +277,8 @@ class Costmap2DROS:
         if not self.initialized or self.stopped:
             return False
         now = self.node.now()
-        self.sources.read_unread()  # a reading that came since the update counts as heard from
+        if self.sources.watched:  # a reading that came since the update counts as heard from
+            self.sources.read_unread()
         for layer in self.layered.layers:
             if not isinstance(layer, ObstacleLayer):
                 continue

@@ -53,11 +53,15 @@ class ObservationSources:
         # (layer, source) -> (readings not read yet, newest last, with when they came; the
         # function that reads one)
         self._unread: dict[tuple[str, str], tuple[deque, Any]] = {}
+        #: whether a source has an expected_update_rate (then `is_current` reads the readings
+        #: that wait, to know when each source was last heard from)
+        self.watched = False
 
     def subscribe(self, layer: ObstacleLayer, source: str) -> Any:
         """Subscribe ``source`` of ``layer`` to its topic; returns the subscription."""
         cm = self.costmap
         sp = layer.buffers[source].params
+        self.watched = self.watched or sp.expected_update_rate > 0
         where = f"{cm.ns}/{layer.name}/{source}"
         if sp.data_type == "LaserScan":
             msg_type, convert = sensor_msgs.LaserScan, _scan_points

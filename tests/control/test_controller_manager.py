@@ -91,7 +91,10 @@ def test_goal_rejections_and_tolerance_violations(hunters):
     assert fast.result.error_string.startswith("arm_joint_0")
     assert "path error" in fast.result.error_string
     hunters.rt.run(1.0)
-    jump = hunters.follow(action, ARM, [(0.2, HOME)])
+    # a 0.2 s jump, allowed 1 ns beyond its end to be at rest (the yaml allows 0.5 s)
+    jump = hunters.follow(
+        action, ARM, [(0.2, HOME)], goal_time_tolerance=Duration(sec=0, nanosec=1)
+    )
     hunters.rt.run(2.0, until=lambda: jump.result is not None)
     assert jump.result.error_code == Result.GOAL_TOLERANCE_VIOLATED
     assert "goal velocity" in jump.result.error_string

@@ -34,6 +34,7 @@ NODES: dict[tuple[str, str], str] = {
     ("grobot_utilities", "spawn_marker_on_robot"): "fleetsim.apps.spawn_marker_on_robot:SpawnMarkerOnRobot",
     ("grobot_navigation", "follow_marker"): "fleetsim.apps.follow_marker:FollowMarker",
     ("controller_manager", "spawner"): "fleetsim.control.spawner:Spawner",
+    ("moveit_ros_move_group", "move_group"): "fleetsim.moveit.move_group:MoveGroup",
 }  # fmt: skip
 
 

@@ -1,0 +1,360 @@
+"""``MoveGroupCommander`` with moveit_commander's names (``PlanningSceneInterface`` is in
+``scene_interface``).
+
+In process they talk to a ``move_group`` node through its action and services on a small node
+of their own, and drive the runtime while they wait (``go()``, ``plan()``, ``execute()`` with
+``wait=True``). ``runtime`` is the fleetsim ``Runtime`` the simulation lives in.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from typing import Any
+
+import numpy as np
+
+from fleetsim.errors import PlanningError
+from fleetsim.msgs import geometry_msgs, moveit_msgs, shape_msgs, std_msgs
+from fleetsim.runtime import Node
+from fleetsim.runtime import names as rnames
+
+E = moveit_msgs.MoveItErrorCodes
+_ids = itertools.count(1)
+
+
+class MoveItCommanderException(PlanningError):
+    """moveit_commander's exception, for bad targets and settings."""
+
+
+class _Client:
+    def __init__(self, runtime, ns: str) -> None:
+        self.runtime = runtime
+        self.ns = rnames.validate_namespace(ns or "/")
+        self.node = Node(runtime, f"move_group_commander_{next(_ids)}", self.ns)
+        self.move_group = self.runtime.graph.nodes.get(rnames.join(self.ns, "move_group"))
+
+    def wait(self, until, timeout: float) -> None:
+        if not until():
+            self.runtime.run(duration=timeout, until=until)
+
+
+class MoveGroupCommander:
+    """moveit_commander.MoveGroupCommander(name, robot_description, ns, wait_for_servers)."""
+
+    def __init__(
+        self,
+        name: str,
+        robot_description: str = "robot_description",
+        ns: str = "",
+        wait_for_servers: float = 5.0,
+        *,
+        runtime,
+    ) -> None:
+        self._c = _Client(runtime, ns)
+        mg = self._c.move_group
+        if mg is None:
+            raise MoveItCommanderException(
+                f"no move_group node in namespace {self._c.ns}; launch move_group.launch first"
+            )
+        self._mg = mg
+        self._model = mg.model
+        try:
+            self._model.check_group(name)
+        except PlanningError as e:
+            raise MoveItCommanderException(f"Group '{name}' was not found. {e}") from None
+        self._name = name
+        self._joints = self._model.active_joints(name)
+        self._target = self.get_current_joint_values_or_zero()
+        self._pose_target: np.ndarray | None = None
+        self._remembered: dict[str, np.ndarray] = {}
+        self._vs, self._as = self._model.default_scaling()
+        self._planning_time = 5.0
+        self._attempts = 1
+        self._planner_id = ""
+        self._joint_tol, self._pos_tol = 1e-4, 1e-4
+        self._ee = self._model.end_effector_link(name)
+        node = self._c.node
+        self._move = node.create_action_client(moveit_msgs.MoveGroup, "move_group")
+        self._exec = node.create_action_client(moveit_msgs.ExecuteTrajectory, "execute_trajectory")
+        self._event = node.create_publisher(std_msgs.String, "trajectory_execution_event")
+        self._timeout_margin = 30.0
+
+    # ------------------------------------------------------------------ introspection
+    def get_name(self) -> str:
+        return self._name
+
+    def get_active_joints(self) -> list[str]:
+        return list(self._joints)
+
+    def get_joints(self) -> list[str]:
+        return list(self._joints)
+
+    def get_variable_count(self) -> int:
+        return len(self._joints)
+
+    def get_planning_frame(self) -> str:
+        return self._mg.frame(self._model.robot.root_link())
+
+    def get_end_effector_link(self) -> str:
+        return self._ee
+
+    def set_end_effector_link(self, link: str) -> None:
+        self._ee = link
+
+    def has_end_effector_link(self) -> bool:
+        return bool(self._ee)
+
+    def get_current_joint_values(self) -> list[float]:
+        from fleetsim.moveit.planner import PlanFailure
+
+        try:
+            return [float(v) for v in self._mg.current(self._name)]
+        except PlanFailure as e:
+            raise MoveItCommanderException(str(e)) from None
+
+    def get_current_joint_values_or_zero(self) -> np.ndarray:
+        return np.array([self._mg.joint_positions.get(j, 0.0) for j in self._joints])
+
+    def get_current_pose(self, end_effector_link: str = "") -> geometry_msgs.PoseStamped:
+        link = end_effector_link or self._ee
+        ctx = self._mg.pipeline.context(self._name)
+        pos, quat = ctx.kin.link_pose(np.array(self.get_current_joint_values()), link)
+        ps = geometry_msgs.PoseStamped()
+        ps.header.frame_id = self.get_planning_frame()
+        ps.pose.position = geometry_msgs.Point(*pos)
+        ps.pose.orientation = geometry_msgs.Quaternion(*quat)
+        return ps
+
+    # ------------------------------------------------------------------ targets
+    def get_named_targets(self) -> list[str]:
+        return list(self._model.named_targets(self._name)) + list(self._remembered)
+
+    def get_named_target_values(self, target: str) -> dict[str, float]:
+        values = self._named(target)
+        return dict(zip(self._joints, map(float, values), strict=True))
+
+    def _named(self, name: str) -> np.ndarray:
+        if name in self._remembered:
+            return self._remembered[name]
+        try:
+            return self._model.named_target(self._name, name)
+        except PlanningError as e:
+            raise MoveItCommanderException(str(e)) from None
+
+    def set_named_target(self, name: str) -> None:
+        self._target, self._pose_target = self._named(name).copy(), None
+
+    def remember_joint_values(self, name: str, values=None) -> None:
+        v = self.get_current_joint_values() if values is None else values
+        self._remembered[name] = np.asarray(v, float)
+
+    def get_remembered_joint_values(self) -> dict[str, list[float]]:
+        return {k: list(map(float, v)) for k, v in self._remembered.items()}
+
+    def forget_joint_values(self, name: str) -> None:
+        self._remembered.pop(name, None)
+
+    def set_joint_value_target(self, arg1, arg2=None, arg3=None) -> None:
+        q = np.array(self._target, float)
+        if isinstance(arg1, str) and arg2 is not None:
+            arg1 = {arg1: arg2}
+        if isinstance(arg1, dict):
+            for j, v in arg1.items():
+                if j not in self._joints:
+                    raise MoveItCommanderException(
+                        f"joint '{j}' is not in group '{self._name}' ({', '.join(self._joints)})"
+                    )
+                q[self._joints.index(j)] = v
+        elif isinstance(arg1, geometry_msgs.Pose | geometry_msgs.PoseStamped):
+            pose = arg1.pose if isinstance(arg1, geometry_msgs.PoseStamped) else arg1
+            self.set_position_target([pose.position.x, pose.position.y, pose.position.z])
+            return
+        elif hasattr(arg1, "name") and hasattr(arg1, "position"):  # JointState
+            self.set_joint_value_target(dict(zip(arg1.name, arg1.position, strict=False)))
+            return
+        else:
+            values = np.asarray(arg1, float)
+            if values.shape != (len(self._joints),):
+                raise MoveItCommanderException(
+                    f"Expected {len(self._joints)} joint values for group '{self._name}', got "
+                    f"{values.size}"
+                )
+            q = values
+        try:
+            self._model.check_within_bounds(self._name, q, "target")
+        except PlanningError as e:
+            raise MoveItCommanderException(
+                f"Error setting joint target. Is the target within bounds? {e}"
+            ) from None
+        self._target, self._pose_target = q, None
+
+    def get_joint_value_target(self) -> list[float]:
+        return [float(v) for v in self._target]
+
+    def set_position_target(self, xyz, end_effector_link: str = "") -> None:
+        if not (end_effector_link or self._ee):
+            raise MoveItCommanderException("There is no end effector to set the pose for")
+        if end_effector_link:
+            self._ee = end_effector_link
+        self._pose_target = np.asarray(xyz, float)[:3]
+
+    def set_pose_target(self, pose, end_effector_link: str = "") -> None:
+        """Position-only for groups with fewer than six joints (the orientation is dropped,
+        as a 4-joint arm cannot follow it)."""
+        if isinstance(pose, geometry_msgs.PoseStamped):
+            pose = pose.pose
+        if isinstance(pose, geometry_msgs.Pose):
+            xyz = [pose.position.x, pose.position.y, pose.position.z]
+        else:
+            values = list(pose)
+            if len(values) not in (6, 7):
+                raise MoveItCommanderException(
+                    "Expected [x, y, z, r, p, y] or [x, y, z, qx, qy, qz, qw]"
+                )
+            xyz = values[:3]
+        if len(self._joints) >= 6:
+            self._mg.get_logger().warning("orientation targets are not supported; position only")
+        self.set_position_target(xyz, end_effector_link)
+
+    def clear_pose_targets(self) -> None:
+        self._pose_target = None
+
+    # ------------------------------------------------------------------ settings
+    def set_max_velocity_scaling_factor(self, value: float) -> None:
+        self._vs = self._scaling(value, "velocity")
+
+    def set_max_acceleration_scaling_factor(self, value: float) -> None:
+        self._as = self._scaling(value, "acceleration")
+
+    @staticmethod
+    def _scaling(value: float, what: str) -> float:
+        if not (0 < value <= 1) or not math.isfinite(value):
+            raise MoveItCommanderException(
+                f"Expected value in the range from 0 to 1 for scaling factor ({what}), got {value}"
+            )
+        return float(value)
+
+    def set_planning_time(self, seconds: float) -> None:
+        self._planning_time = float(seconds)
+
+    def get_planning_time(self) -> float:
+        return self._planning_time
+
+    def set_num_planning_attempts(self, n: int) -> None:
+        self._attempts = int(n)
+
+    def set_planner_id(self, planner_id: str) -> None:
+        self._planner_id = planner_id
+
+    def get_planner_id(self) -> str:
+        return self._planner_id
+
+    def set_goal_tolerance(self, value: float) -> None:
+        self._joint_tol = self._pos_tol = float(value)
+
+    def set_goal_joint_tolerance(self, value: float) -> None:
+        self._joint_tol = float(value)
+
+    def set_goal_position_tolerance(self, value: float) -> None:
+        self._pos_tol = float(value)
+
+    def get_goal_joint_tolerance(self) -> float:
+        return self._joint_tol
+
+    def get_goal_position_tolerance(self) -> float:
+        return self._pos_tol
+
+    # ------------------------------------------------------------------ motion
+    def _request(self) -> moveit_msgs.MotionPlanRequest:
+        req = moveit_msgs.MotionPlanRequest(
+            group_name=self._name, planner_id=self._planner_id,
+            num_planning_attempts=self._attempts, allowed_planning_time=self._planning_time,
+            max_velocity_scaling_factor=self._vs, max_acceleration_scaling_factor=self._as,
+        )  # fmt: skip
+        c = moveit_msgs.Constraints()
+        if self._pose_target is not None:
+            sphere = shape_msgs.SolidPrimitive(
+                type=shape_msgs.SolidPrimitive.SPHERE, dimensions=np.array([self._pos_tol])
+            )
+            at = geometry_msgs.Pose(position=geometry_msgs.Point(*self._pose_target))
+            region = moveit_msgs.BoundingVolume(primitives=[sphere], primitive_poses=[at])
+            c.position_constraints = [
+                moveit_msgs.PositionConstraint(
+                    link_name=self._ee, constraint_region=region, weight=1.0
+                )
+            ]
+        else:
+            c.joint_constraints = [
+                moveit_msgs.JointConstraint(
+                    joint_name=j, position=float(v), tolerance_above=self._joint_tol,
+                    tolerance_below=self._joint_tol, weight=1.0,
+                )
+                for j, v in zip(self._joints, self._target, strict=True)
+            ]  # fmt: skip
+        req.goal_constraints = [c]
+        return req
+
+    def _send(self, client, goal, wait: bool):
+        if not client.wait_for_server():
+            raise MoveItCommanderException(f"no action server at {client.name}")
+        h = client.send_goal(goal)
+        if wait:
+            self._c.wait(
+                lambda: h.result is not None,
+                self._planning_time + self._timeout_margin + self._expected(goal),
+            )
+        return h
+
+    @staticmethod
+    def _expected(goal) -> float:
+        traj = getattr(goal, "trajectory", None)
+        if traj is not None and traj.joint_trajectory.points:
+            return traj.joint_trajectory.points[-1].time_from_start.to_sec() * 1.2 + 1.0
+        return 600.0
+
+    def plan(self, joints=None):
+        """``(success, RobotTrajectory, planning_time, MoveItErrorCodes)``."""
+        if joints is not None:
+            self._set_any(joints)
+        goal = moveit_msgs.MoveGroupGoal(request=self._request())
+        goal.planning_options.plan_only = True
+        h = self._send(self._move, goal, True)
+        r = h.result or moveit_msgs.MoveGroupResult()
+        if h.result is None:
+            r.error_code.val = E.TIMED_OUT
+        return r.error_code.val == E.SUCCESS, r.planned_trajectory, r.planning_time, r.error_code
+
+    def go(self, joints=None, wait: bool = True) -> bool:
+        if joints is not None:
+            self._set_any(joints)
+        goal = moveit_msgs.MoveGroupGoal(request=self._request())
+        self._last = self._send(self._move, goal, wait)
+        if not wait:
+            return True
+        r = self._last.result
+        return r is not None and r.error_code.val == E.SUCCESS
+
+    def execute(self, plan_msg, wait: bool = True) -> bool:
+        traj = plan_msg
+        if not isinstance(plan_msg, moveit_msgs.RobotTrajectory):
+            traj = moveit_msgs.RobotTrajectory(joint_trajectory=plan_msg)
+        h = self._send(self._exec, moveit_msgs.ExecuteTrajectoryGoal(trajectory=traj), wait)
+        self._last = h
+        return not wait or (h.result is not None and h.result.error_code.val == E.SUCCESS)
+
+    def stop(self) -> None:
+        self._event.publish(std_msgs.String("stop"))
+
+    def last_result(self) -> Any:
+        """The last go()/execute() action result (fleetsim addition: its error code and text)."""
+        h = getattr(self, "_last", None)
+        return (h.result, h.text) if h is not None else (None, "")
+
+    def _set_any(self, joints) -> None:
+        if isinstance(joints, str):
+            self.set_named_target(joints)
+        elif isinstance(joints, geometry_msgs.Pose | geometry_msgs.PoseStamped):
+            self.set_pose_target(joints)
+        else:
+            self.set_joint_value_target(joints)

@@ -1,0 +1,347 @@
+"""``moveit_ros_move_group/move_group``: planning and execution for one robot's arm groups.
+
+Reads ``robot_description``, ``robot_description_semantic``, ``robot_description_planning``
+(joint_limits.yaml) and ``robot_description_kinematics`` from its namespace; from its private
+namespace ``controller_list`` (or ``moveit_controller_manager`` =
+``moveit_fake_controller_manager/MoveItFakeControllerManager`` for fake execution),
+``<group>/default_planner_config`` (ompl_planning.yaml), ``allow_trajectory_execution`` and
+``trajectory_execution/*``. Serves MoveIt's interfaces in its namespace: actions ``move_group``
+and ``execute_trajectory``; services ``plan_kinematic_path``, ``compute_ik``, ``compute_fk``,
+``get_planning_scene``, ``apply_planning_scene``; topics ``joint_states`` (in),
+``planning_scene`` (in), ``trajectory_execution_event`` (in, "stop"),
+``~display_planned_path`` (out). World geometry and other robots come from the simulator when
+one runs; planning-scene objects are added with ``apply_planning_scene`` or ``planning_scene``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from fleetsim.description.srdf import parse_srdf
+from fleetsim.description.urdf import parse_urdf
+from fleetsim.errors import FleetsimError, PlanningError
+from fleetsim.moveit.execution import ExecutionManager
+from fleetsim.moveit.pipeline import PlanFailure, PlanningPipeline
+from fleetsim.moveit.robot_model import RobotModel
+from fleetsim.msgs import geometry_msgs, moveit_msgs, sensor_msgs, shape_msgs, std_msgs
+from fleetsim.runtime import Node, param
+
+E = moveit_msgs.MoveItErrorCodes
+FAKE = "moveit_fake_controller_manager/MoveItFakeControllerManager"
+SHAPES = {
+    shape_msgs.SolidPrimitive.BOX: mujoco.mjtGeom.mjGEOM_BOX,
+    shape_msgs.SolidPrimitive.SPHERE: mujoco.mjtGeom.mjGEOM_SPHERE,
+    shape_msgs.SolidPrimitive.CYLINDER: mujoco.mjtGeom.mjGEOM_CYLINDER,
+}
+
+
+@dataclass(frozen=True)
+class MoveGroupParams:
+    allow_trajectory_execution: bool = param(True, help="execute plans (else plan only)")
+    moveit_controller_manager: str = param(
+        "moveit_simple_controller_manager/MoveItSimpleControllerManager",
+        help="or moveit_fake_controller_manager/MoveItFakeControllerManager",
+    )
+    controller_list: list = param([], help="[{name, action_ns, type, joints, default}]")
+    trajectory_execution: dict = param({}, help="allowed_execution_duration_scaling, ...")
+    max_safe_path_cost: float = param(1.0, help="accepted, unused")
+    jiggle_fraction: float = param(0.05, help="accepted, unused")
+    planning_plugin: str = param("ompl_interface/OMPLPlanner", help="only OMPL")
+    request_adapters: str = param("", help="accepted; fleetsim always fixes bounds and times")
+    start_state_max_bounds_error: float = param(0.1, unit="rad", help="FixStartStateBounds")
+    publish_monitored_planning_scene: bool = param(True, help="accepted")
+    capabilities: str = param("", help="accepted")
+
+
+class MoveGroup(Node):
+    Params = MoveGroupParams
+    PARAM_NAMESPACES = ("planner_configs", "ompl", "sensors", "planning_pipelines")
+
+    def __init__(self, runtime, name: str = "move_group", namespace: str = "/", **kw) -> None:
+        super().__init__(runtime, name, namespace, **kw)
+        urdf = self._text("robot_description")
+        robot = parse_urdf(urdf, source=self.resolve_name("robot_description"))
+        srdf = parse_srdf(
+            self._text("robot_description_semantic"),
+            self.resolve_name("robot_description_semantic"),
+            robot,
+        )
+        planning = self.get_param("robot_description_planning", {}) or {}
+        self.model = RobotModel(
+            robot, srdf, planning, self.resolve_name("robot_description_semantic")
+        )
+        defaults = {}
+        for g in self.model.group_names:
+            v = self.get_param(f"~{g}/default_planner_config", None)
+            if v:
+                defaults[g] = str(v)
+        self.pipeline = PlanningPipeline(self.model, self.rng, defaults)
+        p = self.params
+        fake = p.moveit_controller_manager == FAKE
+        self.execution = ExecutionManager(self, p.controller_list, fake, p.trajectory_execution)
+        self.joint_positions: dict[str, float] = {}
+        self.objects: dict[str, moveit_msgs.CollisionObject] = {}
+        self.create_subscription(sensor_msgs.JointState, "joint_states", self._on_joints, 50)
+        self.create_subscription(moveit_msgs.PlanningScene, "planning_scene", self._on_scene, 10)
+        self.create_subscription(std_msgs.String, "trajectory_execution_event", self._on_event, 10)
+        self.display_pub = self.create_publisher(
+            moveit_msgs.DisplayTrajectory, "~display_planned_path"
+        )
+        self.move_action = self.create_action_server(
+            moveit_msgs.MoveGroup, "move_group", goal_callback=self._on_move_goal,
+            preempt_callback=lambda: self._preempt(self.move_action),
+        )  # fmt: skip
+        self.exec_action = self.create_action_server(
+            moveit_msgs.ExecuteTrajectory, "execute_trajectory", goal_callback=self._on_exec_goal,
+            preempt_callback=lambda: self._preempt(self.exec_action),
+        )  # fmt: skip
+        self.create_service(moveit_msgs.GetMotionPlan, "plan_kinematic_path", self._srv_plan)
+        self.create_service(moveit_msgs.GetPositionIK, "compute_ik", self._srv_ik)
+        self.create_service(moveit_msgs.GetPositionFK, "compute_fk", self._srv_fk)
+        self.create_service(moveit_msgs.GetPlanningScene, "get_planning_scene", self._srv_get_scene)
+        self.create_service(moveit_msgs.ApplyPlanningScene, "apply_planning_scene", self._srv_apply)
+        self.get_logger().info("You can start planning now!")
+
+    def _text(self, key: str) -> str:
+        value = self.get_param(key, None)
+        if not isinstance(value, str) or not value.strip():
+            raise PlanningError(
+                f"{self.full_name}: parameter '{self.resolve_name(key)}' is not set; load the "
+                "robot's URDF/SRDF (planning_context.launch) before move_group"
+            )
+        return value
+
+    # ------------------------------------------------------------------ state
+    def _on_joints(self, msg) -> None:
+        for n, q in zip(msg.name, msg.position, strict=False):
+            self.joint_positions[n] = float(q)
+
+    def current(self, group: str) -> np.ndarray:
+        joints = self.model.active_joints(group)
+        missing = [j for j in joints if j not in self.joint_positions]
+        if missing and not self.execution.fake:
+            raise PlanFailure(
+                E.ROBOT_STATE_STALE,
+                f"Didn't receive robot state (joint angles) for {', '.join(missing)} on "
+                f"{self.resolve_name('joint_states')}",
+            )
+        return np.array([self.joint_positions.get(j, 0.0) for j in joints])
+
+    def _start(self, req) -> np.ndarray:
+        q = self.current(req.group_name)
+        js = req.start_state.joint_state
+        if len(js.name) and not req.start_state.is_diff:
+            joints = self.model.active_joints(req.group_name)
+            for n, v in zip(js.name, js.position, strict=False):
+                if n in joints:
+                    q[joints.index(n)] = v
+        return q
+
+    def _sync_world(self) -> None:
+        """Copy the simulator's world near this robot into each group's collision scene."""
+        from fleetsim.sim.node import Simulator
+
+        sim = next((n for n in self.runtime.graph.nodes.values() if isinstance(n, Simulator)), None)
+        if sim is None:
+            return
+        entry = next(
+            (
+                e
+                for e in sim.engine.models.values()
+                if e.kind == "robot" and e.namespace == self.namespace
+            ),
+            None,
+        )
+        if entry is None:
+            return
+        for ctx in self.pipeline.contexts():
+            ctx.scene.set_world_from(sim.engine, entry.name)
+
+    # ------------------------------------------------------------------ planning
+    def plan(self, req):
+        """MotionPlanResponse for a MotionPlanRequest (never raises for a bad request)."""
+        res = moveit_msgs.MotionPlanResponse(group_name=req.group_name)
+        try:
+            ctx = self.pipeline.context(req.group_name)
+            start = self._start(req)
+            self._sync_world()
+            traj, dt = self.pipeline.plan(req, start)
+        except PlanFailure as e:
+            self.get_logger().error("%s", e)
+            res.error_code.val = e.code
+            return res, str(e)
+        except FleetsimError as e:
+            self.get_logger().error("%s", e)
+            res.error_code.val = E.FAILURE
+            return res, str(e)
+        res.trajectory_start.joint_state.name = list(ctx.joints)
+        res.trajectory_start.joint_state.position = start
+        res.trajectory, res.planning_time = traj, dt
+        res.error_code.val = E.SUCCESS
+        self.display_pub.publish(
+            moveit_msgs.DisplayTrajectory(trajectory=[traj], trajectory_start=res.trajectory_start)
+        )
+        return res, ""
+
+    def _srv_plan(self, req):
+        res, _ = self.plan(req.motion_plan_request)
+        return moveit_msgs.GetMotionPlanResponse(motion_plan_response=res)
+
+    # ------------------------------------------------------------------ actions
+    def _on_move_goal(self) -> None:
+        goal = self.move_action.accept_new_goal()
+        if goal.planning_options.planning_scene_diff.is_diff:
+            self._apply(goal.planning_options.planning_scene_diff)
+        res, text = self.plan(goal.request)
+        result = moveit_msgs.MoveGroupResult(
+            error_code=res.error_code, trajectory_start=res.trajectory_start,
+            planned_trajectory=res.trajectory, planning_time=res.planning_time,
+        )  # fmt: skip
+        if res.error_code.val != E.SUCCESS:
+            self.move_action.set_aborted(
+                result, text or "No motion plan found. No execution attempted."
+            )
+            return
+        if goal.planning_options.plan_only or not self.params.allow_trajectory_execution:
+            self.move_action.set_succeeded(result, "Motion plan was computed successfully.")
+            return
+
+        def done(code, why):
+            result.error_code.val = code
+            if code == E.SUCCESS:
+                result.executed_trajectory = res.trajectory
+                self.move_action.set_succeeded(result, "Solution was found and executed.")
+            elif self.move_action.is_active():
+                self.move_action.set_aborted(result, why)
+
+        self.execution.execute(res.trajectory, self.joint_positions, done)
+
+    def _on_exec_goal(self) -> None:
+        goal = self.exec_action.accept_new_goal()
+
+        def done(code, why):
+            if not self.exec_action.is_active():
+                return
+            r = moveit_msgs.ExecuteTrajectoryResult()
+            r.error_code.val = code
+            if code == E.SUCCESS:
+                self.exec_action.set_succeeded(r, "Solution was found and executed.")
+            else:
+                self.exec_action.set_aborted(r, why)
+
+        self.execution.execute(goal.trajectory, self.joint_positions, done)
+
+    def _preempt(self, server) -> None:
+        if server.next is None and server.is_active():
+            self.execution.stop("preempted", E.PREEMPTED)
+            if server.is_active():
+                r = server.type.Result()
+                r.error_code.val = E.PREEMPTED
+                server.set_preempted(r, "preempted")
+
+    def _on_event(self, msg) -> None:
+        if msg.data == "stop":
+            self.execution.stop("stopped by trajectory_execution_event", E.PREEMPTED)
+
+    # ------------------------------------------------------------------ kinematics services
+    def _srv_ik(self, req):
+        r = req.ik_request
+        res = moveit_msgs.GetPositionIKResponse()
+        try:
+            ctx = self.pipeline.context(r.group_name)
+            start = self._start(
+                moveit_msgs.MotionPlanRequest(group_name=r.group_name, start_state=r.robot_state)
+            )
+            p = r.pose_stamped.pose.position
+            q = self.pipeline.ik(ctx, r.ik_link_name or ctx.tip, np.array([p.x, p.y, p.z]), start)
+        except PlanFailure as e:
+            res.error_code.val = e.code
+            return res
+        except PlanningError:
+            res.error_code.val = E.INVALID_LINK_NAME
+            return res
+        if q is None:
+            res.error_code.val = E.NO_IK_SOLUTION
+            return res
+        res.solution.joint_state.name = list(ctx.joints)
+        res.solution.joint_state.position = q
+        res.error_code.val = E.SUCCESS
+        return res
+
+    def _srv_fk(self, req):
+        res = moveit_msgs.GetPositionFKResponse(fk_link_names=list(req.fk_link_names))
+        group = self.model.group_names[0]
+        ctx = self.pipeline.context(group)
+        q = self._start(
+            moveit_msgs.MotionPlanRequest(group_name=group, start_state=req.robot_state)
+        )
+        try:
+            for link in req.fk_link_names:
+                pos, quat = ctx.kin.link_pose(q, link)
+                ps = geometry_msgs.PoseStamped()
+                ps.header.frame_id = self.frame(self.model.robot.root_link())
+                ps.header.stamp = self.now_msg()
+                ps.pose.position = geometry_msgs.Point(*pos)
+                ps.pose.orientation = geometry_msgs.Quaternion(*quat)
+                res.pose_stamped.append(ps)
+        except PlanningError:
+            res.error_code.val = E.INVALID_LINK_NAME
+            res.pose_stamped = []
+            return res
+        res.error_code.val = E.SUCCESS
+        return res
+
+    # ------------------------------------------------------------------ planning scene
+    def _on_scene(self, msg) -> None:
+        self._apply(msg)
+
+    def _apply(self, scene) -> bool:
+        for obj in scene.world.collision_objects:
+            if obj.operation == moveit_msgs.CollisionObject.REMOVE:
+                ids = [obj.id] if obj.id else list(self.objects)
+                for oid in ids:
+                    self.objects.pop(oid, None)
+                    self.pipeline.remove_object(oid)
+                continue
+            geoms = []
+            for prim, pose in zip(obj.primitives, obj.primitive_poses, strict=False):
+                if prim.type not in SHAPES:
+                    self.get_logger().error(
+                        "collision object '%s': unsupported shape %d", obj.id, prim.type
+                    )
+                    return False
+                d = np.asarray(prim.dimensions, float)
+                size = {
+                    mujoco.mjtGeom.mjGEOM_BOX: d[:3] / 2 if len(d) >= 3 else None,
+                    mujoco.mjtGeom.mjGEOM_SPHERE: np.array([d[0], 0, 0]) if len(d) >= 1 else None,
+                    mujoco.mjtGeom.mjGEOM_CYLINDER: np.array([d[1], d[0] / 2, 0])
+                    if len(d) >= 2
+                    else None,
+                }[SHAPES[prim.type]]
+                if size is None:
+                    self.get_logger().error("collision object '%s': too few dimensions", obj.id)
+                    return False
+                pos = np.array([pose.position.x, pose.position.y, pose.position.z])
+                o = pose.orientation
+                q = (
+                    np.array([o.w, o.x, o.y, o.z])
+                    if (o.w or o.x or o.y or o.z)
+                    else np.array([1.0, 0, 0, 0])
+                )
+                geoms.append((int(SHAPES[prim.type]), size, pos, q))
+            self.objects[obj.id] = obj
+            self.pipeline.set_object(obj.id, geoms)
+        return True
+
+    def _srv_get_scene(self, req):
+        scene = moveit_msgs.PlanningScene(name="(noname)", robot_model_name=self.model.srdf.name)
+        scene.robot_state.joint_state.name = list(self.joint_positions)
+        scene.robot_state.joint_state.position = np.array(list(self.joint_positions.values()))
+        scene.world.collision_objects = list(self.objects.values())
+        return moveit_msgs.GetPlanningSceneResponse(scene=scene)
+
+    def _srv_apply(self, req):
+        return moveit_msgs.ApplyPlanningSceneResponse(success=self._apply(req.scene))

@@ -1,0 +1,176 @@
+"""The planning pipeline: a MotionPlanRequest in, a timed RobotTrajectory out.
+
+Per group it keeps the kinematics and collision scene; a request's goal (joint constraints, or
+a position constraint solved by IK) is checked, planned with OMPL and timed with toppra within
+the joint limits times the request's scaling factors (MoveIt's FixStartStateBounds and
+AddTimeParameterization adapters included). Failures carry MoveItErrorCodes values.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from fleetsim.errors import PlanningError
+from fleetsim.moveit.collision import CollisionScene
+from fleetsim.moveit.kinematics import Kinematics
+from fleetsim.moveit.planner import PlanFailure, plan_path
+from fleetsim.moveit.robot_model import RobotModel
+from fleetsim.moveit.timing import time_parameterize
+from fleetsim.msgs import moveit_msgs, trajectory_msgs
+from fleetsim.msgs.builtin_interfaces import Duration
+
+E = moveit_msgs.MoveItErrorCodes
+START_STATE_MAX_BOUNDS_ERROR = 0.1  # rad: FixStartStateBounds pulls this much back inside
+IK_ATTEMPTS = 20
+
+
+class GroupContext:
+    """What planning needs for one group: joints, limits, kinematics, collision scene."""
+
+    def __init__(self, model: RobotModel, group: str) -> None:
+        self.group = group
+        self.joints = model.active_joints(group)
+        self.limits = model.limits(group)
+        self.kin = Kinematics(model.robot, self.joints, self.limits.lower, self.limits.upper)
+        self.scene = CollisionScene(self.kin, model.links(group), model.srdf.disabled_collisions)
+        self.tip = model.end_effector_link(group)
+
+
+class PlanningPipeline:
+    def __init__(self, model: RobotModel, rng: np.random.Generator, default_planner: dict) -> None:
+        self.model = model
+        self.rng = rng
+        self.default_planner = default_planner  # group -> default_planner_config
+        self.groups: dict[str, GroupContext] = {}
+        self.objects: dict[str, list] = {}  # planning-scene objects: id -> geoms
+
+    def context(self, group: str) -> GroupContext:
+        try:
+            self.model.check_group(group)
+        except PlanningError as e:
+            raise PlanFailure(E.INVALID_GROUP_NAME, str(e)) from None
+        if not self.model.active_joints(group):
+            raise PlanFailure(E.INVALID_GROUP_NAME, f"group '{group}' has no joints to plan for")
+        if group not in self.groups:
+            ctx = GroupContext(self.model, group)
+            for oid, geoms in self.objects.items():
+                ctx.scene.add_object(oid, geoms)
+            self.groups[group] = ctx
+        return self.groups[group]
+
+    def set_object(self, oid: str, geoms: list) -> None:
+        """Add or replace a collision object in every group's scene."""
+        self.objects[oid] = geoms
+        for ctx in self.groups.values():
+            ctx.scene.add_object(oid, geoms)
+
+    def remove_object(self, oid: str) -> None:
+        self.objects.pop(oid, None)
+        for ctx in self.groups.values():
+            if oid in ctx.scene.objects:
+                ctx.scene.remove_object(oid)
+
+    def contexts(self):
+        return self.groups.values()
+
+    # ------------------------------------------------------------------ goals
+    def goal_from_constraints(self, ctx: GroupContext, c, start: np.ndarray) -> np.ndarray:
+        if c.joint_constraints:
+            q = start.copy()
+            for jc in c.joint_constraints:
+                if jc.joint_name not in ctx.joints:
+                    raise PlanFailure(
+                        E.INVALID_GOAL_CONSTRAINTS,
+                        f"joint '{jc.joint_name}' is not in group '{ctx.group}' "
+                        f"({', '.join(ctx.joints)})",
+                    )
+                q[ctx.joints.index(jc.joint_name)] = jc.position
+            try:
+                self.model.check_within_bounds(ctx.group, q, "goal")
+            except PlanningError as e:
+                raise PlanFailure(E.INVALID_GOAL_CONSTRAINTS, str(e)) from None
+            return q
+        if c.position_constraints:
+            pc = c.position_constraints[0]
+            link = pc.link_name or ctx.tip
+            region = pc.constraint_region
+            if not region.primitive_poses:
+                raise PlanFailure(E.INVALID_GOAL_CONSTRAINTS, "position constraint has no region")
+            p = region.primitive_poses[0].position
+            target = np.array([p.x, p.y, p.z])
+            tol = region.primitives[0].dimensions[0] if region.primitives else 1e-3
+            try:
+                q = self.ik(ctx, link, target, start, tolerance=max(float(tol), 1e-4))
+            except PlanningError as e:
+                raise PlanFailure(E.INVALID_LINK_NAME, str(e)) from None
+            if q is None:
+                raise PlanFailure(
+                    E.NO_IK_SOLUTION,
+                    f"no collision-free IK solution puts '{link}' at "
+                    f"({target[0]:.3f}, {target[1]:.3f}, {target[2]:.3f}) in the planning frame",
+                )
+            return q
+        raise PlanFailure(
+            E.INVALID_GOAL_CONSTRAINTS, "the goal has no joint or position constraint"
+        )
+
+    def ik(self, ctx: GroupContext, link: str, target, start, tolerance=1e-3):
+        seeds = [start] + [
+            self.rng.uniform(ctx.limits.lower, ctx.limits.upper) for _ in range(IK_ATTEMPTS)
+        ]
+        return ctx.kin.position_ik(link, target, seeds, tolerance, valid=ctx.scene.is_valid)
+
+    # ------------------------------------------------------------------ planning
+    def plan(self, req, start: np.ndarray):
+        """``(RobotTrajectory, planning_time)`` for a MotionPlanRequest from ``start`` (J,)."""
+        t0 = time.perf_counter()
+        ctx = self.context(req.group_name)
+        lim = ctx.limits
+        over = np.maximum(lim.lower - start, start - lim.upper)
+        if np.any(over > START_STATE_MAX_BOUNDS_ERROR):
+            j = ctx.joints[int(np.argmax(over))]
+            raise PlanFailure(E.START_STATE_INVALID, f"start state: joint '{j}' out of bounds")
+        start = np.clip(start, lim.lower, lim.upper)
+        if not req.goal_constraints:
+            raise PlanFailure(E.INVALID_GOAL_CONSTRAINTS, "the request has no goal constraints")
+        goal = self.goal_from_constraints(ctx, req.goal_constraints[0], start)
+        vs = _scaling(req.max_velocity_scaling_factor)
+        acs = _scaling(req.max_acceleration_scaling_factor)
+        planner = req.planner_id or self.default_planner.get(ctx.group) or "RRTConnect"
+        planner = planner.split("kConfigDefault")[0] or "RRTConnect"
+        timeout = req.allowed_planning_time if req.allowed_planning_time > 0 else 5.0
+        seed = int(self.rng.integers(1, 2**31 - 1))
+        p = plan_path(
+            start,
+            goal,
+            lim.lower,
+            lim.upper,
+            ctx.scene.is_valid,
+            planner,
+            timeout,
+            max(1, req.num_planning_attempts),
+            seed,
+        )
+        path = p.path
+        if np.abs(path[-1] - goal).max() > 1e-6:
+            path = np.vstack([path, goal])
+        t, pos, vel, acc = time_parameterize(path, lim.max_velocity, lim.max_acceleration, vs, acs)
+        traj = moveit_msgs.RobotTrajectory()
+        jt = traj.joint_trajectory
+        jt.joint_names = list(ctx.joints)
+        jt.points = [
+            trajectory_msgs.JointTrajectoryPoint(
+                positions=pos[k], velocities=vel[k], accelerations=acc[k],
+                time_from_start=Duration.from_sec(float(t[k])),
+            )
+            for k in range(len(t))
+        ]  # fmt: skip
+        return traj, time.perf_counter() - t0
+
+
+def _scaling(v: float) -> float:
+    """Scaling outside (0, 1] falls back to 1.0, as MoveIt's time parameterisation does."""
+    return v if 0 < v <= 1 and math.isfinite(v) else 1.0

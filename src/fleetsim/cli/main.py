@@ -37,6 +37,7 @@ SUBAPPS = [
     ("fleetsim.cli.tools", "param_app", "param", "Parameters of a running simulation."),
     ("fleetsim.cli.tools", "node_app", "node", "Nodes: list them, or run one in this process."),
     ("fleetsim.cli.tools", "tf_app", "tf", "tf of a running simulation: echo, tree."),
+    ("fleetsim.cli.arm", "app", "arm", "Arms: planning groups, named poses, move_group goals."),
 ]
 # modules with a register(app) function that add single commands
 COMMANDS = ["fleetsim.cli.render", "fleetsim.cli.launch", "fleetsim.cli.tools"]

@@ -105,6 +105,24 @@ class MoveGroup(Node):
         self.create_service(moveit_msgs.ApplyPlanningScene, "apply_planning_scene", self._srv_apply)
         self.get_logger().info("You can start planning now!")
 
+    def _load_params(self):
+        """Its parameters, without the keys MoveIt's launch files put beside them: each
+        group's ompl settings (``<group>/default_planner_config``) and ros_controllers.yaml's
+        controller and hardware entries (loaded whole for its ``controller_list``)."""
+        values = self.runtime.params.get(self.full_name, {})
+        extra = {
+            k
+            for k, v in (values.items() if isinstance(values, dict) else [])
+            if isinstance(v, dict)
+            and (
+                "type" in v
+                or "default_planner_config" in v
+                or k in ("moveit_sim_hw_interface", "generic_hw_control_loop", "hardware_interface")
+            )
+        }
+        self.PARAM_NAMESPACES = (*type(self).PARAM_NAMESPACES, *extra)
+        return super()._load_params()
+
     def _text(self, key: str) -> str:
         value = self.get_param(key, None)
         if not isinstance(value, str) or not value.strip():

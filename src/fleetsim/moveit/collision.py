@@ -193,7 +193,16 @@ class CollisionScene:
         return out
 
     def is_valid(self, q: np.ndarray) -> bool:
-        return not self.contacts(q)
+        """No contact at q (the fast path of ``contacts``: no per-contact Python objects)."""
+        self.kin.set(q)
+        kd, qpos = self.kin.data, self.data.qpos
+        for (b, _), a in self.moving_links:
+            qpos[a : a + 3] = kd.xpos[b]
+            mujoco.mju_mat2Quat(qpos[a + 3 : a + 7], kd.xmat[b])
+        mujoco.mj_kinematics(self.model, self.data)
+        mujoco.mj_collision(self.model, self.data)
+        n = self.data.ncon
+        return n == 0 or not bool(np.any(self.data.contact.dist[:n] <= 0))
 
 
 def _rotate(quat_wxyz: np.ndarray, v: np.ndarray) -> np.ndarray:

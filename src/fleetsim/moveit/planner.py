@@ -51,6 +51,13 @@ class Plan:
     planner: str
 
 
+def motion_is_valid(a, b, lower, upper, is_valid) -> bool:
+    """Every state on the straight motion a -> b, at OMPL's checking resolution, is valid."""
+    resolution = LONGEST_VALID_SEGMENT_FRACTION * float(np.linalg.norm(upper - lower))
+    steps = max(1, int(np.ceil(np.linalg.norm(b - a) / resolution)))
+    return all(is_valid(a + (b - a) * (k / steps)) for k in range(1, steps + 1))
+
+
 def _quiet():
     from ompl import util as ou
 
@@ -97,6 +104,10 @@ def plan_path(
         raise PlanFailure(E.GOAL_IN_COLLISION, "the goal state is in collision")
     n = len(start)
     t0 = time.perf_counter()
+    if motion_is_valid(start, goal, lower, upper, is_valid):
+        # the straight joint-space motion is free: what RRTConnect plus shortcutting would
+        # return, without growing trees (a fleetsim shortcut; MoveIt always runs the planner)
+        return Plan(np.array([start, goal], float), time.perf_counter() - t0, name)
     space = ob.RealVectorStateSpace(n)
     bounds = ob.RealVectorBounds(n)
     for i in range(n):

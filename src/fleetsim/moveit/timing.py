@@ -53,7 +53,7 @@ def time_parameterize(
         constraint.JointVelocityConstraint(np.stack([-vmax, vmax], axis=1)),
         constraint.JointAccelerationConstraint(np.stack([-amax, amax], axis=1)),
     ]
-    gridpoints = np.linspace(0, 1, max(100, 20 * len(path)))
+    gridpoints = np.linspace(0, 1, max(50, 10 * len(path)))
     inst = algo.TOPPRA(cons, spline, gridpoints=gridpoints, parametrizer="ParametrizeConstAccel")
     traj = inst.compute_trajectory(0.0, 0.0)
     if traj is None:

@@ -1,0 +1,132 @@
+"""slam_gmapping's parameters, declared once: ROS name, gmapping's *code* default, unit, range.
+
+The defaults are those ``SlamGMapping::init()`` uses when a parameter is absent
+(``gmapping/src/slam_gmapping.cpp``), not the wiki's: ``maxUrange`` and ``maxRange`` default to
+the first scan's ``range_max - 0.01`` (held as None here), ``temporalUpdate`` is off (-1 in ROS,
+None here), ``srt``/``stt`` are 0.2 and ``angularUpdate`` 0.5. ``srt`` scales *rotation* noise by
+translation and ``str`` *translation* noise by rotation, as ``motionmodel.cpp`` does.
+
+The four ``ll*``/``la*`` sampling parameters are read by gmapping but only used by
+``ScanMatcher::likelihood()``, which slam_gmapping never calls; they are accepted and warned
+about (`NO_EFFECT`).
+"""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from fleetsim.errors import ParameterError
+from fleetsim.runtime.params import load_params, param
+
+#: accepted, but gmapping never uses them on the path slam_gmapping runs
+NO_EFFECT = ("llsamplerange", "llsamplestep", "lasamplerange", "lasamplestep")
+
+#: ROS writes -1 for "unset" here; held as None
+UNSET_WHEN_NEGATIVE = ("temporalUpdate", "maxRange", "maxUrange")
+
+
+@dataclass(frozen=True)
+class GmappingParams:
+    """Parameters of ``gmapping/slam_gmapping`` (ROS names, gmapping's code defaults)."""
+
+    # --- frames and rates ---
+    base_frame: str = param("base_link", help="robot base frame (tf_prefix applied)")
+    map_frame: str = param("map", help="frame of the map (tf_prefix applied)")
+    odom_frame: str = param("odom", help="odometry frame (tf_prefix applied)")
+    throttle_scans: int = param(1, range=(1, None), help="process every n-th scan")
+    map_update_interval: float = param(
+        5.0, unit="s", range=(0.0, None), help="scan time between two publications of the map"
+    )
+    transform_publish_period: float = param(
+        0.05,
+        unit="s",
+        range=(0.0, None),
+        help="period of the map->odom broadcast (0: off; capped at the simulator's rate)",
+    )
+    tf_delay: float | None = param(
+        None,
+        unit="s",
+        range=(0.0, None),
+        help="map->odom is dated this far ahead (None: transform_publish_period)",
+    )
+    # --- laser ---
+    maxRange: float | None = param(
+        None, unit="m", range=(0.0, None), help="beams beyond are dropped (None: range_max-0.01)"
+    )
+    maxUrange: float | None = param(
+        None, unit="m", range=(0.0, None), help="usable range for matching (None: maxRange)"
+    )
+    # --- scan matcher ---
+    minimumScore: float = param(
+        0.0, range=(0.0, None), help="match score at or below which odometry is kept"
+    )
+    sigma: float = param(0.05, unit="m", range=(1e-9, None), help="score s += exp(-d^2/sigma)")
+    kernelSize: int = param(1, range=(0, 10), help="cells searched around each endpoint")
+    lstep: float = param(0.05, unit="m", range=(1e-9, None), help="initial translational step")
+    astep: float = param(0.05, unit="rad", range=(1e-9, None), help="initial angular step")
+    iterations: int = param(5, range=(0, 50), help="step halvings of the hill climber")
+    lsigma: float = param(
+        0.075, unit="m", range=(1e-9, None), help="likelihood l += -d^2/lsigma per beam"
+    )
+    ogain: float = param(3.0, range=(1e-9, None), help="smoothing of the weights")
+    lskip: int = param(0, range=(0, None), help="use every (lskip+1)-th beam")
+    # --- motion model ---
+    srr: float = param(0.1, range=(0.0, None), help="translation noise from translation")
+    srt: float = param(0.2, range=(0.0, None), help="rotation noise from translation")
+    str: float = param(0.1, range=(0.0, None), help="translation noise from rotation")
+    stt: float = param(0.2, range=(0.0, None), help="rotation noise from rotation")
+    # --- update gating and filter ---
+    linearUpdate: float = param(1.0, unit="m", range=(0.0, None), help="travel before an update")
+    angularUpdate: float = param(
+        0.5, unit="rad", range=(0.0, None), help="rotation before an update"
+    )
+    temporalUpdate: float | None = param(
+        None, unit="s", range=(0.0, None), help="scan time before an update (None: off)"
+    )
+    resampleThreshold: float = param(
+        0.5, range=(0.0, 1.0), help="resample when Neff < this * particles"
+    )
+    particles: int = param(30, range=(1, 10000), help="number of particles")
+    # --- map ---
+    xmin: float = param(-100.0, unit="m", help="initial map extent")
+    ymin: float = param(-100.0, unit="m", help="initial map extent")
+    xmax: float = param(100.0, unit="m", help="initial map extent")
+    ymax: float = param(100.0, unit="m", help="initial map extent")
+    delta: float = param(0.05, unit="m", range=(1e-4, 10.0), help="map resolution")
+    occ_thresh: float = param(0.25, range=(0.0, 1.0), help="hit ratio above which a cell is 100")
+    # --- read but never used by gmapping (NO_EFFECT) ---
+    llsamplerange: float = param(0.01, unit="m", help="no effect (gmapping never uses it)")
+    llsamplestep: float = param(0.01, unit="m", help="no effect (gmapping never uses it)")
+    lasamplerange: float = param(0.005, unit="rad", help="no effect (gmapping never uses it)")
+    lasamplestep: float = param(0.005, unit="rad", help="no effect (gmapping never uses it)")
+
+    def __post_init__(self) -> None:
+        if self.xmin >= self.xmax or self.ymin >= self.ymax:
+            raise ParameterError(
+                f"slam_gmapping: the map extent xmin..xmax = {self.xmin}..{self.xmax}, "
+                f"ymin..ymax = {self.ymin}..{self.ymax} is empty; set xmin < xmax and ymin < ymax"
+            )
+
+
+def gmapping_params(
+    mapping: Mapping[str, Any] | None, where: str = "slam_gmapping", logger: Any = None
+) -> GmappingParams:
+    """Validated `GmappingParams` from a ROS mapping; -1 means unset where ROS says so."""
+    log = logger or logging.getLogger("fleetsim.slam")
+    values = dict(mapping or {})
+    for key in UNSET_WHEN_NEGATIVE:
+        v = values.get(key)
+        if isinstance(v, int | float) and not isinstance(v, bool) and v < 0:
+            values[key] = None
+    for key in NO_EFFECT:
+        if key in values:
+            log.warning(
+                "%s: parameter '%s' has no effect: gmapping reads it but never uses it "
+                "(only ScanMatcher::likelihood() does, which slam_gmapping does not call)",
+                where,
+                key,
+            )
+    return load_params(GmappingParams, values, where=where, logger=log)

@@ -1,0 +1,232 @@
+"""gmapping's scan matcher (``scanmatcher.cpp``) as numba kernels batched over particles and beams.
+
+Each particle's map is a tiled hit map (see `fleetsim.slam.tiles`): ``table[p, ty, tx]`` is the
+index of a tile in a shared ``pool`` of shape ``(T, TILE, TILE, 3)`` holding per cell the hit
+count and the sums of the hit positions (x, y in m), or -1 for a tile never hit. This is
+gmapping with ``setgenerateMap(false)``, what slam_gmapping runs: the matching maps store
+endpoints only.
+
+A cell is "full" when it holds a hit and the cell one step back along the beam holds none
+(gmapping's ``cell > fullnessThreshold && fcell < fullnessThreshold`` with endpoint-only
+cells). gmapping computes that free cell from ``world2map(pfree - phit)``, which offsets by the
+map centre; we take the cell one ``sqrt(2) * delta`` back along the beam, as the code intends.
+
+Geometry arguments shared by the kernels:
+``geom = (origin_x, origin_y, delta)`` (m, m, m/cell) of cell (0, 0)'s corner;
+``laser = (x, y, yaw)`` of the laser in the base frame; ``ranges, angles`` (B,) in m and rad
+(laser frame), already restricted to usable beams (``0 < r <= maxUrange``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+TILE = 16  # cells per tile side (0.8 m at 5 cm)
+_SHIFT = 4
+_MASK = TILE - 1
+NULL_LIKELIHOOD = -0.5  # gmapping's nullLikelihood
+
+
+@numba.njit(cache=True, inline="always")
+def _hits_at(pool, table, p, ix, iy):
+    """Tile index and in-tile cell of (ix, iy) in particle p's map; tile -1 outside or unset."""
+    tx = ix >> _SHIFT
+    ty = iy >> _SHIFT
+    if ix < 0 or iy < 0 or ty >= table.shape[1] or tx >= table.shape[2]:
+        return -1
+    return table[p, ty, tx]
+
+
+@numba.njit(cache=True, fastmath=True)
+def _match(pool, table, p, pose, laser, ranges, cos_a, sin_a, geom, kernel, sigma, lsigma, skip,
+           want_l):  # fmt: skip
+    """gmapping's score (and, when want_l, likelihood) of ``pose`` for particle p.
+
+    ``cos_a``/``sin_a`` (B,) are the cosines and sines of the beam angles (laser frame).
+    """
+    ox, oy, delta = geom[0], geom[1], geom[2]
+    inv = 1.0 / delta
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    lx = pose[0] + c * laser[0] - s * laser[1]
+    ly = pose[1] + s * laser[0] + c * laser[1]
+    cl, sl = math.cos(pose[2] + laser[2]), math.sin(pose[2] + laser[2])
+    free_back = delta * math.sqrt(2.0)
+    no_hit = NULL_LIKELIHOOD / lsigma
+    score = 0.0
+    like = 0.0
+    for b in range(0, ranges.shape[0], skip + 1):
+        r = ranges[b]
+        ca = cl * cos_a[b] - sl * sin_a[b]
+        sa = sl * cos_a[b] + cl * sin_a[b]
+        hx, hy = lx + r * ca, ly + r * sa
+        ihx = math.floor((hx - ox) * inv)
+        ihy = math.floor((hy - oy) * inv)
+        dfx = math.floor((hx - free_back * ca - ox) * inv) - ihx
+        dfy = math.floor((hy - free_back * sa - oy) * inv) - ihy
+        found = False
+        best = 0.0
+        for xx in range(-kernel, kernel + 1):
+            cx = ihx + xx
+            for yy in range(-kernel, kernel + 1):
+                cy = ihy + yy
+                t = _hits_at(pool, table, p, cx, cy)
+                if t < 0:
+                    continue
+                n = pool[t, cy & _MASK, cx & _MASK, 0]
+                if n <= 0.0:
+                    continue
+                fx, fy = cx + dfx, cy + dfy
+                ft = _hits_at(pool, table, p, fx, fy)
+                if ft >= 0 and pool[ft, fy & _MASK, fx & _MASK, 0] > 0.0:
+                    continue
+                # sums are offsets from the cell's own corner (float32 stays exact to ~1e-8 m)
+                mx = hx - (ox + cx * delta + pool[t, cy & _MASK, cx & _MASK, 1] / n)
+                my = hy - (oy + cy * delta + pool[t, cy & _MASK, cx & _MASK, 2] / n)
+                d2 = mx * mx + my * my
+                if not found or d2 < best:
+                    best = d2
+                    found = True
+        if found:
+            score += math.exp(-best / sigma)
+        if want_l:
+            like += -best / lsigma if found else no_hit
+    return score, like
+
+
+@numba.njit(cache=True)
+def matched_poses(
+    pool, table, poses, laser, ranges, angles, geom, kernel, sigma, lsigma, skip,
+    lstep, astep, iterations, minimum_score,
+):  # fmt: skip
+    """Hill-climbed poses, scores and log-likelihoods of every particle (``ScanMatcher::optimize``
+    then ``likelihoodAndScore``).
+
+    Parameters
+    ----------
+    pool : (T, TILE, TILE, 3) float32, the shared tiles; table : (P, TY, TX) int32.
+    poses : (P, 3) float64, the particles' sampled base poses in the map frame (m, m, rad).
+
+    Returns
+    -------
+    out : (P, 3) float64, the matched poses (the sampled pose where the score <= minimum_score);
+    scores : (P,) the match scores; likes : (P,) the log-likelihoods at ``out``.
+    """
+    n = poses.shape[0]
+    out = poses.copy()
+    scores = np.zeros(n)
+    likes = np.zeros(n)
+    cand = np.empty(3)
+    cos_a, sin_a = np.cos(angles), np.sin(angles)
+    for p in range(n):
+        cur = poses[p].copy()
+        cur_score, _ = _match(
+            pool,
+            table,
+            p,
+            cur,
+            laser,
+            ranges,
+            cos_a,
+            sin_a,
+            geom,
+            kernel,
+            sigma,
+            lsigma,
+            skip,
+            False,
+        )
+        best_score = -1.0
+        ld, ad = lstep, astep
+        refinement = 0
+        while True:
+            if best_score >= cur_score:
+                refinement += 1
+                ld *= 0.5
+                ad *= 0.5
+            best_score = cur_score
+            best_local = cur.copy()
+            for move in range(6):
+                cand[0], cand[1], cand[2] = cur[0], cur[1], cur[2]
+                if move == 0:
+                    cand[0] += ld
+                elif move == 1:
+                    cand[0] -= ld
+                elif move == 2:
+                    cand[1] -= ld
+                elif move == 3:
+                    cand[1] += ld
+                elif move == 4:
+                    cand[2] += ad
+                else:
+                    cand[2] -= ad
+                sc, _ = _match(
+                    pool, table, p, cand, laser, ranges, cos_a, sin_a, geom, kernel, sigma,
+                    lsigma, skip, False,
+                )  # fmt: skip
+                if sc > cur_score:
+                    cur_score = sc
+                    best_local[:] = cand
+            cur[:] = best_local
+            if not (cur_score > best_score or refinement < iterations):
+                break
+        if best_score > minimum_score:
+            out[p] = cur
+        scores[p] = best_score
+        _, likes[p] = _match(
+            pool,
+            table,
+            p,
+            out[p],
+            laser,
+            ranges,
+            cos_a,
+            sin_a,
+            geom,
+            kernel,
+            sigma,
+            lsigma,
+            skip,
+            True,
+        )
+    return out, scores, likes
+
+
+@numba.njit(cache=True)
+def endpoint_cells(poses, laser, ranges, angles, geom):
+    """(P, B, 2) int64 cells ``(ix, iy)`` of every beam's endpoint for every particle."""
+    n, b = poses.shape[0], ranges.shape[0]
+    out = np.empty((n, b, 2), dtype=np.int64)
+    hits = np.empty((n, b, 2))
+    ox, oy, delta = geom[0], geom[1], geom[2]
+    for p in range(n):
+        c, s = math.cos(poses[p, 2]), math.sin(poses[p, 2])
+        lx = poses[p, 0] + c * laser[0] - s * laser[1]
+        ly = poses[p, 1] + s * laser[0] + c * laser[1]
+        lt = poses[p, 2] + laser[2]
+        for i in range(b):
+            hx = lx + ranges[i] * math.cos(lt + angles[i])
+            hy = ly + ranges[i] * math.sin(lt + angles[i])
+            hits[p, i, 0], hits[p, i, 1] = hx, hy
+            out[p, i, 0] = math.floor((hx - ox) / delta)
+            out[p, i, 1] = math.floor((hy - oy) / delta)
+    return out, hits
+
+
+@numba.njit(cache=True)
+def add_hits(pool, table, cells, hits, geom):
+    """Add each particle's endpoints to its own tiles (which the caller made writable).
+
+    A cell holds its hit count and the sums of the hits' offsets from the cell's corner (m).
+    """
+    ox, oy, delta = geom[0], geom[1], geom[2]
+    for p in range(cells.shape[0]):
+        for i in range(cells.shape[1]):
+            ix, iy = cells[p, i, 0], cells[p, i, 1]
+            t = table[p, iy >> _SHIFT, ix >> _SHIFT]
+            c = pool[t, iy & _MASK, ix & _MASK]
+            c[0] += 1.0
+            c[1] += hits[p, i, 0] - (ox + ix * delta)
+            c[2] += hits[p, i, 1] - (oy + iy * delta)

@@ -1,0 +1,136 @@
+"""Tests for fleetsim.slam.scan_match against a slow transcription of gmapping's score."""
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import Phase, given, settings
+from hypothesis import strategies as st
+
+from fleetsim.slam.scan_match import endpoint_cells, matched_poses
+from fleetsim.slam.tiles import TiledHitMaps
+
+LASER = np.array([0.1, 0.05, 0.2])
+GEOM_ARGS = (-4.0, -4.0, 4.0, 4.0, 0.05)
+W, H = 3.013, 2.017  # half sizes of the room, m
+
+
+def room_maps(particles=2):
+    """Hit maps of a 6 x 4 m rectangle of walls seen from the origin, identical per particle.
+
+    The walls lie off cell boundaries (W, H), so rounding cannot put a beam in another cell.
+    """
+    maps = TiledHitMaps(particles, *GEOM_ARGS)
+    xs = np.arange(-W, W, 0.02)
+    ys = np.arange(-H, H, 0.02)
+    pts = np.concatenate(
+        [
+            np.c_[xs, np.full_like(xs, -H)],
+            np.c_[xs, np.full_like(xs, H)],
+            np.c_[np.full_like(ys, -W), ys],
+            np.c_[np.full_like(ys, W), ys],
+        ]
+    )
+    poses = np.zeros((particles, 3))
+    r = np.hypot(pts[:, 0], pts[:, 1])
+    a = np.arctan2(pts[:, 1], pts[:, 0])
+    cells, hits = endpoint_cells(poses, np.zeros(3), r, a, maps.geom)
+    maps.add_scan(cells, hits)
+    return maps
+
+
+def scan_from(pose, n=180):
+    """Exact ranges of the rectangle from the laser at ``pose (+) LASER``."""
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    lx = pose[0] + c * LASER[0] - s * LASER[1]
+    ly = pose[1] + s * LASER[0] + c * LASER[1]
+    angles = -np.pi + 2 * np.pi / n * np.arange(n)
+    a = pose[2] + LASER[2] + angles
+    dx, dy = np.cos(a), np.sin(a)
+    with np.errstate(divide="ignore"):
+        tx = np.where(dx > 0, (W - lx) / dx, (-W - lx) / dx)
+        ty = np.where(dy > 0, (H - ly) / dy, (-H - ly) / dy)
+    return np.minimum(tx, ty), angles
+
+
+def reference_score(maps, p, pose, ranges, angles, kernel=1, sigma=0.05, lsigma=0.075):
+    """gmapping's ``score`` and ``likelihoodAndScore``, beam by beam, cell by cell."""
+    ox, oy, delta = maps.geom
+    dense = np.zeros((*maps.shape_cells, 3))
+    for ty in range(maps.table.shape[1]):
+        for tx in range(maps.table.shape[2]):
+            t = maps.table[p, ty, tx]
+            if t >= 0:
+                dense[ty * 16 : ty * 16 + 16, tx * 16 : tx * 16 + 16] = maps.pool[t]
+    c, s = math.cos(pose[2]), math.sin(pose[2])
+    lx = pose[0] + c * LASER[0] - s * LASER[1]
+    ly = pose[1] + s * LASER[0] + c * LASER[1]
+    score = like = 0.0
+    for r, ang in zip(ranges, angles):
+        a = pose[2] + LASER[2] + ang
+        hx, hy = lx + r * math.cos(a), ly + r * math.sin(a)
+        fx = hx - delta * math.sqrt(2) * math.cos(a)
+        fy = hy - delta * math.sqrt(2) * math.sin(a)
+        ih = (math.floor((hx - ox) / delta), math.floor((hy - oy) / delta))
+        df = (math.floor((fx - ox) / delta) - ih[0], math.floor((fy - oy) / delta) - ih[1])
+        best = None
+        for xx in range(-kernel, kernel + 1):
+            for yy in range(-kernel, kernel + 1):
+                cx, cy = ih[0] + xx, ih[1] + yy
+                n, sx, sy = dense[cy, cx]
+                if n <= 0 or dense[cy + df[1], cx + df[0], 0] > 0:
+                    continue
+                mu = (hx - (ox + cx * delta + sx / n), hy - (oy + cy * delta + sy / n))
+                d2 = mu[0] ** 2 + mu[1] ** 2
+                best = d2 if best is None else min(best, d2)
+        if best is not None:
+            score += math.exp(-best / sigma)
+        like += -best / lsigma if best is not None else -0.5 / lsigma
+    return score, like
+
+
+@settings(max_examples=20, deadline=None, phases=[Phase.explicit, Phase.generate])
+@given(st.floats(-0.3, 0.3), st.floats(-0.3, 0.3), st.floats(-0.2, 0.2), st.floats(-0.1, 0.1))
+def test_likelihood_at_the_matched_pose_agrees_with_gmapping_score(x, y, yaw, err):
+    maps = room_maps()
+    true = np.array([x, y, yaw])
+    ranges, angles = scan_from(true)
+    start = np.array([[x + err, y - err, yaw + err], [x, y, yaw]])
+    # no steps and a huge minimum score: the pose stays, only score and likelihood are computed
+    out, scores, likes = matched_poses(
+        maps.pool, maps.table, start, LASER, ranges, angles, maps.geom, 1, 0.05, 0.075, 0,
+        0.0, 0.0, 0, 1e9,
+    )  # fmt: skip
+    assert np.array_equal(out, start)
+    for p in range(2):
+        ref_score, ref_like = reference_score(maps, p, start[p], ranges, angles)
+        assert scores[p] == pytest.approx(ref_score, rel=1e-6, abs=1e-6)
+        assert likes[p] == pytest.approx(ref_like, rel=1e-6, abs=1e-6)
+
+
+def test_hill_climbing_recovers_an_offset_pose():
+    maps = room_maps(particles=3)
+    true = np.array([0.2, -0.1, 0.05])
+    ranges, angles = scan_from(true)
+    start = true + np.array([[0.08, -0.06, 0.04], [-0.1, 0.05, -0.03], [0.0, 0.0, 0.0]])
+    out, scores, likes = matched_poses(
+        maps.pool, maps.table, start, LASER, ranges, angles, maps.geom, 1, 0.05, 0.075, 0,
+        0.05, 0.05, 5, 0.0,
+    )  # fmt: skip
+    assert np.abs(out - true).max() < 0.015
+    assert scores.min() > 0.9 * len(ranges)  # nearly every beam on a wall
+    # a score at or below minimumScore keeps the sampled pose
+    out2, *_ = matched_poses(
+        maps.pool, maps.table, start, LASER, ranges, angles, maps.geom, 1, 0.05, 0.075, 0,
+        0.05, 0.05, 5, 1e9,
+    )  # fmt: skip
+    assert np.array_equal(out2, start)
+
+
+def test_lskip_uses_every_nth_beam():
+    maps = room_maps(particles=1)
+    ranges, angles = scan_from(np.zeros(3))
+    args = (maps.pool, maps.table, np.zeros((1, 3)), LASER, ranges, angles, maps.geom, 1)
+    _, s0, _ = matched_poses(*args, 0.05, 0.075, 0, 0.0, 0.0, 0, 1e9)
+    _, s2, _ = matched_poses(*args, 0.05, 0.075, 2, 0.0, 0.0, 0, 1e9)
+    assert s2[0] == pytest.approx(s0[0] / 3, rel=0.05)

@@ -1,0 +1,175 @@
+"""Tests for fleetsim.slam.node: slam_gmapping in a runtime, on the synthetic room.
+
+A fake robot drives a loop with drifting odometry and exact 360-beam scans; the published map
+is checked against the room's true occupancy, the map -> odom tf against the true pose.
+"""
+
+import logging
+
+import numpy as np
+import pytest
+from slam_world import FakeRobot, true_occupied
+
+from fleetsim.errors import ServiceError
+from fleetsim.launch.registry import resolve_node
+from fleetsim.msgs import nav_msgs, std_msgs
+from fleetsim.nav.map_io import load_map
+from fleetsim.nav.map_server import MapSaver
+from fleetsim.runtime import Node, Runtime
+from fleetsim.slam import SlamGmapping
+
+START = np.array([1.5, 1.5, 0.0])  # the route's first pose: the map frame's origin
+FAST = {"xmin": -5.0, "ymin": -5.0, "xmax": 15.0, "ymax": 12.0, "particles": 15}
+
+
+class Listener(Node):
+    def __init__(self, rt, ns="/"):
+        super().__init__(rt, "listener", ns)
+        self.maps, self.meta, self.entropy = [], [], []
+        self.create_subscription(nav_msgs.OccupancyGrid, "map", self.maps.append)
+        self.create_subscription(nav_msgs.MapMetaData, "map_metadata", self.meta.append)
+        self.create_subscription(std_msgs.Float64, "slam_gmapping/entropy", self.entropy.append)
+
+
+def world(ns="/", prefix="", params=None, seed=0, **robot_kw):
+    rt = Runtime(seed=seed)
+    if prefix:
+        rt.params.set(f"{ns}/tf_prefix", prefix)
+    for key, value in {**FAST, **(params or {})}.items():
+        rt.params.set(f"{ns.rstrip('/')}/slam_gmapping/{key}", value)
+    robot = FakeRobot(rt, ns, seed=seed, **robot_kw)
+    slam = SlamGmapping(rt, "slam_gmapping", ns)
+    return rt, robot, slam, Listener(rt, ns)
+
+
+def precision(grid: nav_msgs.OccupancyGrid, offset=START) -> float:
+    """Share of occupied cells within 0.1 m of the room's true occupancy."""
+    data = np.asarray(grid.data).reshape(grid.info.height, grid.info.width)
+    iy, ix = np.nonzero(data == 100)
+    res, o = grid.info.resolution, grid.info.origin.position
+    x, y = o.x + (ix + 0.5) * res + offset[0], o.y + (iy + 0.5) * res + offset[1]
+    near = np.zeros(len(x), dtype=bool)
+    for dx in (-0.1, 0.0, 0.1):
+        for dy in (-0.1, 0.0, 0.1):
+            near |= true_occupied(x + dx, y + dy)
+    return float(near.mean())
+
+
+def test_registered_as_gmapping_slam_gmapping():
+    assert resolve_node("gmapping", "slam_gmapping") is SlamGmapping
+
+
+def test_maps_the_room_in_a_namespace_with_its_own_frames(caplog):
+    with caplog.at_level(logging.WARNING):
+        rt, robot, slam, out = world(
+            "/lizi1", "lizi1", {"map_update_interval": 2.0, "linearUpdate": 0.5}
+        )
+        errors = []
+        for _ in range(8):
+            rt.run(duration=5.0)
+            est = np.array(rt.tf_buffer.lookup_pose2d("lizi1/map", "lizi1/base_link", 0.0))
+            errors.append(np.hypot(*(est[:2] + START[:2] - robot.true[:2])))
+    assert (slam.map_frame, slam.odom_frame, slam.base_frame) == (
+        "lizi1/map",
+        "lizi1/odom",
+        "lizi1/base_link",
+    )
+    assert max(errors) < 0.08, errors
+    grid = out.maps[-1]
+    assert grid.header.frame_id == "lizi1/map" and grid.info.resolution == pytest.approx(0.05)
+    assert out.meta[-1].width == grid.info.width
+    assert precision(grid) > 0.97
+    data = np.asarray(grid.data)
+    assert set(np.unique(data)) <= {-1, 0, 100} and (data == 0).sum() > 10_000
+    assert out.entropy and out.entropy[-1].data > 0
+    # map published every map_update_interval of scan time, not at every update
+    assert 10 <= len(out.maps) <= 22 < slam.filter.updates
+    assert "WARN" not in caplog.text
+    # the tf thread: map -> odom every transform_publish_period, dated ahead by it
+    info = rt.tf_buffer.frame_info("lizi1/odom")
+    assert info.parent == "lizi1/map" and info.most_recent == pytest.approx(
+        rt.now() + 0.05, abs=0.02
+    )
+    # dynamic_map answers the latest map
+    resp = slam.runtime.graph.services["/lizi1/dynamic_map"].callback(nav_msgs.GetMap.Request())
+    assert resp.map is slam.grid_msg
+
+
+def test_transform_publish_period_is_capped_at_the_simulator_rate(caplog):
+    with caplog.at_level(logging.INFO):
+        rt, robot, slam, out = world(params={"transform_publish_period": 0.0005})
+    assert slam.tf_period == pytest.approx(0.01)
+    assert "faster than the simulator publishes" in caplog.text
+
+
+def test_updates_gated_by_linear_angular_and_temporal_update():
+    # the robot stands still: no update after the first unless temporalUpdate is set
+    still = [[1.5, 1.5]]
+    rt, _, slam, _ = world(route=still)
+    rt.run(duration=5.0)
+    assert slam.filter.updates == 1
+    rt, _, slam, _ = world(params={"temporalUpdate": 1.0}, route=still)
+    rt.run(duration=5.05)
+    assert slam.filter.updates == 5  # t = 0, then every scan more than 1 s after the last
+    rt, _, slam, _ = world(params={"temporalUpdate": -1.0}, route=still)  # ROS's "off"
+    assert slam.params.temporalUpdate is None
+
+
+def test_a_scan_whose_beam_count_changes_is_dropped_with_an_error(caplog):
+    rt, robot, slam, _ = world("/r1", "r1")
+    rt.run(duration=1.0)
+    robot.beams = 180
+    with caplog.at_level(logging.WARNING):
+        rt.run(duration=2.0)
+    assert "dropping scans on /r1/scan (frame 'r1/laser'): 180 beams" in caplog.text
+    assert "first scan had 360" in caplog.text
+
+
+def test_a_tilted_laser_is_refused_and_an_upside_down_one_mirrored(caplog):
+    with caplog.at_level(logging.WARNING):
+        rt, _, slam, _ = world(laser_rpy=(0.0, 0.4, 0.0))
+        rt.run(duration=1.0)
+    assert "the laser frame 'laser' of /scan is not level" in caplog.text
+    assert slam.filter is None
+    caplog.clear()
+    with caplog.at_level(logging.WARNING):
+        rt, robot, slam, out = world(laser_rpy=(np.pi, 0.0, 0.0), params={"linearUpdate": 0.5})
+        rt.run(duration=20.0)
+    assert "laser frame 'laser' of /scan is mounted upside down" in caplog.text
+    assert precision(out.maps[-1]) > 0.97  # the mirrored beams still make the right map
+
+
+def test_missing_odometry_tf_is_reported_naming_the_frames(caplog):
+    rt = Runtime(seed=0)
+    robot = FakeRobot(rt)
+    robot.tf.send_transform = lambda *a, **k: None  # the robot publishes no odometry
+    SlamGmapping(rt)
+    with caplog.at_level(logging.WARNING):
+        rt.run(duration=2.0)
+    assert "no odometry for the scans on /scan: cannot look up odom -> base_link" in caplog.text
+
+
+def test_dynamic_map_before_any_scan_is_a_clear_error():
+    rt = Runtime(seed=0)
+    SlamGmapping(rt)
+    client = Node(rt, "client").create_client(nav_msgs.GetMap, "dynamic_map")
+    with pytest.raises(ServiceError, match="no map yet"):
+        client.call(nav_msgs.GetMap.Request())
+
+
+def test_map_saver_saves_the_slam_map(tmp_path):
+    rt, robot, slam, out = world(params={"map_update_interval": 1.0, "linearUpdate": 0.5})
+    rt.run(duration=20.0)
+    saver = MapSaver(rt, args=["-f", str(tmp_path / "room")])
+    rt.run(duration=0.1)
+    assert saver.saved is not None
+    saved = load_map(tmp_path / "room.yaml")
+    grid = slam.grid_msg
+    assert saved.data.shape == (grid.info.height, grid.info.width)
+    assert saved.origin[:2] == pytest.approx(
+        (grid.info.origin.position.x, grid.info.origin.position.y)
+    )
+    # occupied / free / unknown come back as they were published
+    expected = np.asarray(grid.data).reshape(saved.data.shape)
+    assert np.array_equal(saved.data == 100, expected == 100)
+    assert np.array_equal(saved.data == -1, expected == -1)

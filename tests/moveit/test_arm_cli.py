@@ -65,3 +65,21 @@ def test_go_to_a_named_pose_and_bad_targets(served):
         r = run("arm", "go", *args, "--ns", "hunter1", "-c", ep)
         assert r.exit_code != 0 and isinstance(r.exception, FleetsimError), r.output
         assert message in str(r.exception)
+
+
+def test_commander_from_another_process_over_the_bridge(served):
+    from fleetsim.moveit import MoveGroupCommander
+
+    ep, h = served
+    arm = MoveGroupCommander("arm_group", ns="/hunter1", connect=ep)
+    try:
+        assert "cam_back" in arm.get_named_targets()
+        arm.set_named_target("cam_back")
+        assert arm.go(), arm.last_result()
+        assert arm.get_current_joint_values()[0] == pytest.approx(1.6828, abs=0.02)
+        ok, traj, planning_time, code = arm.plan("home")
+        assert ok and code.val == 1 and traj.joint_trajectory.joint_names[0] == "arm_joint_01"
+        with pytest.raises(FleetsimError, match="no named state 'up'"):
+            arm.set_named_target("up")
+    finally:
+        arm._c.close()

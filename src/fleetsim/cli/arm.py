@@ -31,26 +31,9 @@ def _ns(ns: str) -> str:
 
 
 def _model(client, ns: str):
-    from fleetsim.description.srdf import parse_srdf
-    from fleetsim.description.urdf import parse_urdf
-    from fleetsim.moveit.robot_model import RobotModel
+    from fleetsim.moveit.remote import robot_model
 
-    texts = {}
-    for key in ("robot_description", "robot_description_semantic"):
-        name = names.join(ns, key)
-        try:
-            texts[key] = client.param("get", name)
-        except Exception as e:  # the server answers a missing key with an error
-            raise PlanningError(f"{name} is not set in the running simulation ({e})") from None
-    robot = parse_urdf(texts["robot_description"], source=names.join(ns, "robot_description"))
-    srdf = parse_srdf(
-        texts["robot_description_semantic"], names.join(ns, "robot_description_semantic"), robot
-    )
-    try:
-        planning = client.param("get", names.join(ns, "robot_description_planning"))
-    except Exception:
-        planning = {}
-    return RobotModel(robot, srdf, planning if isinstance(planning, dict) else {})
+    return robot_model(client, ns)
 
 
 def error_code_name(code: int) -> str:

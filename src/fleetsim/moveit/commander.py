@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import itertools
 import math
+import os
 from typing import Any
 
 import numpy as np
@@ -49,9 +50,20 @@ class MoveGroupCommander:
         ns: str = "",
         wait_for_servers: float = 5.0,
         *,
-        runtime,
+        runtime=None,
+        connect: str | None = None,
     ) -> None:
-        self._c = _Client(runtime, ns)
+        """``runtime``: the simulation's Runtime in this process; without one, the commander
+        joins a simulation in another process over the Zenoh bridge (``connect``: its locator,
+        default ``$FLEETSIM_ZENOH`` or tcp/127.0.0.1:7447)."""
+        if runtime is None:
+            from fleetsim.moveit.remote import RemoteSession
+
+            self._c = RemoteSession(
+                connect or os.environ.get("FLEETSIM_ZENOH"), ns, wait_for_servers
+            )
+        else:
+            self._c = _Client(runtime, ns)
         mg = self._c.move_group
         if mg is None:
             raise MoveItCommanderException(

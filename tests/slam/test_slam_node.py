@@ -173,3 +173,12 @@ def test_map_saver_saves_the_slam_map(tmp_path):
     expected = np.asarray(grid.data).reshape(saved.data.shape)
     assert np.array_equal(saved.data == 100, expected == 100)
     assert np.array_equal(saved.data == -1, expected == -1)
+
+
+def test_frame_parameters_are_strings_next_to_the_str_noise_parameter():
+    rt = Runtime(seed=0)
+    for key, value in {"base_frame": "base_footprint", "str": 0.3, "temporalUpdate": 3}.items():
+        rt.params.set(f"/slam_gmapping/{key}", value)
+    slam = SlamGmapping(rt)
+    assert slam.base_frame == "base_footprint" and slam.params.str == 0.3
+    assert slam.params.temporalUpdate == 3.0

@@ -13,6 +13,7 @@ about (`NO_EFFECT`).
 
 from __future__ import annotations
 
+import builtins
 import logging
 from collections.abc import Mapping
 from dataclasses import dataclass
@@ -30,12 +31,16 @@ UNSET_WHEN_NEGATIVE = ("temporalUpdate", "maxRange", "maxUrange")
 
 @dataclass(frozen=True)
 class GmappingParams:
-    """Parameters of ``gmapping/slam_gmapping`` (ROS names, gmapping's code defaults)."""
+    """Parameters of ``gmapping/slam_gmapping`` (ROS names, gmapping's code defaults).
+
+    The field ``str`` (gmapping's name) shadows the builtin in this class body, hence
+    ``builtins.str`` for the frame names.
+    """
 
     # --- frames and rates ---
-    base_frame: str = param("base_link", help="robot base frame (tf_prefix applied)")
-    map_frame: str = param("map", help="frame of the map (tf_prefix applied)")
-    odom_frame: str = param("odom", help="odometry frame (tf_prefix applied)")
+    base_frame: builtins.str = param("base_link", help="robot base frame (tf_prefix applied)")
+    map_frame: builtins.str = param("map", help="frame of the map (tf_prefix applied)")
+    odom_frame: builtins.str = param("odom", help="odometry frame (tf_prefix applied)")
     throttle_scans: int = param(1, range=(1, None), help="process every n-th scan")
     map_update_interval: float = param(
         5.0, unit="s", range=(0.0, None), help="scan time between two publications of the map"
@@ -121,12 +126,14 @@ def gmapping_params(
         v = values.get(key)
         if isinstance(v, int | float) and not isinstance(v, bool) and v < 0:
             values[key] = None
-    for key in NO_EFFECT:
-        if key in values:
-            log.warning(
-                "%s: parameter '%s' has no effect: gmapping reads it but never uses it "
-                "(only ScanMatcher::likelihood() does, which slam_gmapping does not call)",
-                where,
-                key,
-            )
+    unused = [key for key in NO_EFFECT if key in values]
+    if unused:
+        log.warning(
+            "%s: parameter%s %s ha%s no effect: gmapping reads them but never uses them (only "
+            "ScanMatcher::likelihood() does, which slam_gmapping does not call)",
+            where,
+            "s" if len(unused) > 1 else "",
+            ", ".join(repr(k) for k in unused),
+            "ve" if len(unused) > 1 else "s",
+        )
     return load_params(GmappingParams, values, where=where, logger=log)

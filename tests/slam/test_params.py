@@ -1,0 +1,36 @@
+"""Tests for fleetsim.slam.params: gmapping's code defaults, ROS's -1, the no-effect four."""
+
+import logging
+
+import pytest
+
+from fleetsim.errors import ParameterError
+from fleetsim.slam.params import GmappingParams, gmapping_params
+
+
+def test_code_defaults_not_the_wikis():
+    p = GmappingParams()
+    assert p.maxUrange is None and p.maxRange is None  # the laser's range_max - 0.01
+    assert p.temporalUpdate is None  # off
+    assert (p.srr, p.srt, p.str, p.stt) == (0.1, 0.2, 0.1, 0.2)
+    assert (p.particles, p.angularUpdate, p.linearUpdate, p.iterations) == (30, 0.5, 1.0, 5)
+    assert (p.xmin, p.xmax, p.delta, p.occ_thresh) == (-100.0, 100.0, 0.05, 0.25)
+    assert p.transform_publish_period == 0.05 and p.tf_delay is None
+
+
+def test_minus_one_means_unset_and_the_four_sampling_parameters_warn(caplog):
+    with caplog.at_level(logging.WARNING):
+        p = gmapping_params(
+            {"temporalUpdate": -1.0, "maxUrange": -1, "llsamplerange": 0.01, "lasamplestep": 0.1}
+        )
+    assert p.temporalUpdate is None and p.maxUrange is None
+    assert "'llsamplerange', 'lasamplestep' have no effect" in caplog.text
+
+
+def test_bad_values_name_the_parameter():
+    with pytest.raises(ParameterError, match="parameter 'particles' = 0 is out of range"):
+        gmapping_params({"particles": 0}, "/robot/slam_gmapping")
+    with pytest.raises(ParameterError, match="parameter 'sigma' must be float"):
+        gmapping_params({"sigma": "wide"})
+    with pytest.raises(ParameterError, match="xmin < xmax"):
+        gmapping_params({"xmin": 5.0, "xmax": 1.0})

@@ -1,0 +1,79 @@
+"""Tests for fleetsim.slam.filter, motion and tree: the RBPF off the graph on the synthetic room."""
+
+import numpy as np
+import pytest
+from slam_world import LASER, ROUTE, drive, exact_ranges
+
+from fleetsim.slam import filter as slam_filter
+from fleetsim.slam.filter import Beams, GmappingFilter, systematic_resample
+from fleetsim.slam.motion import poses_after_motion
+from fleetsim.slam.params import GmappingParams
+
+ANGLES = -np.pi + 2 * np.pi / 360 * np.arange(360)
+
+
+def beams_at(true, rng):
+    c, s = np.cos(true[2]), np.sin(true[2])
+    sensor = true + np.array([c * LASER[0], s * LASER[0], 0.0])
+    r = exact_ranges(sensor, ANGLES, 12.0) + 0.01 * rng.standard_normal(360)
+    keep = np.isfinite(r)
+    return Beams(r[keep], ANGLES[keep])
+
+
+def test_motion_noise_follows_gmappings_formula():
+    rng = np.random.default_rng(0)
+    poses = np.zeros((20000, 3))
+    out = poses_after_motion(poses, np.array([1.0, 0.0, 0.5]), np.zeros(3), 0.1, 0.2, 0.1, 0.2, rng)
+    assert out.mean(axis=0) == pytest.approx([1.0, 0.0, 0.5], abs=0.01)
+    # x: srr|dx| + str|dth| = 0.15; y: str|dth| + 0.3 srr|dx| = 0.08; yaw: stt|dth| + srt*1 = 0.3
+    assert out.std(axis=0) == pytest.approx([0.15, 0.08, 0.3], rel=0.05)
+
+
+def test_systematic_resampling_keeps_heavy_particles():
+    rng = np.random.default_rng(1)
+    idx = systematic_resample(np.array([0.7, 0.1, 0.1, 0.1, 0.0]), rng)
+    assert len(idx) == 5 and 4 not in idx and (idx == 0).sum() in (3, 4)
+
+
+def test_rendering_replays_only_the_scans_since_the_particles_agreed(monkeypatch):
+    rng = np.random.default_rng(2)
+    params = GmappingParams(
+        particles=10, xmin=-4, ymin=-4, xmax=14, ymax=10, linearUpdate=0.3, angularUpdate=0.3
+    )
+    f = GmappingFilter(params, rng, LASER, 11.99, 11.99)
+    casts = []
+    real = GmappingFilter._cast
+    monkeypatch.setattr(
+        GmappingFilter, "_cast", lambda self, g, n: (casts.append(n), real(self, g, n))
+    )
+    replayed = []
+    resampled = 0
+    depths = []
+    for i, (true, odom) in enumerate(drive(ROUTE, np.random.default_rng(3))):
+        result = f.process(odom, 0.1 * i, beams_at(true, rng))
+        resampled += result.resampled
+        if result.updated and f.updates % 5 == 0:
+            casts.clear()
+            f.occupancy()
+            replayed.append(len(casts))
+            depths.append(f.nodes[0].depth - f.base_node.depth)
+    assert f.updates > 60 and resampled > 5
+    # each map costs the scans since the particles' common ancestor plus those newly agreed
+    # on, not the whole run: it falls back whenever the lineages coalesce
+    assert max(replayed) < f.updates / 2
+    half = len(replayed) // 2
+    assert min(replayed[half:]) < max(replayed[:half])
+    assert f.base_node is not None and f.base_node.parent is None  # older history freed
+    assert 0 < f.maps.tiles_in_use < 3 * 10 * 200  # tiles shared, not 10 full copies
+
+
+def test_map_grows_when_the_robot_leaves_it():
+    rng = np.random.default_rng(4)
+    params = GmappingParams(particles=3, xmin=-1, ymin=-1, xmax=1, ymax=1)
+    f = GmappingFilter(params, rng, LASER, 11.99, 11.99)
+    true = np.array([1.5, 1.5, 0.0])
+    f.process(np.zeros(3), 0.0, beams_at(true, rng))
+    x0, y0, x1, y1 = f.maps.bounds
+    assert x0 <= -12 - slam_filter.ENLARGE_STEP + 1 and x1 >= 12 + slam_filter.ENLARGE_STEP - 1
+    data, geom = f.occupancy()
+    assert data.shape == f.base.visits.shape and tuple(geom[:2]) == (x0, y0)

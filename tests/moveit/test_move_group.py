@@ -184,3 +184,51 @@ def test_fake_execution_without_physics(hunter_robot):
     np.testing.assert_allclose(
         fake[-1].position, list(arm.get_named_target_values("cam_back").values()), atol=1e-9
     )
+
+
+def test_stop_start_deviation_and_the_plan_service(one):
+    arm = MoveGroupCommander("arm_group", ns="/hunter1", runtime=one.rt)
+    arm.set_named_target("home")
+    assert arm.go()
+    arm.set_named_target("cam_back")
+    arm.go(wait=False)
+    one.rt.run(2.0)
+    arm.stop()
+    one.rt.run(1.0, until=lambda: arm._last.result is not None)
+    result, text = arm.last_result()
+    assert result.error_code.val == E.PREEMPTED and "trajectory_execution_event" in text
+    held = np.array(arm.get_current_joint_values())
+    one.rt.run(1.0)
+    np.testing.assert_allclose(arm.get_current_joint_values(), held, atol=0.01)
+    # a trajectory that starts away from where the arm is: refused before it moves
+    far = trajectory_msgs.JointTrajectory(joint_names=ARM)
+    far.points = [
+        trajectory_msgs.JointTrajectoryPoint(
+            positions=held + 0.2, time_from_start=Duration.from_sec(0.0)
+        ),
+        trajectory_msgs.JointTrajectoryPoint(
+            positions=held + 0.3, time_from_start=Duration.from_sec(1.0)
+        ),
+    ]
+    assert not arm.execute(far)
+    assert "start point deviates from current robot state more than 0.01" in arm.last_result()[1]
+    req = moveit_msgs.GetMotionPlanRequest()
+    req.motion_plan_request.group_name = "arm_group"
+    req.motion_plan_request.goal_constraints = [
+        moveit_msgs.Constraints(
+            joint_constraints=[
+                moveit_msgs.JointConstraint(joint_name=j, position=v)
+                for j, v in arm.get_named_target_values("cam_left").items()
+            ]
+        )
+    ]
+    now = arm.get_current_joint_values()
+    res = one.rt.graph.call_service(
+        "/hunter1/plan_kinematic_path", moveit_msgs.GetMotionPlan, req
+    ).motion_plan_response
+    assert res.error_code.val == E.SUCCESS
+    pts = res.trajectory.joint_trajectory.points
+    np.testing.assert_allclose(pts[0].positions, now, atol=1e-9)  # from the current state
+    np.testing.assert_allclose(
+        pts[-1].positions, list(arm.get_named_target_values("cam_left").values()), atol=1e-9
+    )

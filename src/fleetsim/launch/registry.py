@@ -24,6 +24,7 @@ NODES: dict[tuple[str, str], str] = {
     ("map_server", "map_saver"): "fleetsim.nav.map_server:MapSaver",
     ("move_base", "move_base"): "fleetsim.nav.move_base:MoveBase",
     ("gmapping", "slam_gmapping"): "fleetsim.slam.node:SlamGmapping",
+    ("explore_lite", "explore"): "fleetsim.nav.explore.explore:Explore",
     ("fleetsim", "send_goals"): "fleetsim.nav.send_goals:SendGoals",
     ("navigation_multi", "send_goals"): "fleetsim.nav.send_goals:SendGoals",
     ("gazebo_ros", "gzserver"): "fleetsim.sim.node:Simulator",

@@ -1,0 +1,205 @@
+"""The ``explore_lite/explore`` node: greedy frontier exploration over move_base.
+
+Every ``1 / planner_frequency`` s the node finds the frontiers of the costmap it subscribes to
+(``costmap_topic``, usually ``move_base/global_costmap/costmap``), drops those on its blacklist
+(within 5 cells of a goal that failed), and sends the cheapest frontier's centroid to
+``move_base``. A goal move_base aborts is blacklisted; so is one the robot makes no progress
+towards (its distance to it does not shrink) for ``progress_timeout`` s. When no frontier is
+left the node stops (``finished``), as explore_lite does ("All frontiers traversed/tried out,
+stopping"). With ``visualize`` it publishes ``~frontiers`` (visualization_msgs/MarkerArray).
+
+``costmap_updates_topic`` is accepted but fleetsim's costmaps publish whole grids only (see
+`fleetsim.nav.costmap.costmap_ros`), so it is not subscribed. ``orientation_scale`` is accepted
+and, as in explore_lite, unused.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from fleetsim.errors import FleetsimError
+from fleetsim.msgs import geometry_msgs, move_base_msgs, nav_msgs, std_msgs, visualization_msgs
+from fleetsim.runtime import Node, param
+from fleetsim.tf.names import resolve_frame_once
+
+from .frontier_search import Frontier, frontiers_from_grid
+
+BLACKLIST_RADIUS_CELLS = 5  # explore_lite's goalOnBlacklist tolerance
+SUCCEEDED, ABORTED = 3, 4
+
+
+@dataclass(frozen=True)
+class ExploreParams:
+    """explore_lite's parameters (ROS names and defaults)."""
+
+    robot_base_frame: str = param("base_link", help="robot base frame (tf_prefix applied)")
+    costmap_topic: str = param("costmap", help="nav_msgs/OccupancyGrid to explore")
+    costmap_updates_topic: str = param(
+        "costmap_updates", help="accepted; fleetsim's costmaps publish whole grids"
+    )
+    visualize: bool = param(False, help="publish frontiers as markers on ~frontiers")
+    planner_frequency: float = param(1.0, unit="Hz", range=(1e-3, None), help="replanning rate")
+    progress_timeout: float = param(
+        30.0, unit="s", range=(0.0, None), help="blacklist a goal without progress this long"
+    )
+    potential_scale: float = param(1e-3, range=(0.0, None), help="weight of frontier distance")
+    orientation_scale: float = param(0.0, range=(0.0, None), help="unused, as in explore_lite")
+    gain_scale: float = param(1.0, range=(0.0, None), help="weight of frontier size")
+    transform_tolerance: float = param(0.3, unit="s", range=(0.0, None), help="tf tolerance")
+    min_frontier_size: float = param(
+        0.5, unit="m", range=(0.0, None), help="smallest frontier considered"
+    )
+
+
+class Explore(Node):
+    """Frontier exploration for one robot namespace."""
+
+    Params = ExploreParams
+
+    def __init__(self, runtime, name: str = "explore", namespace: str = "/", **kw: Any) -> None:
+        super().__init__(runtime, name, namespace, **kw)
+        p: ExploreParams = self.params
+        self.base_frame = resolve_frame_once(self.tf_prefix, p.robot_base_frame)
+        self.grid: nav_msgs.OccupancyGrid | None = None
+        self.blacklist: list[tuple[float, float]] = []
+        self.goal: tuple[float, float] | None = None
+        self.finished = False
+        self.goals_sent = 0
+        self._handle: Any = None
+        self._best_distance = math.inf
+        self._last_progress = 0.0
+        self._warned: set[str] = set()
+        self.frontiers: list[Frontier] = []
+        _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now
+        self.create_subscription(nav_msgs.OccupancyGrid, p.costmap_topic, self.on_costmap, 1)
+        self.move_base = self.create_action_client(move_base_msgs.MoveBase, "move_base")
+        self.marker_pub = (
+            self.create_publisher(visualization_msgs.MarkerArray, "~frontiers", 1)
+            if p.visualize
+            else None
+        )
+        self.timer = self.create_timer(1.0 / p.planner_frequency, self.make_plan)
+
+    def _warn_once(self, key: str, text: str) -> None:
+        if key not in self._warned:
+            self._warned.add(key)
+            self.get_logger().warning(text)
+
+    def on_costmap(self, msg: nav_msgs.OccupancyGrid) -> None:
+        self.grid = msg
+
+    def _robot_position(self, frame: str) -> tuple[float, float] | None:
+        try:
+            x, y, _ = self.tf_buffer.lookup_pose2d(frame, self.base_frame, 0.0)
+        except FleetsimError as err:
+            self._warn_once("tf", f"cannot find the robot ({self.base_frame}) in {frame}: {err}")
+            return None
+        return x, y
+
+    def make_plan(self) -> None:
+        """explore_lite's makePlan: pick the best frontier, watch progress, send the goal."""
+        if self.finished or self.grid is None:
+            return
+        grid = self.grid
+        frame = grid.header.frame_id
+        robot = self._robot_position(frame)
+        if robot is None:
+            return
+        info = grid.info
+        data = np.asarray(grid.data, dtype=np.int8).reshape(info.height, info.width)
+        p = self.params
+        self.frontiers = frontiers_from_grid(
+            data,
+            info.resolution,
+            (info.origin.position.x, info.origin.position.y),
+            robot,
+            p.potential_scale,
+            p.gain_scale,
+            p.min_frontier_size,
+        )
+        if self.marker_pub is not None:
+            self._publish_markers(frame)
+        tolerance = BLACKLIST_RADIUS_CELLS * info.resolution
+        candidates = [
+            f
+            for f in self.frontiers
+            if not any(math.dist(f.centroid, b) < tolerance for b in self.blacklist)
+        ]
+        if not candidates:
+            self.stop("all frontiers traversed/tried out, stopping")
+            return
+        target = candidates[0].centroid
+        same = self.goal is not None and math.dist(target, self.goal) < 1e-6
+        distance = math.dist(robot, target)
+        now = self.now()
+        if not same or distance < self._best_distance:
+            self._best_distance = distance
+            self._last_progress = now
+        if same and now - self._last_progress > p.progress_timeout:
+            self.get_logger().info(f"no progress towards {target} for {p.progress_timeout} s")
+            self.blacklist.append(target)
+            self.goal = None
+            self.make_plan()
+            return
+        if same and self._handle is not None:
+            return
+        self._send(target, frame)
+
+    def _send(self, target: tuple[float, float], frame: str) -> None:
+        if not self.move_base.wait_for_server():
+            self._warn_once("move_base", f"waiting for move_base at {self.move_base.name}")
+            return
+        self.goal = target
+        pose = geometry_msgs.PoseStamped(
+            header=std_msgs.Header(stamp=self.now_msg(), frame_id=frame),
+            pose=geometry_msgs.Pose(
+                position=geometry_msgs.Point(x=target[0], y=target[1], z=0.0),
+                orientation=geometry_msgs.Quaternion(x=0.0, y=0.0, z=0.0, w=1.0),
+            ),
+        )
+        self.goals_sent += 1
+        self._handle = self.move_base.send_goal(
+            move_base_msgs.MoveBaseGoal(target_pose=pose),
+            done_cb=lambda h, goal=target: self._on_done(goal, h.status),
+        )
+
+    def _on_done(self, goal: tuple[float, float], status: int) -> None:
+        if self.goal != goal:
+            return  # an older goal, replaced meanwhile
+        self._handle = None
+        if status == ABORTED:
+            self.get_logger().info(f"move_base aborted the goal {goal}; blacklisting it")
+            self.blacklist.append(goal)
+        self.goal = None
+        self.runtime.call_later(0.0, self.make_plan)  # explore_lite replans on reaching a goal
+
+    def stop(self, why: str) -> None:
+        self.finished = True
+        self.move_base.cancel_all_goals()
+        self.timer.cancel()
+        self.get_logger().info(why)
+
+    def _publish_markers(self, frame: str) -> None:
+        header = std_msgs.Header(stamp=self.now_msg(), frame_id=frame)
+        markers = [
+            visualization_msgs.Marker(header=header, action=visualization_msgs.Marker.DELETEALL)
+        ]
+        for i, f in enumerate(self.frontiers):
+            markers.append(
+                visualization_msgs.Marker(
+                    header=header,
+                    ns="frontiers",
+                    id=i,
+                    type=visualization_msgs.Marker.POINTS,
+                    scale=geometry_msgs.Vector3(x=0.1, y=0.1, z=0.1),
+                    color=std_msgs.ColorRGBA(r=1.0, g=0.0, b=0.0, a=1.0),
+                    points=[
+                        geometry_msgs.Point(x=float(x), y=float(y), z=0.0) for x, y in f.points
+                    ],
+                )
+            )
+        self.marker_pub.publish(visualization_msgs.MarkerArray(markers=markers))

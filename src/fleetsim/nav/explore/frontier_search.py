@@ -1,0 +1,96 @@
+"""explore_lite's frontier search (``frontier_search.cpp``) over an OccupancyGrid, vectorised.
+
+explore_lite walks breadth-first from the robot's cell through cells whose cost does not rise
+(from free space that means free cells only) and marks as frontier every unknown cell with a
+free 4-neighbour; 8-connected frontier cells form one frontier. Here the free region reachable
+from the robot is the 4-connected component of free cells holding the robot's cell (or the
+nearest free cell), found with `scipy.ndimage.label` instead of a queue, as are the frontiers.
+A frontier's ``cost = potential_scale * min_distance * res - gain_scale * size * res``; those
+smaller than ``min_frontier_size`` m are dropped, and the list is sorted by cost.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+FOUR = ndimage.generate_binary_structure(2, 1)
+EIGHT = ndimage.generate_binary_structure(2, 2)
+
+
+@dataclass(frozen=True)
+class Frontier:
+    """One frontier: its cells' count, centroid, closest cell to the robot, cost (map frame)."""
+
+    size: int
+    centroid: tuple[float, float]
+    middle: tuple[float, float]
+    initial: tuple[float, float]
+    min_distance: float
+    cost: float
+    points: np.ndarray  # (N, 2) cell centres, m
+
+
+def frontiers_from_grid(
+    data: np.ndarray,
+    resolution: float,
+    origin: tuple[float, float],
+    robot: tuple[float, float],
+    potential_scale: float = 1e-3,
+    gain_scale: float = 1.0,
+    min_frontier_size: float = 0.5,
+) -> list[Frontier]:
+    """Frontiers of the (H, W) int8 grid ``data`` (-1 unknown, 0 free, >0 cost), cheapest first.
+
+    ``robot`` is the robot's position (m) in the grid's frame; a robot off the grid sees none.
+    """
+    data = np.asarray(data)
+    h, w = data.shape
+    rx = int(np.floor((robot[0] - origin[0]) / resolution))
+    ry = int(np.floor((robot[1] - origin[1]) / resolution))
+    if not (0 <= rx < w and 0 <= ry < h):
+        return []
+    free = data == 0
+    if not free.any():
+        return []
+    labels, _ = ndimage.label(free, structure=FOUR)
+    start = labels[ry, rx]
+    if start == 0:  # the robot stands on cost: start from the nearest free cell, as explore_lite
+        _, (iy, ix) = ndimage.distance_transform_edt(~free, return_indices=True)
+        start = labels[iy[ry, rx], ix[ry, rx]]
+    reachable = labels == start
+    unknown = data < 0
+    frontier = unknown & ndimage.binary_dilation(reachable, structure=FOUR)
+    groups, count = ndimage.label(frontier, structure=EIGHT)
+    out = []
+    if count == 0:
+        return out
+    ys, xs = np.nonzero(groups)
+    ids = groups[ys, xs]
+    order = np.argsort(ids, kind="stable")
+    ys, xs, ids = ys[order], xs[order], ids[order]
+    splits = np.flatnonzero(np.diff(ids)) + 1
+    for gy, gx in zip(np.split(ys, splits), np.split(xs, splits)):
+        size = len(gx)
+        if size * resolution < min_frontier_size:
+            continue
+        px = origin[0] + (gx + 0.5) * resolution
+        py = origin[1] + (gy + 0.5) * resolution
+        d = np.hypot(px - robot[0], py - robot[1])
+        k = int(np.argmin(d))
+        mid = size // 2
+        out.append(
+            Frontier(
+                size=size,
+                centroid=(float(px.mean()), float(py.mean())),
+                middle=(float(px[mid]), float(py[mid])),
+                initial=(float(px[k]), float(py[k])),
+                min_distance=float(d[k]),
+                cost=float(potential_scale * d[k] * resolution - gain_scale * size * resolution),
+                points=np.c_[px, py],
+            )
+        )
+    out.sort(key=lambda f: f.cost)
+    return out

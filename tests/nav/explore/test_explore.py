@@ -1,0 +1,74 @@
+"""Tests for fleetsim.nav.explore.explore: explore_lite over move_base and slam_gmapping."""
+
+import logging
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fleetsim.cli.launch import resolve_launch_file
+from fleetsim.launch.registry import resolve_node
+from fleetsim.launch.runner import LaunchSession, load_plan
+from fleetsim.msgs import nav_msgs, std_msgs, visualization_msgs
+from fleetsim.nav.explore import Explore
+from fleetsim.runtime import Node, Runtime
+from fleetsim.tf import StaticTransformBroadcaster, make_transform_stamped
+
+
+def test_registered_as_explore_lite_explore():
+    assert resolve_node("explore_lite", "explore") is Explore
+
+
+class FakeWorld(Node):
+    """A costmap with one frontier and a robot at (0.35, 1.05); no move_base."""
+
+    def __init__(self, rt, data):
+        super().__init__(rt, "fake_world")
+        pub = self.create_publisher(nav_msgs.OccupancyGrid, "costmap", 1, latch=True)
+        info = nav_msgs.MapMetaData(resolution=0.1, width=data.shape[1], height=data.shape[0])
+        pub.publish(
+            nav_msgs.OccupancyGrid(
+                header=std_msgs.Header(frame_id="map"), info=info, data=data.ravel()
+            )
+        )
+        StaticTransformBroadcaster(self).send_transform(
+            make_transform_stamped("map", "base_link", 0.0, (0.35, 1.05, 0.0))
+        )
+
+
+def test_without_move_base_it_waits_and_a_closed_map_stops_it(caplog):
+    data = np.full((20, 30), -1, dtype=np.int8)
+    data[:, :10] = 0
+    rt = Runtime(seed=0)
+    rt.params.set("/explore/visualize", True)
+    FakeWorld(rt, data)
+    markers = []
+    rt.graph.subscribe("/explore/frontiers", visualization_msgs.MarkerArray, markers.append)
+    ex = Explore(rt)
+    with caplog.at_level(logging.WARNING):
+        rt.run(duration=2.5)
+    assert "waiting for move_base at /move_base" in caplog.text
+    assert ex.goals_sent == 0 and not ex.finished and len(ex.frontiers) == 1
+    assert markers and len(markers[-1].markers) == 2  # DELETEALL + one frontier
+    # everything known: no frontier left, exploration stops
+    ex.grid.data = np.zeros(600, dtype=np.int8)
+    rt.run(duration=1.0)
+    assert ex.finished
+
+
+@pytest.mark.scenario
+def test_slam_explore_drives_the_hunter_to_frontiers_of_its_own_map(caplog):
+    plan = load_plan(resolve_launch_file("slam_explore"), {})
+    with caplog.at_level(logging.WARNING), LaunchSession(plan, seed=1) as s:
+        ex = s.nodes["/explore"]
+        s.runtime.run(duration=25.0)
+        pos, _ = s.monitor.sim.engine.model_pose("robocluedo_robot")
+        slam = s.nodes["/slam_gmapping"].grid_msg
+    assert ex.goals_sent >= 2 and ex.frontiers and not ex.finished
+    assert math.hypot(pos[0] - 4.0, pos[1] - 10.0) > 3.0  # it went somewhere
+    known = np.count_nonzero(np.asarray(slam.data) >= 0) * slam.info.resolution**2
+    assert known > 60.0  # m^2 mapped
+    others = [r.getMessage() for r in caplog.records if "no effect" not in r.getMessage()]
+    assert not others
+    assert not Path("MUJOCO_LOG.TXT").exists()

@@ -161,3 +161,25 @@ def test_map_saver_argument_errors(tokens, match):
 
 def test_map_saver_defaults():
     assert saver_options([]) == ("map", 65, 25)
+
+
+def test_map_saver_save_on_shutdown_writes_the_latest_map(tmp_path, caplog):
+    from fleetsim.nav.map_server import grid_msg_from_map
+
+    rt = Runtime()
+    pub = Node(rt, "slam").create_publisher(nav_msgs.OccupancyGrid, "/map", 1, latch=True)
+    out = tmp_path / "latest"
+    saver = MapSaver(rt, args=["-f", str(out)], params={"save_on_shutdown": True})
+    for value in (0, 100):
+        grid = OccupancyMap(np.full((3, 4), value, dtype=np.int8), 0.1, (0.0, 0.0, 0.0))
+        pub.publish(grid_msg_from_map(grid))
+        rt.run(duration=0.1)
+    assert saver.saved is None  # nothing written while the map may still grow
+    rt.shutdown()
+    assert (load_map(out.with_suffix(".yaml")).data == 100).all()
+    # a run that ends before any map says so
+    rt = Runtime()
+    MapSaver(rt, args=["-f", str(tmp_path / "none")], params={"save_on_shutdown": True})
+    with caplog.at_level("WARNING"):
+        rt.shutdown()
+    assert "no map received on /map; nothing saved" in caplog.text

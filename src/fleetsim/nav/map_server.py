@@ -9,7 +9,9 @@ dropped, since tf frame ids carry none.
 
 ``map_saver`` (``args="-f NAME [--occ 65] [--free 25]"``) subscribes to ``map`` and writes
 ``NAME.pgm`` + ``NAME.yaml`` from the first map it receives, as ROS's map_saver does before it
-exits; `MapSaver.saved` holds the two paths once written.
+exits; `MapSaver.saved` holds the two paths once written. With ``~save_on_shutdown`` (a
+fleetsim addition, for maps that grow during a run such as slam_gmapping's) it keeps the latest
+map instead and writes it when the run ends.
 
 `grid_msg_from_map` and `map_from_grid_msg` convert between `OccupancyMap` arrays and the
 message; the costmap wrapper uses them too.
@@ -199,17 +201,46 @@ def saver_options(tokens: Sequence[str], where: str = "map_saver") -> tuple[str,
     return name, occ, free
 
 
+@dataclass(frozen=True)
+class MapSaverParams:
+    """``map_saver`` private parameters."""
+
+    save_on_shutdown: bool = param(
+        False, help="keep the latest map and write it when the run ends (fleetsim addition)"
+    )
+
+
 class MapSaver(Node):
     """Writes the first map received on ``map`` as ``<name>.pgm`` + ``<name>.yaml``."""
+
+    Params = MapSaverParams
 
     def __init__(self, runtime, name: str = "map_saver", namespace: str = "/", **kw: Any) -> None:
         super().__init__(runtime, name, namespace, **kw)
         self.map_name, self.occupied, self.free = saver_options(_tokens(self.args), self.full_name)
         self.saved: tuple[Path, Path] | None = None
+        self._latest: nav_msgs.OccupancyGrid | None = None
         self._sub = self.create_subscription(nav_msgs.OccupancyGrid, "map", self.on_map, 1)
+        if self.params.save_on_shutdown:
+            runtime.on_shutdown(self.save_latest)
         self.get_logger().info(f"waiting for the map on {self.resolve_name('map')}")
 
     def on_map(self, msg: nav_msgs.OccupancyGrid) -> None:
+        if self.params.save_on_shutdown:
+            self._latest = msg
+            return
+        self._save(msg)
+
+    def save_latest(self) -> None:
+        """Write the latest map received (``save_on_shutdown``); a warning if none came."""
+        if self._latest is None:
+            self.get_logger().warning(
+                f"no map received on {self.resolve_name('map')}; nothing saved"
+            )
+            return
+        self._save(self._latest)
+
+    def _save(self, msg: nav_msgs.OccupancyGrid) -> None:
         if self.saved is not None:
             return
         occupancy = map_from_grid_msg(msg, f"{self.full_name}: {self.resolve_name('map')}")

@@ -12,6 +12,7 @@ from fleetsim.launch.registry import resolve_node
 from fleetsim.launch.runner import LaunchSession, load_plan
 from fleetsim.msgs import nav_msgs, std_msgs, visualization_msgs
 from fleetsim.nav.explore import Explore
+from fleetsim.nav.map_io import load_map
 from fleetsim.runtime import Node, Runtime
 from fleetsim.tf import StaticTransformBroadcaster, make_transform_stamped
 
@@ -58,14 +59,19 @@ def test_without_move_base_it_waits_and_a_closed_map_stops_it(caplog):
 
 
 @pytest.mark.scenario
-def test_slam_explore_drives_the_hunter_to_frontiers_of_its_own_map(caplog):
-    plan = load_plan(resolve_launch_file("slam_explore"), {})
+def test_slam_explore_drives_the_hunter_to_frontiers_of_its_own_map(caplog, tmp_path):
+    out = tmp_path / "office_slam"
+    plan = load_plan(resolve_launch_file("slam_explore"), {"map_out": str(out)})
     with caplog.at_level(logging.WARNING), LaunchSession(plan, seed=1) as s:
         ex = s.nodes["/explore"]
         s.runtime.run(duration=25.0)
         pos, _ = s.monitor.sim.engine.model_pose("robocluedo_robot")
         slam = s.nodes["/slam_gmapping"].grid_msg
+        assert not out.with_suffix(".yaml").exists()  # written when the run ends
+        assert not s.monitor.all_goals_done()  # exploring: the explorer is not done
     assert ex.goals_sent >= 2 and ex.frontiers and not ex.finished
+    saved = load_map(out.with_suffix(".yaml"))
+    assert saved.data.shape == (slam.info.height, slam.info.width)
     assert math.hypot(pos[0] - 4.0, pos[1] - 10.0) > 3.0  # it went somewhere
     known = np.count_nonzero(np.asarray(slam.data) >= 0) * slam.info.resolution**2
     assert known > 60.0  # m^2 mapped

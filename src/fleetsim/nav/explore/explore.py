@@ -8,6 +8,11 @@ towards (its distance to it does not shrink) for ``progress_timeout`` s. When no
 left the node stops (``finished``), as explore_lite does ("All frontiers traversed/tried out,
 stopping"). With ``visualize`` it publishes ``~frontiers`` (visualization_msgs/MarkerArray).
 
+For ``fleetsim launch --until-goals`` the node is a goal sender (``sends_goals``, ``done`` once
+it has stopped): the run ends when exploration does, and succeeds when every goal it sent was
+reached (a blacklisted frontier, aborted or without progress, means it gave up on part of the
+world).
+
 ``costmap_updates_topic`` is accepted but fleetsim's costmaps publish whole grids only (see
 `fleetsim.nav.costmap.costmap_ros`), so it is not subscribed. ``orientation_scale`` is accepted
 and, as in explore_lite, unused.
@@ -59,6 +64,7 @@ class Explore(Node):
     """Frontier exploration for one robot namespace."""
 
     Params = ExploreParams
+    sends_goals = True  # the run monitor waits for `done`
 
     def __init__(self, runtime, name: str = "explore", namespace: str = "/", **kw: Any) -> None:
         super().__init__(runtime, name, namespace, **kw)
@@ -83,6 +89,10 @@ class Explore(Node):
             else None
         )
         self.timer = self.create_timer(1.0 / p.planner_frequency, self.make_plan)
+
+    @property
+    def done(self) -> bool:
+        return self.finished
 
     def _warn_once(self, key: str, text: str) -> None:
         if key not in self._warned:
@@ -179,7 +189,8 @@ class Explore(Node):
 
     def stop(self, why: str) -> None:
         self.finished = True
-        self.move_base.cancel_all_goals()
+        if self._handle is not None:
+            self.move_base.cancel_all_goals()
         self.timer.cancel()
         self.get_logger().info(why)
 

@@ -1,0 +1,166 @@
+"""SLAM quality of slam_gmapping (issue 17): the hunter explores the office on its own.
+
+``slam_explore`` runs until explore_lite has no frontier left (or ``--max-time`` sim seconds);
+then the final map is compared with the world's true occupancy (the office map the simulator
+extrudes its walls from), and the trajectory with the simulator's ground truth:
+
+- occupied-cell precision and recall after the best rigid alignment (a grid search of
+  +-0.2 m, +-2 deg): a SLAM cell is right when a true occupied cell lies within 0.1 m, a true
+  cell is found when a SLAM occupied cell lies within 0.1 m (true cells counted only where the
+  SLAM map has seen space, i.e. next to a known cell);
+- ATE (RMS of position error after a rigid Umeyama alignment, written out here in NumPy in a
+  few lines rather than adding ``evo`` for one function) of map -> base_link sampled every 1 s;
+- the time to explore (sim s) and the wall time per filter update (median and p90), plus one
+  update with 30 particles and 360 beams timed on the synthetic room of tests/slam.
+
+Not done yet: the Willow loop and two robots (issue 17 asks for both).
+
+Usage: python benchmarks/slam_quality.py [--max-time 900] [--seed 1]
+"""
+
+from __future__ import annotations
+
+import argparse
+import math
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+from scipy import ndimage
+
+ROOT = Path(__file__).resolve().parent.parent
+sys.path.insert(0, str(ROOT / "tests" / "slam"))
+
+
+def umeyama_ate(est: np.ndarray, truth: np.ndarray) -> float:
+    """RMS position error (m) of (N, 2) ``est`` after the rigid alignment onto ``truth``."""
+    me, mt = est.mean(0), truth.mean(0)
+    u, _, vt = np.linalg.svd((truth - mt).T @ (est - me))
+    d = np.diag([1.0, np.sign(np.linalg.det(u @ vt))])
+    rot = u @ d @ vt
+    aligned = (est - me) @ rot.T + mt
+    return float(np.sqrt(np.mean(np.sum((aligned - truth) ** 2, axis=1))))
+
+
+def precision_recall(slam, truth) -> tuple[float, float, tuple[float, float, float]]:
+    """Best precision/recall over small rigid shifts of the SLAM map onto the truth grid."""
+    res = truth.resolution
+    true_occ = truth.data == 100
+    dist_true = ndimage.distance_transform_edt(~true_occ) * res
+    data = np.asarray(slam.data).reshape(slam.info.height, slam.info.width)
+    iy, ix = np.nonzero(data == 100)
+    o = slam.info.origin.position
+    px = o.x + (ix + 0.5) * slam.info.resolution
+    py = o.y + (iy + 0.5) * slam.info.resolution
+    # true cells the robot could have seen: within 0.3 m of a cell the SLAM map knows
+    ky, kx = np.nonzero(data >= 0)
+    known = np.zeros_like(true_occ)
+    tx = np.floor((o.x + (kx + 0.5) * slam.info.resolution - truth.origin[0]) / res).astype(int)
+    ty = np.floor((o.y + (ky + 0.5) * slam.info.resolution - truth.origin[1]) / res).astype(int)
+    ok = (tx >= 0) & (ty >= 0) & (tx < truth.width) & (ty < truth.height)
+    known[ty[ok], tx[ok]] = True
+    known = ndimage.binary_dilation(known, iterations=max(1, round(0.3 / res)))
+    ty_true, tx_true = np.nonzero(true_occ & known)
+    best = (0.0, 0.0, (0.0, 0.0, 0.0))
+    for yaw in np.radians(np.arange(-2.0, 2.01, 0.5)):
+        c, s = math.cos(yaw), math.sin(yaw)
+        for dx in np.arange(-0.2, 0.201, 0.05):
+            for dy in np.arange(-0.2, 0.201, 0.05):
+                qx, qy = c * px - s * py + dx, s * px + c * py + dy
+                gx = np.floor((qx - truth.origin[0]) / res).astype(int)
+                gy = np.floor((qy - truth.origin[1]) / res).astype(int)
+                inside = (gx >= 0) & (gy >= 0) & (gx < truth.width) & (gy < truth.height)
+                hit = np.zeros(len(qx), dtype=bool)
+                hit[inside] = dist_true[gy[inside], gx[inside]] <= 0.1 + 1e-9
+                precision = float(hit.mean()) if len(hit) else 0.0
+                slam_img = np.zeros_like(true_occ)
+                slam_img[gy[inside], gx[inside]] = True
+                dist_slam = ndimage.distance_transform_edt(~slam_img) * res
+                recall = float((dist_slam[ty_true, tx_true] <= 0.1 + 1e-9).mean())
+                if precision + recall > best[0] + best[1]:
+                    best = (precision, recall, (dx, dy, math.degrees(yaw)))
+    return best
+
+
+def office(max_time: float, seed: int) -> None:
+    import fleetsim
+    from fleetsim.cli.launch import resolve_launch_file
+    from fleetsim.launch.runner import LaunchSession, load_plan
+    from fleetsim.nav.map_io import load_map
+    from fleetsim.slam.filter import GmappingFilter
+
+    update_times: list[float] = []
+    real = GmappingFilter.process
+
+    def timed(self, *a, **k):
+        t = time.perf_counter()
+        out = real(self, *a, **k)
+        if out.updated:
+            update_times.append(time.perf_counter() - t)
+        return out
+
+    GmappingFilter.process = timed
+    truth = load_map(Path(fleetsim.__file__).parent / "assets" / "maps" / "office.yaml")
+    t0 = time.perf_counter()
+    with LaunchSession(load_plan(resolve_launch_file("slam_explore"), {}), seed=seed) as s:
+        ex = s.nodes["/explore"]
+        est, true = [], []
+        while not ex.finished and s.runtime.now() < max_time:
+            s.runtime.run(duration=1.0)
+            pos, _ = s.monitor.sim.engine.model_pose("robocluedo_robot")
+            est.append(s.runtime.tf_buffer.lookup_pose2d("map", "base_link", 0.0)[:2])
+            true.append((float(pos[0]), float(pos[1])))
+        explored_at = s.runtime.now()
+        slam = s.nodes["/slam_gmapping"].grid_msg
+        blacklisted = len(ex.blacklist)
+    wall = time.perf_counter() - t0
+    p, r, shift = precision_recall(slam, truth)
+    ate = umeyama_ate(np.array(est), np.array(true))
+    ut = np.array(update_times) * 1e3
+    print(f"office (hunter, seed {seed}): finished={ex.finished} blacklisted={blacklisted}")
+    print(f"  time to explore      {explored_at:8.1f} sim s ({wall:.0f} s wall)")
+    print(f"  occupied precision   {p:8.3f}   recall {r:.3f}   (alignment {shift})")
+    print(f"  ATE RMS              {ate:8.3f} m over {len(est)} poses")
+    print(f"  filter update        {np.median(ut):8.1f} ms median, p90 {np.percentile(ut, 90):.1f}"
+          f" ms ({len(ut)} updates, 20 particles)")  # fmt: skip
+
+
+def update_30x360() -> None:
+    from slam_world import LASER, ROUTE, drive, exact_ranges
+
+    from fleetsim.slam.filter import Beams, GmappingFilter
+    from fleetsim.slam.params import GmappingParams
+
+    angles = -np.pi + 2 * np.pi / 360 * np.arange(360)
+    rng = np.random.default_rng(0)
+    params = GmappingParams(particles=30, xmin=-5, ymin=-5, xmax=15, ymax=12)
+    f = GmappingFilter(params, rng, LASER, 11.99, 11.99)
+    times = []
+    for i, (true, odom) in enumerate(drive(ROUTE, np.random.default_rng(1))):
+        c, s = math.cos(true[2]), math.sin(true[2])
+        sensor = true + np.array([c * LASER[0], s * LASER[0], 0.0])
+        r = exact_ranges(sensor, angles, 12.0) + 0.01 * rng.standard_normal(360)
+        r = np.where(np.isfinite(r), r, 12.0)
+        t = time.perf_counter()
+        res = f.process(odom, 0.1 * i, Beams(r, angles))
+        if res.updated and f.updates > 2:  # past numba's compilation
+            times.append(time.perf_counter() - t)
+    ms = np.array(times) * 1e3
+    print(
+        f"one update, 30 particles x 360 beams (gmapping defaults): median {np.median(ms):.1f} "
+        f"ms, p90 {np.percentile(ms, 90):.1f} ms over {len(ms)} updates (target 20 ms)"
+    )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--max-time", type=float, default=900.0)
+    ap.add_argument("--seed", type=int, default=1)
+    a = ap.parse_args()
+    update_30x360()
+    office(a.max_time, a.seed)
+
+
+if __name__ == "__main__":
+    main()

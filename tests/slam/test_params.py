@@ -19,12 +19,15 @@ def test_code_defaults_not_the_wikis():
 
 
 def test_minus_one_means_unset_and_the_four_sampling_parameters_warn(caplog):
-    with caplog.at_level(logging.WARNING):
+    with caplog.at_level(logging.INFO):
         p = gmapping_params(
             {"temporalUpdate": -1.0, "maxUrange": -1, "llsamplerange": 0.01, "lasamplestep": 0.1}
         )
     assert p.temporalUpdate is None and p.maxUrange is None
-    assert "'llsamplerange', 'lasamplestep' have no effect" in caplog.text
+    warnings = [r.getMessage() for r in caplog.records if r.levelno == logging.WARNING]
+    notes = [r.getMessage() for r in caplog.records if r.levelno == logging.INFO]
+    assert len(warnings) == 1 and "parameter 'lasamplestep' has no effect" in warnings[0]
+    assert len(notes) == 1 and "parameter 'llsamplerange' has no effect" in notes[0]
 
 
 def test_bad_values_name_the_parameter():

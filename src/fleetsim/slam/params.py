@@ -7,8 +7,10 @@ None here), ``srt``/``stt`` are 0.2 and ``angularUpdate`` 0.5. ``srt`` scales *r
 translation and ``str`` *translation* noise by rotation, as ``motionmodel.cpp`` does.
 
 The four ``ll*``/``la*`` sampling parameters are read by gmapping but only used by
-``ScanMatcher::likelihood()``, which slam_gmapping never calls; they are accepted and warned
-about (`NO_EFFECT`).
+``ScanMatcher::likelihood()``, which slam_gmapping never calls; they are accepted, with a
+warning that they have no effect when set to anything but their default (`NO_EFFECT`; at the
+default, as the manual's launch file sets them, the same note at INFO level, so that a normal
+run stays free of warnings).
 """
 
 from __future__ import annotations
@@ -126,14 +128,22 @@ def gmapping_params(
         v = values.get(key)
         if isinstance(v, int | float) and not isinstance(v, bool) and v < 0:
             values[key] = None
-    unused = [key for key in NO_EFFECT if key in values]
-    if unused:
-        log.warning(
-            "%s: parameter%s %s ha%s no effect: gmapping reads them but never uses them (only "
-            "ScanMatcher::likelihood() does, which slam_gmapping does not call)",
-            where,
-            "s" if len(unused) > 1 else "",
-            ", ".join(repr(k) for k in unused),
-            "ve" if len(unused) > 1 else "s",
-        )
+    # a value changed from gmapping's default would silently do nothing: warn; the default
+    # itself (what the manual's launch file sets) changes nothing either way: a note
+    defaults = GmappingParams()
+    for changed in (True, False):
+        keys = [
+            k for k in NO_EFFECT if k in values and (values[k] != getattr(defaults, k)) == changed
+        ]
+        if keys:
+            (log.warning if changed else log.info)(
+                "%s: parameter%s %s ha%s no effect: gmapping reads %s but never uses %s (only "
+                "ScanMatcher::likelihood() does, which slam_gmapping does not call)",
+                where,
+                "s" if len(keys) > 1 else "",
+                ", ".join(repr(k) for k in keys),
+                "ve" if len(keys) > 1 else "s",
+                "them" if len(keys) > 1 else "it",
+                "them" if len(keys) > 1 else "it",
+            )
     return load_params(GmappingParams, values, where=where, logger=log)

@@ -68,27 +68,36 @@ def _match(pool, table, p, pose, laser, ranges, cos_a, sin_a, geom, kernel, sigm
         dfy = math.floor((hy - free_back * sa - oy) * inv) - ihy
         found = False
         best = 0.0
-        for xx in range(-kernel, kernel + 1):
-            cx = ihx + xx
-            for yy in range(-kernel, kernel + 1):
-                cy = ihy + yy
-                t = _hits_at(pool, table, p, cx, cy)
-                if t < 0:
-                    continue
-                n = pool[t, cy & _MASK, cx & _MASK, 0]
-                if n <= 0.0:
-                    continue
-                fx, fy = cx + dfx, cy + dfy
-                ft = _hits_at(pool, table, p, fx, fy)
-                if ft >= 0 and pool[ft, fy & _MASK, fx & _MASK, 0] > 0.0:
-                    continue
-                # sums are offsets from the cell's own corner (float32 stays exact to ~1e-8 m)
-                mx = hx - (ox + cx * delta + pool[t, cy & _MASK, cx & _MASK, 1] / n)
-                my = hy - (oy + cy * delta + pool[t, cy & _MASK, cx & _MASK, 2] / n)
-                d2 = mx * mx + my * my
-                if not found or d2 < best:
-                    best = d2
-                    found = True
+        tx0, tx1 = (ihx - kernel) >> _SHIFT, (ihx + kernel) >> _SHIFT
+        ty0, ty1 = (ihy - kernel) >> _SHIFT, (ihy + kernel) >> _SHIFT
+        one_tile = (
+            tx0 == tx1 and ty0 == ty1 and ihx - kernel >= 0 and ihy - kernel >= 0
+            and ty0 < table.shape[1] and tx0 < table.shape[2]
+        )  # fmt: skip
+        if one_tile and table[p, ty0, tx0] < 0:
+            pass  # the whole window lies in a tile this particle never hit: no match
+        else:
+            for xx in range(-kernel, kernel + 1):
+                cx = ihx + xx
+                for yy in range(-kernel, kernel + 1):
+                    cy = ihy + yy
+                    t = table[p, ty0, tx0] if one_tile else _hits_at(pool, table, p, cx, cy)
+                    if t < 0:
+                        continue
+                    n = pool[t, cy & _MASK, cx & _MASK, 0]
+                    if n <= 0.0:
+                        continue
+                    fx, fy = cx + dfx, cy + dfy
+                    ft = _hits_at(pool, table, p, fx, fy)
+                    if ft >= 0 and pool[ft, fy & _MASK, fx & _MASK, 0] > 0.0:
+                        continue
+                    # sums are offsets from the cell's own corner (float32 exact to ~1e-8 m)
+                    mx = hx - (ox + cx * delta + pool[t, cy & _MASK, cx & _MASK, 1] / n)
+                    my = hy - (oy + cy * delta + pool[t, cy & _MASK, cx & _MASK, 2] / n)
+                    d2 = mx * mx + my * my
+                    if not found or d2 < best:
+                        best = d2
+                        found = True
         if found:
             score += math.exp(-best / sigma)
         if want_l:

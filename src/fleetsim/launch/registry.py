@@ -25,6 +25,8 @@ NODES: dict[tuple[str, str], str] = {
     ("move_base", "move_base"): "fleetsim.nav.move_base:MoveBase",
     ("gmapping", "slam_gmapping"): "fleetsim.slam.node:SlamGmapping",
     ("explore_lite", "explore"): "fleetsim.nav.explore.explore:Explore",
+    ("multirobot_map_merge", "map_merge"): "fleetsim.slam.map_merge:MapMerge",
+    ("map_merge", "map_merge"): "fleetsim.slam.map_merge:MapMerge",
     ("fleetsim", "send_goals"): "fleetsim.nav.send_goals:SendGoals",
     ("navigation_multi", "send_goals"): "fleetsim.nav.send_goals:SendGoals",
     ("gazebo_ros", "gzserver"): "fleetsim.sim.node:Simulator",

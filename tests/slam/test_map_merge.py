@@ -1,0 +1,93 @@
+"""Tests for fleetsim.slam.map_merge: two robots' maps merged by their known initial poses."""
+
+import logging
+import math
+
+import numpy as np
+import pytest
+
+from fleetsim.errors import ParameterError
+from fleetsim.launch.registry import resolve_node
+from fleetsim.msgs import nav_msgs
+from fleetsim.nav.map_io import OccupancyMap
+from fleetsim.nav.map_server import grid_msg_from_map, map_from_grid_msg
+from fleetsim.runtime import Node, Runtime
+from fleetsim.slam.map_merge import MapMerge
+
+RES = 0.1
+
+
+def world():
+    """(40, 60) cells: unknown border, free inside, an L-shaped wall."""
+    d = np.full((40, 60), -1, dtype=np.int8)
+    d[5:35, 5:55] = 0
+    d[10, 10:40] = 100
+    d[10:30, 40] = 100
+    return d
+
+
+def robot_view(truth, init, x_range):
+    """The part of ``truth`` with x in ``x_range`` (cells), as seen from a map frame placed at
+    ``init`` (x, y, yaw) in the world: a grid in that frame (yaw 0 or pi/2 only)."""
+    part = np.full(truth.shape, -1, dtype=np.int8)
+    part[:, x_range[0] : x_range[1]] = truth[:, x_range[0] : x_range[1]]
+    x, y, yaw = init
+    if abs(yaw) < 1e-9:
+        return OccupancyMap(part, RES, (-x, -y, 0.0))
+    # yaw = pi/2: world (u, v) -> map (v - y, x - u): map column = world row, map row k =
+    # world column W - 1 - k
+    rotated = np.ascontiguousarray(part[:, ::-1].T)
+    return OccupancyMap(rotated, RES, (-y, x - truth.shape[1] * RES, 0.0))
+
+
+class Robots(Node):
+    def __init__(self, rt, maps):
+        super().__init__(rt, "robots")
+        for ns, (occupancy, init) in maps.items():
+            pub = self.create_publisher(nav_msgs.OccupancyGrid, f"{ns}/map", 1, latch=True)
+            pub.publish(grid_msg_from_map(occupancy, f"{ns.strip('/')}/map"))
+            for key, value in zip(("init_pose_x", "init_pose_y", "init_pose_yaw"), init):
+                rt.params.set(f"{ns}/map_merge/{key}", value)
+
+
+def test_registered_under_both_package_names():
+    assert resolve_node("multirobot_map_merge", "map_merge") is MapMerge
+    assert resolve_node("map_merge", "map_merge") is MapMerge
+
+
+def test_two_maps_merge_back_into_the_world_by_their_initial_poses():
+    truth = world()
+    inits = {"/robot1": (1.0, 2.0, 0.0), "/robot2": (3.0, 1.0, math.pi / 2)}
+    views = {
+        "/robot1": (robot_view(truth, inits["/robot1"], (0, 35)), inits["/robot1"]),
+        "/robot2": (robot_view(truth, inits["/robot2"], (30, 60)), inits["/robot2"]),
+    }
+    rt = Runtime()
+    Robots(rt, views)
+    rt.params.set("/map_merge/world_frame", "map")
+    merge = MapMerge(rt)
+    got = []
+    rt.graph.subscribe("/map", nav_msgs.OccupancyGrid, got.append)
+    rt.run(duration=0.5)
+    merged = map_from_grid_msg(got[-1])
+    assert got[-1].header.frame_id == "map" and merge.merged is got[-1]
+    ox, oy = merged.origin[:2]
+    i0, j0 = round(-oy / RES), round(-ox / RES)  # the world's cell (0, 0) in the merged grid
+    window = merged.data[i0 : i0 + 40, j0 : j0 + 60]
+    assert window.shape == truth.shape
+    assert np.array_equal(window, truth)
+
+
+def test_a_robot_without_an_initial_pose_is_left_out_and_estimation_is_refused(caplog):
+    rt = Runtime()
+    occupancy = OccupancyMap(world(), RES, (0.0, 0.0, 0.0))
+    pub = Node(rt, "r").create_publisher(nav_msgs.OccupancyGrid, "/robot3/map", 1, latch=True)
+    pub.publish(grid_msg_from_map(occupancy))
+    merge = MapMerge(rt)
+    with caplog.at_level(logging.WARNING):
+        rt.run(duration=0.5)
+    assert "leaving /robot3/map out: /robot3/map_merge/init_pose_x is not set" in caplog.text
+    assert merge.merged is None
+    rt.params.set("/map_merge2/known_init_poses", False)
+    with pytest.raises(ParameterError, match="known_init_poses false"):
+        MapMerge(rt, "map_merge2")

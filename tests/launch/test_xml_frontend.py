@@ -90,7 +90,7 @@ def test_eval_env_optenv_anon_dirname(tmp_path, monkeypatch):
         tmp_path,
         '<arg name="n" default="3"/>'
         '<param name="e" value="$(eval int(n) * 2)"/>'
-        "<param name=\"s\" value=\"$(eval arg('n') == 3)\"/>"
+        '<param name="s" value="$(eval arg(\'n\') == 3)"/>'
         '<param name="v" value="$(env FLEET_TEST_VAR)"/>'
         '<param name="o" value="$(optenv FLEET_NOT_SET fallback)"/>'
         '<param name="a" value="$(anon rviz)"/>'

@@ -23,6 +23,38 @@ def test_orientation_joints_and_namespace():
     assert {"-sdf", "-unpause"} <= s["flags"]
 
 
+def test_wait_takes_a_model_name():
+    # the tutorial's patrol_robot.xml: -wait ground_plane
+    s = parse_spawn_args("-urdf -param d -model karl -wait ground_plane -x 1".split())
+    assert s["wait"] == "ground_plane" and s["pose"][0] == 1.0
+    with pytest.raises(SimulationError, match="'-wait' needs a value"):
+        parse_spawn_args("-urdf -param d -model karl -wait".split())
+
+
+def test_wait_holds_the_spawn_until_the_model_exists():
+    from fleetsim.runtime import Runtime
+    from fleetsim.sim.node import Simulator
+    from fleetsim.sim.spawn_model import SpawnModel
+
+    rt = Runtime(seed=0)
+    sim = Simulator(rt)
+    rt.params.set("/crate_description", CRATE)
+    rt.params.set("/box_description", CRATE)
+    first = SpawnModel(
+        rt, "spawn_box", args="-sdf -param box_description -model box -wait crate -y 2".split()
+    )
+    rt.run(duration=0.5)
+    assert not first.done and "box" not in sim.engine.models  # no crate yet
+    SpawnModel(rt, "spawn_crate", args="-sdf -param crate_description -model crate".split())
+    rt.run(duration=0.5)
+    assert first.done and first.response.success and "box" in sim.engine.models
+
+
+CRATE = """<sdf version="1.6"><model name="m"><static>true</static><link name="l">
+  <collision name="c"><geometry><box><size>0.5 0.5 0.5</size></box></geometry></collision>
+  </link></model></sdf>"""
+
+
 @pytest.mark.parametrize(
     ("args", "match"),
     [

@@ -11,6 +11,7 @@ Arguments as gazebo_ros's spawn_model takes them::
     -robot_namespace NS    the namespace its plugins publish in (default: the node's namespace)
     -reference_frame F     the frame the pose is given in (default: world)
     -unpause               unpause physics after spawning
+    -wait MODEL_NAME       spawn only once that model is in the world
     -gazebo_namespace NS   where the world services are (default: /gazebo)
 
 The node calls ``/gazebo/spawn_urdf_model`` (or ``spawn_sdf_model``) at start; if the simulator
@@ -27,10 +28,10 @@ from fleetsim.msgs import gazebo_msgs, geometry_msgs, std_srvs
 from fleetsim.runtime import Node
 from fleetsim.tf.quaternions import quaternion_from_euler
 
-_FLAGS = {"-urdf", "-sdf", "-unpause", "-wait", "-trimesh", "-b", "-package_to_model"}
+_FLAGS = {"-urdf", "-sdf", "-unpause", "-trimesh", "-b", "-package_to_model"}
 _VALUES = {
     "-file", "-param", "-database", "-model", "-x", "-y", "-z", "-R", "-P", "-Y",
-    "-reference_frame", "-gazebo_namespace", "-robot_namespace", "-J", "-urdf_param",
+    "-reference_frame", "-gazebo_namespace", "-robot_namespace", "-J", "-urdf_param", "-wait",
 }  # fmt: skip
 _POSE = {"-x": 0, "-y": 1, "-z": 2, "-R": 3, "-P": 4, "-Y": 5}
 
@@ -102,6 +103,8 @@ class SpawnModel(Node):
         gz = self.spec.get("gazebo_namespace", "/gazebo").rstrip("/") or "/gazebo"
         self._client = self.create_client(gazebo_msgs.SpawnModel, f"{gz}/spawn_{fmt}_model")
         self._unpause = self.create_client(std_srvs.Empty, f"{gz}/unpause_physics")
+        self._state = self.create_client(gazebo_msgs.GetModelState, f"{gz}/get_model_state")
+        self._told_waiting = False
         self._timer = self.create_timer(self.RETRY_PERIOD, self._try_spawn, priority=-60)
         runtime.call_later(0.0, self._try_spawn, priority=-60)
 
@@ -142,11 +145,28 @@ class SpawnModel(Node):
             reference_frame=s.get("reference_frame", ""),
         )
 
+    def _awaited_model_exists(self) -> bool:
+        """``-wait MODEL_NAME``: whether that model is in the world yet (gazebo_ros's spawn_model
+        watches model_states for it; asking get_model_state answers the same)."""
+        name = self.spec.get("wait")
+        if not name:
+            return True
+        if self._state.wait_for_service():
+            req = gazebo_msgs.GetModelState.Request(model_name=name)
+            if self._state.call(req).success:
+                return True
+        if not self._told_waiting:
+            self._told_waiting = True
+            self.get_logger().info(f"waiting for model '{name}' before spawning")
+        return False
+
     def _try_spawn(self) -> None:
         if self.done:
             return
         if not self._client.wait_for_service():
             return  # the simulator is not up yet; try again next period
+        if not self._awaited_model_exists():
+            return
         self.response = self._client.call(self._request())
         self.done = True
         self._timer.cancel()

@@ -15,6 +15,7 @@ ends. A detection cancels it (`cancel`, once). Strategies, keyed by ``~explorati
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 from dataclasses import dataclass
 from typing import Any, ClassVar
 
@@ -65,7 +66,7 @@ def pose_stamped(frame: str, stamp: Any, t: np.ndarray, q: np.ndarray) -> Any:
     )
 
 
-class Exploration:
+class Exploration(ABC):
     """Base: one move_base action goal at a time, cancelled at most once."""
 
     STRATEGIES: ClassVar[dict[str, type[Exploration]]] = {}
@@ -125,8 +126,9 @@ class Exploration:
             self.exploring = self.cancelled = False
             self.node.get_logger().info("Exploration is done")
 
-    def goal(self) -> Any:  # pragma: no cover - each strategy defines it
-        raise NotImplementedError
+    @abstractmethod
+    def goal(self) -> Any:
+        """The next exploration goal (a PoseStamped in map), or None when there is none yet."""
 
     def robot_in_map(self) -> tuple[np.ndarray, np.ndarray] | None:
         try:

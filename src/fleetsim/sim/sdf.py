@@ -42,8 +42,8 @@ __all__ = ["GAZEBO_COLOURS", "load_sdf_model", "load_sdf_world", "model_from_ele
 ASSET_MODELS = Path(__file__).resolve().parent.parent / "assets" / "worlds" / "models"
 
 
-#: the world file being read: its packages' exported model paths join the search
-_reading: ContextVar[Path | None] = ContextVar("sdf_reading", default=None)
+#: while a world file is read: the model paths its packages export, found once for the file
+_exported: ContextVar[list[Path] | None] = ContextVar("sdf_exported_model_paths", default=None)
 
 
 def exported_model_paths(near: Path | None) -> list[Path]:
@@ -79,7 +79,10 @@ def model_path() -> list[Path]:
     out: list[Path] = []
     for var in ("FLEETSIM_MODEL_PATH", "GAZEBO_MODEL_PATH"):
         out += [Path(p) for p in os.environ.get(var, "").split(os.pathsep) if p]
-    return [*out, *exported_model_paths(_reading.get()), ASSET_MODELS]
+    exported = _exported.get()
+    if exported is None:  # not inside a world file: the package path's exports only
+        exported = exported_model_paths(None)
+    return [*out, *exported, ASSET_MODELS]
 
 
 def find_model(name: str, where: str) -> Path:
@@ -345,11 +348,11 @@ def _plugin_params(el) -> dict[str, str]:
 def load_sdf_world(path: str | Path) -> WorldDesc:
     """Parse an SDF ``.world`` file (``<sdf><world>``) into a ``WorldDesc``."""
     path = Path(path)
-    token = _reading.set(path.resolve())
+    token = _exported.set(exported_model_paths(path.resolve()))
     try:
         return _load_sdf_world(path)
     finally:
-        _reading.reset(token)
+        _exported.reset(token)
 
 
 def _load_sdf_world(path: Path) -> WorldDesc:

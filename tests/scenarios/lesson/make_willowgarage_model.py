@@ -20,7 +20,8 @@ from pathlib import Path
 
 import numpy as np
 
-from fleetsim.sim.mapworld import OccupancyMap, _read_image, wall_boxes
+from fleetsim.nav.map_io import load_map_image
+from fleetsim.sim.mapworld import OccupancyMap, wall_boxes
 
 #: the lesson's <pose> of the included model: x, y, z (m), roll, pitch, yaw (rad)
 LESSON_POSE = (-3.0, 54.0, 0.0, 0.0, 0.0, 30.0)
@@ -36,10 +37,9 @@ _BOX_FACES = np.array(  # 12 triangles of a unit box's corners (index bits: x, y
 
 
 def map_grid(png: Path) -> OccupancyMap:
-    """The lesson's map image as map_server reads ``willow-full.png 0.1`` (origin 0, negate 0)."""
-    img = _read_image(png)
-    occ = (255.0 - img) / 255.0 > 0.65
-    return OccupancyMap(occ[::-1].copy(), RESOLUTION, (0.0, 0.0, 0.0), str(png))
+    """The lesson's map image as map_server reads ``willow-full.png 0.1``, as walls to extrude."""
+    grid = load_map_image(png, RESOLUTION)
+    return OccupancyMap(grid.data == 100, grid.resolution, grid.origin, str(png))
 
 
 def wall_triangles(grid: OccupancyMap, height: float = WALL_HEIGHT) -> np.ndarray:

@@ -13,14 +13,12 @@ from fleetsim.nav.costmap import LayeredCostmap
 from fleetsim.nav.map_io import OccupancyMap, load_map
 from fleetsim.nav.planners import NavFn
 
-#: the shared data folder beside the repository (../shared from its root)
-SHARED = Path(__file__).resolve().parents[1].parent / "shared"
-
+#: the Willow map in the shared data folder beside the repository (../shared from its root)
 MAP = Path(__file__).resolve().parents[1].parent / "shared/data/maps/willow-full.yaml"
 
 
 def main() -> None:
-    m = load_map(MAP if MAP.exists() else str(SHARED / "data/maps/willow-full.yaml"))
+    m = load_map(MAP)
     fine = OccupancyMap(np.repeat(np.repeat(m.data, 2, 0), 2, 1), m.resolution / 2, m.origin)
     lc = LayeredCostmap.from_params({"robot_radius": 0.2, "observation_sources": ""}, "global")
     lc.set_map(fine)

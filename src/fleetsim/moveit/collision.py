@@ -173,8 +173,8 @@ class CollisionScene:
         self._build()
 
     # ------------------------------------------------------------------ checks
-    def contacts(self, q: np.ndarray) -> list[tuple[str, str]]:
-        """Pairs of names (links, ``world#k``, ``object:id``) in contact with the group at q."""
+    def _collide(self, q: np.ndarray) -> None:
+        """Pose the group's moving links at q and run MuJoCo's collision detection."""
         self.kin.set(q)
         kd, qpos = self.kin.data, self.data.qpos
         for (b, _), a in self.moving_links:
@@ -183,6 +183,10 @@ class CollisionScene:
             mujoco.mju_mat2Quat(qpos[a + 3 : a + 7], kd.xmat[b])
         mujoco.mj_kinematics(self.model, self.data)
         mujoco.mj_collision(self.model, self.data)
+
+    def contacts(self, q: np.ndarray) -> list[tuple[str, str]]:
+        """Pairs of names (links, ``world#k``, ``object:id``) in contact with the group at q."""
+        self._collide(q)
         out = []
         m = self.model
         for c in self.data.contact[: self.data.ncon]:
@@ -194,13 +198,7 @@ class CollisionScene:
 
     def is_valid(self, q: np.ndarray) -> bool:
         """No contact at q (the fast path of ``contacts``: no per-contact Python objects)."""
-        self.kin.set(q)
-        kd, qpos = self.kin.data, self.data.qpos
-        for (b, _), a in self.moving_links:
-            qpos[a : a + 3] = kd.xpos[b]
-            mujoco.mju_mat2Quat(qpos[a + 3 : a + 7], kd.xmat[b])
-        mujoco.mj_kinematics(self.model, self.data)
-        mujoco.mj_collision(self.model, self.data)
+        self._collide(q)
         n = self.data.ncon
         return n == 0 or not bool(np.any(self.data.contact.dist[:n] <= 0))
 

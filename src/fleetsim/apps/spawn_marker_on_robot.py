@@ -26,6 +26,7 @@ from typing import Any
 from fleetsim.errors import FleetsimError, ServiceError
 from fleetsim.msgs import gazebo_msgs, gazebo_ros_link_attacher, geometry_msgs, std_srvs
 from fleetsim.runtime import Node, param
+from fleetsim.tf.quaternions import yaw_from_quaternion
 
 #: the marker relative to the robot's base_footprint: x, y (m), absolute centre height z (m), yaw
 MARKER_POSE = (-0.05, 0.0, 0.30, math.pi)
@@ -55,14 +56,11 @@ class SpawnMarkerParams:
     poll_period: float = param(0.1, unit="s", range=(1e-3, None), help="how often to look")
 
 
-def _yaw(q: Any) -> float:
-    return math.atan2(2 * (q.w * q.z + q.x * q.y), 1 - 2 * (q.y**2 + q.z**2))
-
-
 def marker_pose_on(robot: geometry_msgs.Pose) -> geometry_msgs.Pose:
     """The marker's world pose for a robot at ``robot`` (only its x, y and heading count)."""
     dx, dy, z, dyaw = MARKER_POSE
-    yaw = _yaw(robot.orientation)
+    q = robot.orientation
+    yaw = yaw_from_quaternion((q.x, q.y, q.z, q.w))
     c, s = math.cos(yaw), math.sin(yaw)
     half = (yaw + dyaw) / 2
     return geometry_msgs.Pose(

@@ -63,6 +63,11 @@ class SimRobotHW:
         st = self.plugin.states(self.engine)
         return np.array([st[j][0] for j in joints])
 
+    def states(self, joints: list[str]) -> tuple[np.ndarray, np.ndarray]:
+        """(J,) positions and (J,) velocities from one read of the joints (a control step's)."""
+        st = self.plugin.states(self.engine)
+        return np.array([st[j][0] for j in joints]), np.array([st[j][1] for j in joints])
+
     def velocities(self, joints: list[str]) -> np.ndarray:
         """(J,) joint velocities (rad/s or m/s)."""
         st = self.plugin.states(self.engine)

@@ -58,8 +58,8 @@ class JointPositionController(Controller):
         self.pid.reset()
 
     def update(self, t: float, dt: float) -> None:
-        pos = float(self.hw.positions([self.joint])[0])
-        vel = float(self.hw.velocities([self.joint])[0])
+        q, qd = self.hw.states([self.joint])
+        pos, vel = float(q[0]), float(qd[0])
         err = self.target - pos
         cmd = self.pid.compute(err, -vel, dt)
         self.hw.command(self.joint, cmd)

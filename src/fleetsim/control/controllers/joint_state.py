@@ -44,23 +44,11 @@ class JointStateController(Controller):
         msg = sensor_msgs.JointState()
         msg.header.stamp = self.now_msg()
         msg.name = self.joints + [str(e["name"]) for e in self.extra]
-        n = len(self.extra)
         extra = [
             [float(e.get(k, 0.0)) for e in self.extra] for k in ("position", "velocity", "effort")
         ]
-        msg.position = (
-            np.concatenate([self.hw.positions(self.joints), extra[0]])
-            if n
-            else self.hw.positions(self.joints)
-        )
-        msg.velocity = (
-            np.concatenate([self.hw.velocities(self.joints), extra[1]])
-            if n
-            else self.hw.velocities(self.joints)
-        )
-        msg.effort = (
-            np.concatenate([self.hw.efforts(self.joints), extra[2]])
-            if n
-            else self.hw.efforts(self.joints)
-        )
+        q, qd = self.hw.states(self.joints)
+        msg.position = np.concatenate([q, extra[0]])
+        msg.velocity = np.concatenate([qd, extra[1]])
+        msg.effort = np.concatenate([self.hw.efforts(self.joints), extra[2]])
         self.pub.publish(msg)

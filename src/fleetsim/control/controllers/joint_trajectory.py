@@ -286,7 +286,7 @@ class JointTrajectoryController(Controller):
         if self.traj is None:
             self._hold(t)
         des_p, des_v, des_a = sample(self.traj, t)
-        q, qd = self.hw.positions(self.joints), self.hw.velocities(self.joints)
+        q, qd = self.hw.states(self.joints)
         err, err_v = des_p - q, des_v - qd
         if self.interface == "position":
             cmd = des_p

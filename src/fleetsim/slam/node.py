@@ -20,7 +20,6 @@ is refused, an upside-down one is mirrored with a warning, missing odometry tf i
 from __future__ import annotations
 
 import math
-from collections import deque
 from typing import Any
 
 import numpy as np
@@ -31,7 +30,12 @@ from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.nav.map_io import OccupancyMap
 from fleetsim.nav.map_server import grid_msg_from_map
 from fleetsim.runtime import Node
-from fleetsim.tf import TransformBroadcaster, make_transform_stamped, resolve_frame_once
+from fleetsim.tf import (
+    MessageFilter,
+    TransformBroadcaster,
+    make_transform_stamped,
+    resolve_frame_once,
+)
 
 from .errors import SlamError
 from .filter import Beams, GmappingFilter
@@ -82,7 +86,6 @@ class SlamGmapping(Node):
         self._mirrored = False
         self._scans_seen = 0
         self._warned: set[str] = set()
-        self._pending: deque[sensor_msgs.LaserScan] = deque(maxlen=SCAN_QUEUE_SIZE)
         self.scan_topic = self.resolve_name("scan")
         self.map_pub = self.create_publisher(nav_msgs.OccupancyGrid, "map", 1, latch=True)
         self.meta_pub = self.create_publisher(nav_msgs.MapMetaData, "map_metadata", 1, latch=True)
@@ -90,6 +93,7 @@ class SlamGmapping(Node):
         self.create_service(nav_msgs.GetMap, "dynamic_map", self.on_dynamic_map)
         self.tf_pub = TransformBroadcaster(self)
         _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now
+        self._pending = MessageFilter(self.tf_buffer, self._process, SCAN_QUEUE_SIZE)
         self.create_subscription(sensor_msgs.LaserScan, "scan", self.on_scan, queue_size=5)
         self.tf_period = self._tf_period(p.transform_publish_period)
         if self.tf_period > 0:
@@ -128,15 +132,7 @@ class SlamGmapping(Node):
         self._scans_seen += 1
         if (self._scans_seen - 1) % self.params.throttle_scans:
             return
-        self._pending.append(scan)
-        self._drain()
-
-    def _drain(self) -> None:
-        while self._pending:
-            if not self._process(self._pending[0]):
-                self.tf_buffer.call_after_next_message(self._drain)
-                return
-            self._pending.popleft()
+        self._pending.add(scan)
 
     def _process(self, scan: sensor_msgs.LaserScan) -> bool:
         """Run the filter on one scan; False when tf has not caught up with its stamp."""

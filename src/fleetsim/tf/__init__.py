@@ -2,7 +2,7 @@
 
 Import the math from :mod:`fleetsim.tf.transforms`, and these from here::
 
-    from fleetsim.tf import Buffer, make_transform_stamped, resolve_frame
+    from fleetsim.tf import Buffer, MessageFilter, make_transform_stamped, resolve_frame
     from fleetsim.tf import TransformBroadcaster, StaticTransformBroadcaster, TransformListener
 
 The node-facing classes (broadcasters, listener, static_transform_publisher) are imported on
@@ -17,6 +17,7 @@ from typing import Any
 from fleetsim.tf._msgs import make_transform_stamped
 from fleetsim.tf.buffer import Buffer
 from fleetsim.tf.frame_info import FrameInfo
+from fleetsim.tf.message_filter import MessageFilter
 from fleetsim.tf.names import normalize_frame, resolve_frame, resolve_frame_once
 
 _LAZY = {
@@ -29,6 +30,7 @@ _LAZY = {
 __all__ = [
     "Buffer",
     "FrameInfo",
+    "MessageFilter",
     "make_transform_stamped",
     "normalize_frame",
     "resolve_frame",

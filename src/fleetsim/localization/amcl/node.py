@@ -21,7 +21,6 @@ yet, a map that cannot be used) is logged and skipped; it never stops the run.
 from __future__ import annotations
 
 import math
-from collections import deque
 from typing import Any
 
 import numpy as np
@@ -30,7 +29,12 @@ from fleetsim.errors import ExtrapolationError, FleetsimError, TransformError
 from fleetsim.msgs import geometry_msgs, nav_msgs, sensor_msgs, std_msgs, std_srvs
 from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.runtime import Node
-from fleetsim.tf import TransformBroadcaster, make_transform_stamped, resolve_frame_once
+from fleetsim.tf import (
+    MessageFilter,
+    TransformBroadcaster,
+    make_transform_stamped,
+    resolve_frame_once,
+)
 from fleetsim.tf.names import normalize_frame
 
 from .estimate import covariance_3x3
@@ -91,7 +95,7 @@ class Amcl(Node):
         )
         self.tf_pub = TransformBroadcaster(self) if p.tf_broadcast else None
         _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now, not at the first scan
-        self._pending_scans: deque[sensor_msgs.LaserScan] = deque(maxlen=SCAN_QUEUE_SIZE)
+        self._pending_scans = MessageFilter(self.tf_buffer, self._process_scan, SCAN_QUEUE_SIZE)
         self.create_subscription(sensor_msgs.LaserScan, "scan", self.on_scan, queue_size=1)
         self.create_subscription(
             geometry_msgs.PoseWithCovarianceStamped, "initialpose", self.on_initial_pose, 2
@@ -275,16 +279,7 @@ class Amcl(Node):
         if self.filter.grid is None:
             self._warn_once("no_map", "received a scan but no map yet; waiting for the map")
             return
-        self._pending_scans.append(scan)
-        self._drain_scans()
-
-    def _drain_scans(self) -> None:
-        while self._pending_scans:
-            if not self._process_scan(self._pending_scans[0]):
-                # retried when tf changes (the buffer calls back, as tf2's message filter is)
-                self.tf_buffer.call_after_next_message(self._drain_scans)
-                return
-            self._pending_scans.popleft()
+        self._pending_scans.add(scan)
 
     def _process_scan(self, scan: sensor_msgs.LaserScan) -> bool:
         """Run the filter on one scan; False when tf cannot answer for its stamp yet."""

@@ -9,8 +9,6 @@ value outside the joint limits: one clear error, nothing sent), then sends a Mov
 
 from __future__ import annotations
 
-import os
-import queue
 import time as _wall
 
 import typer
@@ -70,7 +68,8 @@ def arm_go(
     connect: str | None = Connect,
 ) -> None:
     """Plan and execute a move to TARGET through move_group; prints the result."""
-    from fleetsim.msgs import actionlib_msgs, builtin_interfaces, moveit_msgs, std_msgs
+    from fleetsim.moveit.remote import RemoteActionClient
+    from fleetsim.msgs import moveit_msgs
 
     if not 0 < scaling <= 1:
         raise PlanningError(f"--scaling must be in (0, 1], got {scaling}")
@@ -114,40 +113,21 @@ def arm_go(
             )
         ]
         action = names.join(robot_ns, "move_group")
-        act = moveit_msgs.MoveGroup
-        now = c.sim_time()
-        goal_id = actionlib_msgs.GoalID(
-            stamp=builtin_interfaces.Time.from_sec(now), id=f"fleetsim_arm-{os.getpid()}-{now:.3f}"
-        )
-        inbox: queue.SimpleQueue = queue.SimpleQueue()
-        c.subscribe(f"{action}/result", lambda r: inbox.put(r.msg), latched=False)
-        pub = c.publisher(f"{action}/goal", act.ActionGoal)
-        if not pub.wait_for_subscribers(c.timeout):
+        client = RemoteActionClient(c, action, moveit_msgs.MoveGroup)
+        if not client.wait_for_server():
             raise TransportError(
                 f"{action}/goal has no subscriber (is move_group running in {robot_ns}?)"
             )
-        pub.publish(
-            act.ActionGoal(
-                header=std_msgs.Header(stamp=goal_id.stamp),
-                goal_id=goal_id,
-                goal=moveit_msgs.MoveGroupGoal(request=req),
-            )
-        )
+        handle = client.send_goal(moveit_msgs.MoveGroupGoal(request=req))
         deadline = _wall.monotonic() + timeout
-        while True:
+        while handle.result is None:
             if _wall.monotonic() > deadline:
                 raise TransportError(f"{action}: no result within {timeout:g} s")
-            try:
-                msg = inbox.get(timeout=0.1)
-            except queue.Empty:
-                continue
-            if isinstance(msg, Exception) or msg.status.goal_id.id != goal_id.id:
-                continue
-            code = msg.result.error_code.val
-            typer.echo(f"result: {error_code_name(code)} ({msg.status.text})")
-            if code != moveit_msgs.MoveItErrorCodes.SUCCESS:
-                raise PlanningError(f"{action}: {error_code_name(code)}: {msg.status.text}")
-            return
+            _wall.sleep(0.02)
+        code = handle.result.error_code.val
+        typer.echo(f"result: {error_code_name(code)} ({handle.text})")
+        if code != moveit_msgs.MoveItErrorCodes.SUCCESS:
+            raise PlanningError(f"{action}: {error_code_name(code)}: {handle.text}")
 
 
 def _is_number(text: str) -> bool:

@@ -89,3 +89,16 @@ def test_reexports_rotation_functions_like_tf_transformations():
     assert tm.quaternion_from_euler is not None and "slerp" in tm.__all__
     assert np.allclose(tm.euler_from_quaternion(tm.quaternion_from_euler(0.1, 0.2, 0.3)),
                        (0.1, 0.2, 0.3))  # fmt: skip
+
+
+xy = st.floats(-50, 50)
+
+
+@tf_settings
+@given(st.tuples(xy, xy, angles), st.tuples(xy, xy, angles))
+def test_planar_pose_composition_matches_the_3d_transforms(a, b):
+    c = tm.compose_pose2d(a, b)
+    t, q = tm.compose_transforms(*tm.transform_from_pose2d(*a), *tm.transform_from_pose2d(*b))
+    np.testing.assert_allclose(c[:2], t[:2], atol=1e-9)
+    assert np.cos(c[2] - tm.pose2d_from_transform(t, q)[2]) == pytest.approx(1.0)
+    np.testing.assert_allclose(tm.compose_pose2d(a, tm.inverse_pose2d(a)), 0.0, atol=1e-9)

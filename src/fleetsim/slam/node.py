@@ -36,6 +36,7 @@ from fleetsim.tf import (
     make_transform_stamped,
     resolve_frame_once,
 )
+from fleetsim.tf.transforms import compose_pose2d, inverse_pose2d
 
 from .errors import SlamError
 from .filter import Beams, GmappingFilter
@@ -44,16 +45,6 @@ from .params import GmappingParams, gmapping_params
 SCAN_QUEUE_SIZE = 5  # gmapping's tf::MessageFilter queue
 TF_GRACE = 1.0  # s of sim time before missing odometry tf is reported
 DEFAULT_SIM_PERIOD = 0.01  # s: the simulator's publish period when no simulator node is found
-
-
-def _compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return np.array([a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], a[2] + b[2]])
-
-
-def _inverse(a: np.ndarray) -> np.ndarray:
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return np.array([-c * a[0] - s * a[1], s * a[0] - c * a[1], -a[2]])
 
 
 def _rotate(q: Any, v: tuple[float, float, float]) -> np.ndarray:
@@ -168,7 +159,7 @@ class SlamGmapping(Node):
         assert self.filter is not None
         result = self.filter.process(odom, stamp, beams)
         if result.updated:
-            self.map_to_odom = _compose(self.filter.best_pose, _inverse(odom))
+            self.map_to_odom = compose_pose2d(self.filter.best_pose, inverse_pose2d(odom))
             if (
                 self.grid_msg is None
                 or stamp - self._last_map_time > self.params.map_update_interval

@@ -13,6 +13,8 @@ quaternion products, slerp) live in :mod:`fleetsim.tf.quaternions` and are re-ex
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 from numpy.typing import ArrayLike
 
@@ -176,3 +178,18 @@ def poses2d_from_transforms(translation: ArrayLike, rotation: ArrayLike) -> Floa
     t = _f(translation)
     yaw = yaws_from_quaternions(rotation)
     return np.concatenate([t[..., :2], yaw[..., None]], axis=-1)
+
+
+def compose_pose2d(a: ArrayLike, b: ArrayLike) -> FloatArray:
+    """Return the planar pose ``a (+) b``: ``b`` given in ``a``'s frame, expressed where ``a`` is.
+
+    Poses are ``(x, y, yaw)`` in metres and radians, shape ``(3,)``; yaw is not wrapped.
+    """
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return np.array([a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], a[2] + b[2]])
+
+
+def inverse_pose2d(a: ArrayLike) -> FloatArray:
+    """Return the planar pose ``a^-1`` (``(3,)``: m, m, rad), so that ``a (+) a^-1`` is zero."""
+    c, s = math.cos(a[2]), math.sin(a[2])
+    return np.array([-c * a[0] - s * a[1], s * a[0] - c * a[1], -a[2]])

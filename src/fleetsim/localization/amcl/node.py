@@ -36,6 +36,7 @@ from fleetsim.tf import (
     resolve_frame_once,
 )
 from fleetsim.tf.names import normalize_frame
+from fleetsim.tf.transforms import compose_pose2d, inverse_pose2d
 
 from .estimate import covariance_3x3
 from .filter import ParticleFilter
@@ -56,17 +57,6 @@ def _yaw_of(q: Any) -> float:
 
 def _quaternion(yaw: float) -> geometry_msgs.Quaternion:
     return geometry_msgs.Quaternion(x=0.0, y=0.0, z=math.sin(yaw / 2), w=math.cos(yaw / 2))
-
-
-def _compose(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Planar pose composition ``a (+) b`` of ``(x, y, yaw)``."""
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return np.array([a[0] + c * b[0] - s * b[1], a[1] + s * b[0] + c * b[1], a[2] + b[2]])
-
-
-def _inverse(a: np.ndarray) -> np.ndarray:
-    c, s = math.cos(a[2]), math.sin(a[2])
-    return np.array([-c * a[0] - s * a[1], s * a[0] - c * a[1], -a[2]])
 
 
 class Amcl(Node):
@@ -234,7 +224,7 @@ class Amcl(Node):
             now = np.array(buf.lookup_pose2d(self.odom_frame, self.base_frame, 0.0))
         except FleetsimError:
             return mean
-        return _compose(mean, _compose(_inverse(then), now))
+        return compose_pose2d(mean, compose_pose2d(inverse_pose2d(then), now))
 
     def on_global_localization(self, req: Any) -> Any:
         try:
@@ -376,7 +366,7 @@ class Amcl(Node):
         )
         self.pose_pub.publish(msg)
         # map -> odom = map -> base (estimate) (+) inverse(odom -> base)
-        self._map_to_odom = _compose(est.pose, _inverse(odom_pose))
+        self._map_to_odom = compose_pose2d(est.pose, inverse_pose2d(odom_pose))
 
     def _send_map_to_odom(self, stamp: float) -> None:
         x, y, yaw = self._map_to_odom

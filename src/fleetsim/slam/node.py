@@ -36,6 +36,7 @@ from fleetsim.tf import (
     make_transform_stamped,
     resolve_frame_once,
 )
+from fleetsim.tf.quaternions import rotate_vector
 from fleetsim.tf.transforms import compose_pose2d, inverse_pose2d
 
 from .errors import SlamError
@@ -45,14 +46,6 @@ from .params import GmappingParams, gmapping_params
 SCAN_QUEUE_SIZE = 5  # gmapping's tf::MessageFilter queue
 TF_GRACE = 1.0  # s of sim time before missing odometry tf is reported
 DEFAULT_SIM_PERIOD = 0.01  # s: the simulator's publish period when no simulator node is found
-
-
-def _rotate(q: Any, v: tuple[float, float, float]) -> np.ndarray:
-    """Vector ``v`` rotated by quaternion ``q``."""
-    w, x, y, z = q.w, q.x, q.y, q.z
-    u = np.array([x, y, z])
-    vv = np.asarray(v, dtype=float)
-    return vv + 2.0 * np.cross(u, np.cross(u, vv) + w * vv)
 
 
 class SlamGmapping(Node):
@@ -178,7 +171,8 @@ class SlamGmapping(Node):
                 f"cannot place the laser of {self.scan_topic}: no transform from "
                 f"{self.base_frame} to its frame '{frame}' ({err})"
             ) from None
-        up = _rotate(tf.rotation, (0.0, 0.0, 1.0))
+        q = tf.rotation
+        up = rotate_vector((q.x, q.y, q.z, q.w), (0.0, 0.0, 1.0))
         if abs(abs(up[2]) - 1.0) > 1e-3:
             raise SlamError(
                 f"the laser frame '{frame}' of {self.scan_topic} is not level (its z axis is "
@@ -190,7 +184,7 @@ class SlamGmapping(Node):
                 f"the laser frame '{frame}' of {self.scan_topic} is mounted upside down; "
                 "mirroring its beams"
             )
-        x_axis = _rotate(tf.rotation, (1.0, 0.0, 0.0))
+        x_axis = rotate_vector((q.x, q.y, q.z, q.w), (1.0, 0.0, 0.0))
         t = tf.translation
         laser = np.array([t.x, t.y, math.atan2(x_axis[1], x_axis[0])])
         p = self.params

@@ -219,3 +219,14 @@ def test_a_subscription_with_publisher_is_told_who_sent_each_message():
     pa.publish(Num(5))
     rt.spin_once()
     assert len(tagged) == 4 and plain[-1].data == 5
+
+
+def test_a_node_warns_once_per_key_until_the_key_is_discarded(caplog):
+    node = Node(Runtime(), "n")
+    for _ in range(3):
+        node._warn_once("tf", "no tf yet")
+    node._warn_once("map", "no map yet")
+    assert caplog.text.count("no tf yet") == 1 and caplog.text.count("no map yet") == 1
+    node._warned.discard("tf")
+    node._warn_once("tf", "no tf yet")
+    assert caplog.text.count("no tf yet") == 2

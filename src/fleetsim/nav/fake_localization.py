@@ -106,7 +106,6 @@ class FakeLocalization(Node):
             -p.delta_x, -p.delta_y, 0.0, 0.0, 0.0, math.sin(half), math.cos(half)
         )  # fmt: skip
         self._pending: deque[nav_msgs.Odometry] = deque(maxlen=QUEUE_SIZE)
-        self._warned: set[str] = set()
         self._patience = TransformPatience()
         period = 1.0 / p.publish_rate if p.publish_rate > 0 else 0.0
         self._period_ns = round(min(period, p.transform_tolerance / 2) * 1e9)
@@ -128,11 +127,6 @@ class FakeLocalization(Node):
         self.create_subscription(
             geometry_msgs.PoseWithCovarianceStamped, "initialpose", self.on_initial_pose, 1
         )
-
-    def _warn_once(self, key: str, text: str) -> None:
-        if key not in self._warned:
-            self._warned.add(key)
-            self.get_logger().warning(text)
 
     # -- ground truth --------------------------------------------------------------------------
     def on_ground_truth(self, msg: nav_msgs.Odometry) -> None:

@@ -77,6 +77,7 @@ class Node:
         self._timers: list[Timer] = []
         self._actions: list[Any] = []
         self._logger = NodeLogger(self)
+        self._warned: set[str] = set()  # keys already warned about (see _warn_once)
         self.rng: np.random.Generator = runtime.rng(self.full_name)
         if params:
             runtime.params.update(self.full_name, dict(params))
@@ -144,6 +145,13 @@ class Node:
 
     def get_logger(self) -> NodeLogger:
         return self._logger
+
+    def _warn_once(self, key: str, text: str) -> None:
+        """Log ``text`` as a warning the first time ``key`` is seen (``ROS_WARN_ONCE`` by key);
+        discarding ``key`` from ``_warned`` lets it warn again."""
+        if key not in self._warned:
+            self._warned.add(key)
+            self._logger.warning(text)
 
     @property
     def tf_buffer(self):

@@ -69,7 +69,6 @@ class SlamGmapping(Node):
         self._beam_count: int | None = None
         self._mirrored = False
         self._scans_seen = 0
-        self._warned: set[str] = set()
         self.scan_topic = self.resolve_name("scan")
         self.map_pub = self.create_publisher(nav_msgs.OccupancyGrid, "map", 1, latch=True)
         self.meta_pub = self.create_publisher(nav_msgs.MapMetaData, "map_metadata", 1, latch=True)
@@ -105,11 +104,6 @@ class SlamGmapping(Node):
             )
             return sim_period
         return period
-
-    def _warn_once(self, key: str, text: str) -> None:
-        if key not in self._warned:
-            self._warned.add(key)
-            self.get_logger().warning(text)
 
     # ----- scans -----
     def on_scan(self, scan: sensor_msgs.LaserScan) -> None:

@@ -76,7 +76,6 @@ class Amcl(Node):
         self._laser_poses: dict[str, np.ndarray] = {}
         self._map_to_odom: np.ndarray | None = None
         self._last_cloud_time = -math.inf
-        self._warned: set[str] = set()
         self.pose_pub = self.create_publisher(
             geometry_msgs.PoseWithCovarianceStamped, "amcl_pose", queue_size=2, latch=True
         )
@@ -103,11 +102,6 @@ class Amcl(Node):
             self.create_timer(1.0 / p.save_pose_rate, self._save_pose)
 
     # ----- logging helpers -----
-    def _warn_once(self, key: str, text: str) -> None:
-        if key not in self._warned:
-            self._warned.add(key)
-            self.get_logger().warning(text)
-
     # ----- map -----
     def _request_map(self) -> None:
         if self.map_received:

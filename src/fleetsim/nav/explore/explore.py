@@ -78,7 +78,6 @@ class Explore(Node):
         self._handle: Any = None
         self._best_distance = math.inf
         self._last_progress = 0.0
-        self._warned: set[str] = set()
         self.frontiers: list[Frontier] = []
         _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now
         self.create_subscription(nav_msgs.OccupancyGrid, p.costmap_topic, self.on_costmap, 1)
@@ -93,11 +92,6 @@ class Explore(Node):
     @property
     def done(self) -> bool:
         return self.finished
-
-    def _warn_once(self, key: str, text: str) -> None:
-        if key not in self._warned:
-            self._warned.add(key)
-            self.get_logger().warning(text)
 
     def on_costmap(self, msg: nav_msgs.OccupancyGrid) -> None:
         self.grid = msg

@@ -103,7 +103,6 @@ class MapMerge(Node):
             )
         self.maps: dict[str, nav_msgs.OccupancyGrid] = {}
         self.merged: nav_msgs.OccupancyGrid | None = None
-        self._warned: set[str] = set()
         self.pub = self.create_publisher(nav_msgs.OccupancyGrid, p.merged_map_topic, 1, latch=True)
         self.create_timer(1.0 / p.discovery_rate, self.discover)
         self.create_timer(1.0 / p.merging_rate, self.merge)
@@ -131,11 +130,10 @@ class MapMerge(Node):
         for key in ("init_pose_x", "init_pose_y", "init_pose_yaw"):
             v = self.runtime.params.get(f"{ns}/map_merge/{key}", None)
             if not isinstance(v, int | float) or isinstance(v, bool):
-                if topic not in self._warned:
-                    self._warned.add(topic)
-                    self.get_logger().warning(
-                        f"leaving {topic} out: {ns}/map_merge/{key} is not set (known_init_poses)"
-                    )
+                self._warn_once(
+                    topic,
+                    f"leaving {topic} out: {ns}/map_merge/{key} is not set (known_init_poses)",
+                )
                 return None
             values.append(float(v))
         return values[0], values[1], values[2]

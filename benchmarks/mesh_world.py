@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import argparse
 import os
+import sys
 import tempfile
 import time
 from pathlib import Path
@@ -27,6 +28,10 @@ from fleetsim.sim import Engine, decompose
 from fleetsim.sim.mesh_assets import HULL_GROUP
 from fleetsim.sim.mesh_files import triangle_mesh
 from fleetsim.sim.plugins.laser import LaserPlugin
+
+sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+
+from sim.ray_triangle import first_hit, horizontal
 
 BURGER = (
     Path(__file__).resolve().parents[1]
@@ -55,22 +60,6 @@ def free_points(engine, n, rng, lo, hi):
         if clear:
             out.append(p)
     return out
-
-
-def exact_range(a, e1, e2, origin, angle, rmin, rmax):
-    d = np.array([np.cos(angle), np.sin(angle), 0.0])
-    p = np.cross(d, e2)
-    det = np.einsum("ij,ij->i", e1, p)
-    ok = np.abs(det) > 1e-12
-    inv = np.where(ok, 1 / np.where(ok, det, 1), 0)
-    s = origin - a
-    u = np.einsum("ij,ij->i", s, p) * inv
-    q = np.cross(s, e1)
-    w = (q @ d) * inv
-    t = np.einsum("ij,ij->i", e2, q) * inv
-    hit = ok & (u >= 0) & (w >= 0) & (u + w <= 1) & (t >= rmin)
-    best = t[hit].min() if hit.any() else np.inf
-    return best if best <= rmax else np.inf
 
 
 def main() -> None:
@@ -126,12 +115,12 @@ def main() -> None:
         [[np.cos(POSE[5]), -np.sin(POSE[5]), 0], [np.sin(POSE[5]), np.cos(POSE[5]), 0], [0, 0, 1]]
     )
     wv = wv @ rot.T + POSE[:3]
-    a, b, c = (wv[wf[:, i]] for i in range(3))
+    tris = wv[wf]
     worst = 0.0
     for lz, reading in list(zip(lasers, readings))[:10]:
         origins, angles, _ = lz.rays(engine)
         for g, ang in zip(reading.ranges, angles):
-            ex = exact_range(a, b - a, c - a, origins[0], ang, lz.range_min, lz.range_max)
+            ex = first_hit(tris, origins[0], horizontal(ang), lz.range_min, lz.range_max)
             if np.isfinite(g) and g < ex - 1e-3:
                 continue  # another robot in the way
             if np.isfinite(g) and np.isfinite(ex):
@@ -150,7 +139,7 @@ def main() -> None:
             for ang in np.linspace(0, 2 * np.pi, 90, endpoint=False):
                 vec = np.array([np.cos(ang), np.sin(ang), 0.0])
                 got = mujoco.mj_ray(engine.model, engine.data, origin, vec, mask, 1, -1, gid)
-                ex = exact_range(a, b - a, c - a, origin, ang, 0.0, 10.0)
+                ex = first_hit(tris, origin, vec, 0.0, 10.0)
                 if np.isfinite(ex) and 0 <= got <= 10.0:
                     errors.append(abs(got - ex))
                 elif np.isfinite(ex) != (0 <= got <= 10.0):

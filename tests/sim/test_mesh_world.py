@@ -4,6 +4,7 @@ stopped by walls, lasers and the collision parts match the true triangles."""
 
 from __future__ import annotations
 
+import functools
 from pathlib import Path
 
 import mujoco
@@ -19,6 +20,7 @@ from fleetsim.sim.plugins.base import DrivePlugin
 from fleetsim.sim.plugins.laser import LaserPlugin
 
 from .conftest import FIXTURES
+from .ray_triangle import first_hit, horizontal
 
 WORLD = FIXTURES / "mesh_building.world"
 OBJ = FIXTURES / "models/mesh_building/meshes/building.obj"
@@ -46,27 +48,21 @@ def no_mujoco_warnings(e: Engine) -> None:
     assert not any(counts), counts
 
 
+@functools.cache
+def building_triangles():
+    """(T, 3, 3) corners of every triangle of the OBJ, m."""
+    v, f = triangle_mesh(OBJ)
+    return v[f]
+
+
+#: the smallest positive float: hits strictly in front of the origin
+AHEAD = np.nextafter(0.0, 1.0)
+
+
 def exact_ranges(origin, angles, rmax):
     """First hit of horizontal rays against every triangle of the OBJ (Moller-Trumbore)."""
-    v, f = triangle_mesh(OBJ)
-    a, b, c = (v[f[:, i]] for i in range(3))
-    e1, e2 = b - a, c - a
-    out = np.full(len(angles), np.inf)
-    for i, ang in enumerate(angles):
-        d = np.array([np.cos(ang), np.sin(ang), 0.0])
-        p = np.cross(d, e2)
-        det = np.einsum("ij,ij->i", e1, p)
-        ok = np.abs(det) > 1e-12
-        inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-        s = origin - a
-        u = np.einsum("ij,ij->i", s, p) * inv
-        q = np.cross(s, e1)
-        w = (q @ d) * inv
-        t = np.einsum("ij,ij->i", e2, q) * inv
-        hit = ok & (u >= 0) & (w >= 0) & (u + w <= 1) & (t > 0)
-        if hit.any():
-            out[i] = t[hit].min() if t[hit].min() <= rmax else np.inf
-    return out
+    tris = building_triangles()
+    return np.array([first_hit(tris, origin, horizontal(ang), AHEAD, rmax) for ang in angles])
 
 
 def test_building_is_cut_into_prisms_that_fill_exactly_its_volume():
@@ -211,27 +207,10 @@ def test_depth_camera_sees_the_true_walls_through_a_door():
         R = e.data.cam_xmat[cam.cam_id].reshape(3, 3)
         d = R @ [ray[0], -ray[1], -1.0]
         d /= np.linalg.norm(d)
-        exact = exact_ranges_3d(origin, d)
+        exact = first_hit(building_triangles(), origin, d, AHEAD)
         assert abs(depth[h // 2, col] - exact * (d @ axis)) < 0.02, col
     assert depth[h // 2, w // 2] > 4.0  # the corridor's far wall, seen through the door
     no_mujoco_warnings(e)
-
-
-def exact_ranges_3d(origin, d):
-    v, f = triangle_mesh(OBJ)
-    a, b, c = (v[f[:, i]] for i in range(3))
-    e1, e2 = b - a, c - a
-    p = np.cross(d, e2)
-    det = np.einsum("ij,ij->i", e1, p)
-    ok = np.abs(det) > 1e-12
-    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-    s = origin - a
-    u = np.einsum("ij,ij->i", s, p) * inv
-    q = np.cross(s, e1)
-    w = (q @ d) * inv
-    t = np.einsum("ij,ij->i", e2, q) * inv
-    hit = ok & (u >= 0) & (w >= 0) & (u + w <= 1) & (t > 0)
-    return t[hit].min()
 
 
 def test_lasers_see_a_convex_static_mesh_as_its_triangles(tmp_path):

@@ -4,6 +4,8 @@ from hypothesis import strategies as st
 
 from fleetsim.sim import raycast
 
+from .ray_triangle import first_hit, horizontal
+
 
 def brute_force(prims, origin, angle, rmin, rmax):
     """Exact first hit of one ray against every primitive (no grid)."""
@@ -108,25 +110,6 @@ def random_triangles(rng, n):
     return out, corners
 
 
-def exact_triangle_range(corners, origin, angle, rmin, rmax):
-    """Moller-Trumbore: the first triangle a horizontal ray meets at t >= rmin."""
-    a, b, c = corners[:, 0], corners[:, 1], corners[:, 2]
-    e1, e2 = b - a, c - a
-    d = np.array([np.cos(angle), np.sin(angle), 0.0])
-    p = np.cross(d, e2)
-    det = np.einsum("ij,ij->i", e1, p)
-    ok = np.abs(det) > 1e-12
-    inv = np.where(ok, 1.0 / np.where(ok, det, 1.0), 0.0)
-    s = origin - a
-    u = np.einsum("ij,ij->i", s, p) * inv
-    q = np.cross(s, e1)
-    w = (q @ d) * inv
-    t = np.einsum("ij,ij->i", e2, q) * inv
-    hit = ok & (u >= 0) & (w >= 0) & (u + w <= 1) & (t >= rmin)
-    best = t[hit].min() if hit.any() else np.inf
-    return best if best <= rmax else np.inf
-
-
 @settings(max_examples=30, deadline=None)
 @given(seed=st.integers(0, 10_000), cell=st.sampled_from([0.3, 1.0, 2.5]))
 def test_triangles_on_the_grid_match_exact_ray_triangle_intersection(seed, cell):
@@ -139,7 +122,7 @@ def test_triangles_on_the_grid_match_exact_ray_triangle_intersection(seed, cell)
     got = raycast.cast(grid, origins, angles, 0.05, 15.0, -1)
     for g, o, a in zip(got, origins, angles):
         want = min(
-            exact_triangle_range(corners, o, a, 0.05, 15.0),
+            first_hit(corners, o, horizontal(a), 0.05, 15.0),
             brute_force(mixed[:10, :7], o, a, 0.05, 15.0),
         )
         if np.isinf(want):

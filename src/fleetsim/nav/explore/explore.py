@@ -28,6 +28,7 @@ import numpy as np
 
 from fleetsim.errors import FleetsimError
 from fleetsim.msgs import geometry_msgs, move_base_msgs, nav_msgs, std_msgs, visualization_msgs
+from fleetsim.nav.move_base_support import pose_stamped
 from fleetsim.runtime import Node, param
 from fleetsim.tf.names import resolve_frame_once
 
@@ -158,13 +159,7 @@ class Explore(Node):
             self._warn_once("move_base", f"waiting for move_base at {self.move_base.name}")
             return
         self.goal = target
-        pose = geometry_msgs.PoseStamped(
-            header=std_msgs.Header(stamp=self.now_msg(), frame_id=frame),
-            pose=geometry_msgs.Pose(
-                position=geometry_msgs.Point(x=target[0], y=target[1], z=0.0),
-                orientation=geometry_msgs.Quaternion(x=0.0, y=0.0, z=0.0, w=1.0),
-            ),
-        )
+        pose = pose_stamped(target[0], target[1], 0.0, frame, self.now_msg())
         self.goals_sent += 1
         self._handle = self.move_base.send_goal(
             move_base_msgs.MoveBaseGoal(target_pose=pose),

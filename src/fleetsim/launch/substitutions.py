@@ -16,7 +16,7 @@ import os
 import re
 import zlib
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from fleetsim.errors import LaunchError, did_you_mean
@@ -55,15 +55,14 @@ class Context:
         passed: dict[str, str],
         pass_all_args: bool = False,
     ) -> Context:
-        return Context(
-            args, self.find, filename, self.anon, self.seed, passed, pass_all_args, self.kinds
+        return replace(
+            self, args=args, filename=filename, passed=passed, pass_all_args=pass_all_args
         )
 
     def scoped(self) -> Context:
         """A ``<group>``'s context: args declared inside it are not seen after it (roslaunch
         copies the arg dictionary into each group)."""
-        return Context(dict(self.args), self.find, self.filename, self.anon, self.seed,
-                       dict(self.passed), False, self.kinds)  # fmt: skip
+        return replace(self, args=dict(self.args), passed=dict(self.passed), pass_all_args=False)
 
     def value_of(self, name: str) -> str | None:
         """The arg's current value: its declared value, else the one passed in."""

@@ -17,6 +17,8 @@ from fleetsim.sim.prisms import prisms_of_architecture
 from fleetsim.sim.sdf import load_sdf_model
 from fleetsim.sim.world import WorldDesc, ground_plane
 
+from .fixtures.make_building import grid_mesh
+
 
 @pytest.fixture(autouse=True)
 def cache(monkeypatch, tmp_path):
@@ -52,32 +54,7 @@ def u_shape():
     """A U of three boxes welded into one closed mesh: the union's surface, by a grid."""
     cells = np.zeros((3, 2, 1), bool)
     cells[0, :, 0] = cells[2, :, 0] = cells[1, 0, 0] = True
-    return _grid_mesh(cells, [0, 1, 2, 3], [0, 1, 3], [0, 2])
-
-
-def _grid_mesh(solid, xs, ys, zs):
-    index, faces = {}, []
-    nx, ny, nz = solid.shape
-    for i, j, k in zip(*np.nonzero(solid)):
-        for axis in range(3):
-            for side in (0, 1):
-                n = [i, j, k]
-                n[axis] += 1 if side else -1
-                if all(0 <= n[q] < solid.shape[q] for q in range(3)) and solid[tuple(n)]:
-                    continue
-                u, w = [(1, 2), (2, 0), (0, 1)][axis]
-                corners = []
-                for du, dw in ((0, 0), (1, 0), (1, 1), (0, 1)):
-                    c = [i, j, k]
-                    c[axis] += side
-                    c[u] += du
-                    c[w] += dw
-                    corners.append(index.setdefault(tuple(c), len(index)))
-                if not side:
-                    corners.reverse()
-                faces += [tuple(corners[:3]), (corners[0], corners[2], corners[3])]
-    v = np.array([(xs[i], ys[j], zs[k]) for i, j, k in index], float)
-    return v, np.array(faces)
+    return grid_mesh(cells, [0, 1, 2, 3], [0, 1, 3], [0, 2])
 
 
 def test_a_box_is_convex_and_kept_whole():

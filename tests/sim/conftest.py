@@ -17,6 +17,15 @@ BARN = Path(SHARED, "data/barn/world_3.world")
 WILLOW = Path(SHARED, "data/maps/willow-full.yaml")
 
 
+@pytest.fixture
+def in_tmp_dir(tmp_path, monkeypatch):
+    """Run the test in its own folder (where MuJoCo would write MUJOCO_LOG.TXT) and fail if
+    MuJoCo wrote that log. Modules opt in: ``pytestmark = pytest.mark.usefixtures(...)``."""
+    monkeypatch.chdir(tmp_path)
+    yield
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+
+
 @pytest.fixture(scope="session")
 def diffbot():
     from fleetsim.description import load_robot

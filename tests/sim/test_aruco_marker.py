@@ -17,11 +17,7 @@ SPAWN_XML = (
 )
 
 
-@pytest.fixture(autouse=True)
-def in_tmp_dir(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    yield
-    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+pytestmark = pytest.mark.usefixtures("in_tmp_dir")
 
 
 def detect(image_rgb):

@@ -21,11 +21,7 @@ BURGER = ASSETS / "robots/turtlebot3_burger/urdf/turtlebot3_burger.urdf.xacro"
 POSES = [(4.95, 1.10, -2.65), (-2.0, 2.0, 0.0), (0.0, -4.0, 0.0), (-2.0, -1.0, 1.0)]
 
 
-@pytest.fixture(autouse=True)
-def in_tmp_dir(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)  # where MuJoCo would write MUJOCO_LOG.TXT
-    yield
-    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+pytestmark = pytest.mark.usefixtures("in_tmp_dir")
 
 
 def generator():

@@ -29,11 +29,7 @@ ROBOTS = Path(__file__).resolve().parents[2] / "src" / "fleetsim" / "assets" / "
 FILES = sorted(ROBOTS.glob("*/urdf/*.urdf.xacro"))
 
 
-@pytest.fixture(autouse=True)
-def in_tmp_dir(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)
-    yield
-    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+pytestmark = pytest.mark.usefixtures("in_tmp_dir")
 
 
 def drive_of(entry) -> DrivePlugin:

@@ -21,11 +21,7 @@ MARKER_XML = (
 )
 
 
-@pytest.fixture(autouse=True)
-def in_tmp_dir(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)  # where MuJoCo would write MUJOCO_LOG.TXT
-    yield
-    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+pytestmark = pytest.mark.usefixtures("in_tmp_dir")
 
 
 def pose_msg(x, y, z, yaw):

@@ -10,12 +10,7 @@ from fleetsim.sim import Engine
 from fleetsim.sim.sdf import load_sdf_model
 from fleetsim.sim.textures import box_uv_mesh
 
-
-@pytest.fixture(autouse=True)
-def in_tmp_dir(tmp_path, monkeypatch):
-    monkeypatch.chdir(tmp_path)  # where MuJoCo would write MUJOCO_LOG.TXT
-    yield
-    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+pytestmark = pytest.mark.usefixtures("in_tmp_dir")
 
 
 def assert_no_mujoco_warnings(engine):

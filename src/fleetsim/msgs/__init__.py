@@ -8,6 +8,7 @@ Import per-package modules (``from fleetsim.msgs import geometry_msgs``) and use
 from fleetsim.msgs import (
     actionlib_msgs,
     builtin_interfaces,
+    collvoid_msgs,
     control_msgs,
     controller_manager_msgs,
     fiducial_msgs,
@@ -57,6 +58,7 @@ __all__ = [
     "all_srv_types",
     "all_types",
     "builtin_interfaces",
+    "collvoid_msgs",
     "control_msgs",
     "controller_manager_msgs",
     "deserialize",

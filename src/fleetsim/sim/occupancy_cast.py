@@ -108,7 +108,6 @@ def ranges_from_walls(
     """
     h, w = occupied.shape
     inv = 1.0 / res
-    two_pi = 2.0 * np.pi
     maxnb = 1
     for q in range(nb.shape[0]):
         maxnb = max(maxnb, nb[q])
@@ -151,69 +150,130 @@ def ranges_from_walls(
         ty0 = max(int(np.floor((oy - tmax) / tile)), 0)
         ty1 = min(int(np.floor((oy + tmax) / tile)), th - 1)
         tmax2 = tmax * tmax
-        for ty in range(ty0, ty1 + 1):
-            for tx in range(tx0, tx1 + 1):
-                ex = max(tx * tile - ox, 0.0, ox - (tx + 1) * tile)
-                ey = max(ty * tile - oy, 0.0, oy - (ty + 1) * tile)
-                if ex * ex + ey * ey > tmax2:
-                    continue
-                t_i = ty * tw + tx
-                for j in range(start[t_i], start[t_i + 1]):
-                    b = items[j]
-                    if seen[b] == q:
+        # tiles ring by ring outwards from the laser's own, so that near walls are found first
+        # and the tiles behind them are skipped whole (`_occluded`): in a building most boxes
+        # in range are behind a wall
+        cx = min(max(int(np.floor(ox / tile)), tx0), tx1)
+        cy = min(max(int(np.floor(oy / tile)), ty0), ty1)
+        rings = max(cx - tx0, tx1 - cx, cy - ty0, ty1 - cy)
+        for ring in range(rings + 1):
+            for ty in range(max(cy - ring, ty0), min(cy + ring, ty1) + 1):
+                on_edge = ty == cy - ring or ty == cy + ring
+                step = 1 if on_edge else 2 * ring
+                for tx in range(cx - ring, cx + ring + 1, max(step, 1)):
+                    if tx < tx0 or tx > tx1:
                         continue
-                    seen[b] = q
-                    bx0 = boxes[b, 0] - ox
-                    by0 = boxes[b, 1] - oy
-                    bx1 = boxes[b, 2] - ox
-                    by1 = boxes[b, 3] - oy
-                    ex = max(bx0, 0.0, -bx1)
-                    ey = max(by0, 0.0, -by1)
-                    if ex * ex + ey * ey > tmax2:
+                    t_i = ty * tw + tx
+                    if start[t_i] == start[t_i + 1]:
                         continue
-                    if (ex == 0.0 and ey == 0.0) or ida == 0.0:
-                        lo = 0.0  # the origin touches the box (or a single beam): all beams
-                        hi = span
-                    else:
-                        # angular extent: the corners' directions about the centre's (< pi)
-                        ac = _atan2(by0 + by1, bx0 + bx1)
-                        lo = 0.0
-                        hi = 0.0
-                        for corner in range(4):
-                            px = bx0 if corner & 1 == 0 else bx1
-                            py = by0 if corner & 2 == 0 else by1
-                            d = _atan2(py, px) - ac
-                            if d > np.pi:
-                                d -= two_pi
-                            elif d < -np.pi:
-                                d += two_pi
-                            lo = min(lo, d)
-                            hi = max(hi, d)
-                        rel = ac - a0
-                        rel -= two_pi * np.floor(rel / two_pi)
-                        lo += rel - _MARGIN
-                        hi += rel + _MARGIN
-                    # beams k cover angles k * da in [0, span]; the extent repeats every 2 pi
-                    m0 = int(np.ceil(-hi / two_pi))
-                    m1 = int(np.floor((span - lo) / two_pi))
-                    for m in range(m0, m1 + 1):
-                        if ida == 0.0:
-                            k0, k1 = 0, n - 1
-                        else:
-                            k0 = max(int(np.ceil((lo + m * two_pi) * ida)), 0)
-                            k1 = min(int(np.floor((hi + m * two_pi) * ida)), n - 1)
-                        for k in range(k0, k1 + 1):
-                            t1 = bx0 * ibx[k]
-                            t2 = bx1 * ibx[k]
-                            t3 = by0 * iby[k]
-                            t4 = by1 * iby[k]
-                            tn = max(min(t1, t2), min(t3, t4))
-                            tf = min(max(t1, t2), max(t3, t4))
-                            if tf >= tn and tf >= tmin:
-                                t = max(tn, tmin)
-                                if t <= tmax and t < hit[k]:
-                                    hit[k] = t
+                    ex = max(tx * tile - ox, 0.0, ox - (tx + 1) * tile)
+                    ey = max(ty * tile - oy, 0.0, oy - (ty + 1) * tile)
+                    d2 = ex * ex + ey * ey
+                    if d2 > tmax2:
+                        continue
+                    if d2 > 0.0 and _occluded(
+                        tx * tile - ox, ty * tile - oy, (tx + 1) * tile - ox,
+                        (ty + 1) * tile - oy, np.sqrt(d2), a0, span, ida, n, hit,
+                    ):  # fmt: skip
+                        continue
+                    _cast_tile(
+                        start, items, boxes, seen, q, ox, oy, tmin, tmax, tmax2, a0, span,
+                        ida, n, ibx, iby, hit, t_i,
+                    )  # fmt: skip
         o = offsets[q]
         for k in range(n):
             i = o + k if inc[q] >= 0 else o + n - 1 - k
             out[i] = min(out[i], hit[k] * res)
+
+
+@numba.njit(cache=True, inline="always")
+def _beam_span(bx0, by0, bx1, by1, a0, span, ida):
+    """The angles (lo, hi) relative to the first beam, within ``[0, 2 pi)`` for ``lo``, that a
+    rectangle (corners relative to the origin, which lies outside it) subtends, widened by the
+    arctangent's margin."""
+    two_pi = 2.0 * np.pi
+    # the corners' directions about the centre's (the extent is < pi)
+    ac = _atan2(by0 + by1, bx0 + bx1)
+    lo = 0.0
+    hi = 0.0
+    for corner in range(4):
+        px = bx0 if corner & 1 == 0 else bx1
+        py = by0 if corner & 2 == 0 else by1
+        d = _atan2(py, px) - ac
+        if d > np.pi:
+            d -= two_pi
+        elif d < -np.pi:
+            d += two_pi
+        lo = min(lo, d)
+        hi = max(hi, d)
+    rel = ac - a0
+    rel -= two_pi * np.floor(rel / two_pi)
+    return lo + rel - _MARGIN, hi + rel + _MARGIN
+
+
+@numba.njit(cache=True, inline="always")
+def _occluded(bx0, by0, bx1, by1, dmin, a0, span, ida, n, hit):
+    """Whether every beam that can cross a tile (corners relative to the origin, which lies
+    outside it, nearest point ``dmin`` away) already hits something nearer than ``dmin``: then
+    nothing in the tile can lower a range (a box reaching out of the tile is listed in the
+    other tiles it overlaps too)."""
+    two_pi = 2.0 * np.pi
+    lo, hi = _beam_span(bx0, by0, bx1, by1, a0, span, ida)
+    m0 = int(np.ceil(-hi / two_pi))
+    m1 = int(np.floor((span - lo) / two_pi))
+    for m in range(m0, m1 + 1):
+        if ida == 0.0:
+            k0, k1 = 0, n - 1
+        else:
+            k0 = max(int(np.ceil((lo + m * two_pi) * ida)), 0)
+            k1 = min(int(np.floor((hi + m * two_pi) * ida)), n - 1)
+        for k in range(k0, k1 + 1):
+            if hit[k] >= dmin:
+                return False
+    return True
+
+
+@numba.njit(cache=True, inline="always")
+def _cast_tile(
+    start, items, boxes, seen, q, ox, oy, tmin, tmax, tmax2, a0, span, ida, n, ibx, iby, hit, t_i
+):  # fmt: skip
+    """Lower ``hit`` (cell units) by the boxes of tile ``t_i`` not yet seen by laser ``q``."""
+    two_pi = 2.0 * np.pi
+    for j in range(start[t_i], start[t_i + 1]):
+        b = items[j]
+        if seen[b] == q:
+            continue
+        seen[b] = q
+        bx0 = boxes[b, 0] - ox
+        by0 = boxes[b, 1] - oy
+        bx1 = boxes[b, 2] - ox
+        by1 = boxes[b, 3] - oy
+        ex = max(bx0, 0.0, -bx1)
+        ey = max(by0, 0.0, -by1)
+        if ex * ex + ey * ey > tmax2:
+            continue
+        if (ex == 0.0 and ey == 0.0) or ida == 0.0:
+            lo = 0.0  # the origin touches the box (or a single beam): all beams
+            hi = span
+        else:
+            lo, hi = _beam_span(bx0, by0, bx1, by1, a0, span, ida)
+        # beams k cover angles k * da in [0, span]; the extent repeats every 2 pi
+        m0 = int(np.ceil(-hi / two_pi))
+        m1 = int(np.floor((span - lo) / two_pi))
+        for m in range(m0, m1 + 1):
+            if ida == 0.0:
+                k0, k1 = 0, n - 1
+            else:
+                k0 = max(int(np.ceil((lo + m * two_pi) * ida)), 0)
+                k1 = min(int(np.floor((hi + m * two_pi) * ida)), n - 1)
+            for k in range(k0, k1 + 1):
+                t1 = bx0 * ibx[k]
+                t2 = bx1 * ibx[k]
+                t3 = by0 * iby[k]
+                t4 = by1 * iby[k]
+                tn = max(min(t1, t2), min(t3, t4))
+                tf = min(max(t1, t2), max(t3, t4))
+                if tf >= tn and tf >= tmin:
+                    t = max(tn, tmin)
+                    if t <= tmax and t < hit[k]:
+                        hit[k] = t

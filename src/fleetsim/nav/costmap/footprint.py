@@ -76,31 +76,69 @@ def polygon_cells(costmap: Costmap2D, polygon: np.ndarray) -> tuple[np.ndarray, 
     """Cells (rows, cols) covered by a world polygon: centres inside it, plus its outline.
 
     As costmap_2d's convexFillCells, but by an even-odd test on cell centres (any polygon)
-    unioned with the outline cells, clipped to the grid. Returns (my, mx) int arrays.
+    unioned with the outline cells (points at most half a cell apart), clipped to the grid.
+    Returns (my, mx) int arrays, row by row. Compiled: footprint clearing calls it for every
+    costmap update of every robot, and the NumPy version of these few dozen cells cost
+    ~0.2 ms in array overhead.
     """
-    poly = np.asarray(polygon, dtype=np.float64)
-    cells, _ = costmap.cells_of(poly)
-    x0 = max(int(cells[:, 0].min()), 0)
-    x1 = min(int(cells[:, 0].max()), costmap.size_x - 1)
-    y0 = max(int(cells[:, 1].min()), 0)
-    y1 = min(int(cells[:, 1].max()), costmap.size_y - 1)
+    poly = np.ascontiguousarray(polygon, dtype=np.float64)
+    return _polygon_cells(
+        poly, costmap.origin_x, costmap.origin_y, costmap.resolution, costmap.size_x,
+        costmap.size_y,
+    )  # fmt: skip
+
+
+@njit(cache=True)
+def _polygon_cells(poly, ox, oy, res, size_x, size_y):
+    k = poly.shape[0]
+    cx0 = cy0 = 1 << 62
+    cx1 = cy1 = -(1 << 62)
+    for i in range(k):
+        cx = math.floor((poly[i, 0] - ox) / res)
+        cy = math.floor((poly[i, 1] - oy) / res)
+        cx0, cx1 = min(cx0, cx), max(cx1, cx)
+        cy0, cy1 = min(cy0, cy), max(cy1, cy)
+    x0, x1 = max(cx0, 0), min(cx1, size_x - 1)
+    y0, y1 = max(cy0, 0), min(cy1, size_y - 1)
     if x1 < x0 or y1 < y0:
         return np.empty(0, np.int64), np.empty(0, np.int64)
-    mx, my = np.meshgrid(np.arange(x0, x1 + 1), np.arange(y0, y1 + 1))
-    px = costmap.origin_x + (mx + 0.5) * costmap.resolution
-    py = costmap.origin_y + (my + 0.5) * costmap.resolution
-    inside = np.zeros(px.shape, dtype=bool)
-    a, b = poly, np.roll(poly, -1, axis=0)
-    for (ax, ay), (bx, by) in zip(a, b):
-        crosses = (ay > py) != (by > py)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            xc = ax + (py - ay) * (bx - ax) / (by - ay)
-        inside ^= crosses & (px < xc)
-    outline = outline_points(poly, costmap.resolution * 0.5)
-    oc, ok = costmap.cells_of(outline)
-    inside[oc[ok, 1] - y0, oc[ok, 0] - x0] = True
-    rows, cols = np.nonzero(inside)
-    return rows + y0, cols + x0
+    w, h = x1 - x0 + 1, y1 - y0 + 1
+    inside = np.zeros((h, w), np.bool_)
+    for r in range(h):
+        py = oy + (y0 + r + 0.5) * res
+        for i in range(k):
+            ax, ay = poly[i, 0], poly[i, 1]
+            bx, by = poly[(i + 1) % k, 0], poly[(i + 1) % k, 1]
+            if (ay > py) != (by > py):
+                xc = ax + (py - ay) * (bx - ax) / (by - ay)
+                for c in range(w):
+                    if ox + (x0 + c + 0.5) * res < xc:
+                        inside[r, c] = not inside[r, c]
+    spacing = res * 0.5
+    for i in range(k):  # the outline, as `outline_points`
+        ax, ay = poly[i, 0], poly[i, 1]
+        dx, dy = poly[(i + 1) % k, 0] - ax, poly[(i + 1) % k, 1] - ay
+        n = max(1, math.ceil(math.hypot(dx, dy) / spacing))
+        for j in range(n):
+            t = j / n
+            cx = math.floor((ax + t * dx - ox) / res)
+            cy = math.floor((ay + t * dy - oy) / res)
+            if 0 <= cx < size_x and 0 <= cy < size_y:
+                inside[cy - y0, cx - x0] = True
+    count = 0
+    for r in range(h):
+        for c in range(w):
+            count += inside[r, c]
+    rows = np.empty(count, np.int64)
+    cols = np.empty(count, np.int64)
+    count = 0
+    for r in range(h):
+        for c in range(w):
+            if inside[r, c]:
+                rows[count] = r + y0
+                cols[count] = c + x0
+                count += 1
+    return rows, cols
 
 
 def outline_points(polygon: np.ndarray, spacing: float) -> np.ndarray:

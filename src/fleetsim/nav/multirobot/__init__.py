@@ -1,0 +1,1 @@
+"""Multi-robot navigation: position sharing, ORCA, collision avoidance (collvoid)."""

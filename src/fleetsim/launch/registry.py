@@ -20,6 +20,7 @@ NODES: dict[tuple[str, str], str] = {
     ("robot_state_publisher", "state_publisher"): "fleetsim.description.robot_state_publisher:RobotStatePublisher",
     ("amcl", "amcl"): "fleetsim.localization.amcl.node:Amcl",
     ("fake_localization", "fake_localization"): "fleetsim.nav.fake_localization:FakeLocalization",
+    ("collvoid", "me_publisher"): "fleetsim.nav.multirobot.me_publisher:MePublisher",
     ("map_server", "map_server"): "fleetsim.nav.map_server:MapServer",
     ("map_server", "map_saver"): "fleetsim.nav.map_server:MapSaver",
     ("move_base", "move_base"): "fleetsim.nav.move_base:MoveBase",

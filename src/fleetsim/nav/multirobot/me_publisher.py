@@ -1,0 +1,143 @@
+"""``collvoid/me_publisher``: a robot tells the others where it is, on ``/position_share``.
+
+Every ``1 / publish_me_frequency`` s the node looks up its base in ``global_frame`` (newest tf)
+and publishes a `collvoid_msgs.PoseTwistWithCovariance`:
+
+* ``robot_id``: ``~name``, else the robot's ``tf_prefix``, else its namespace without slashes;
+* ``footprint``: ``~footprint`` (``[[x, y], ...]``, robot frame; else a ``~robot_radius`` circle)
+  padded by the localization uncertainty, ``radius`` its circumscribed radius;
+* the uncertainty: from the latest ``particlecloud`` (amcl's PoseArray, relative name, so it is
+  ``/lizi1/particlecloud``): the distance from the estimate within which ``1 - eps`` of the
+  particles lie, capped at twice the robot radius (`uncertainty_radius`). fake_localization's
+  cloud is the one true pose, so the uncertainty is zero, as it is before any cloud arrives;
+* ``pose`` (map frame, with the particle spread's x/y covariance), ``twist`` (``odom``'s
+  twist, base frame) and ``holonomic_velocity`` (that velocity turned into the map frame).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from fleetsim.errors import TransformError
+from fleetsim.msgs import collvoid_msgs, geometry_msgs, nav_msgs
+from fleetsim.nav.costmap.footprint import (
+    footprint_from_param,
+    footprint_from_radius,
+    footprint_radii,
+    padded_footprint,
+)
+from fleetsim.nav.multirobot.position_share import TOPIC
+from fleetsim.nav.multirobot.uncertainty import uncertainty_radius
+from fleetsim.runtime import Node, param
+from fleetsim.tf import resolve_frame_once
+from fleetsim.tf.names import normalize_frame
+from fleetsim.tf.quaternions import quaternion_from_yaw
+
+#: s of sim time without a transform before the node warns (tf comes up a moment late)
+TF_GRACE = 2.0
+
+
+@dataclass(frozen=True)
+class MePublisherParams:
+    """``me_publisher`` private parameters (collvoid's names and defaults)."""
+
+    publish_me_frequency: float = param(
+        10.0, unit="Hz", range=(1e-6, None), help="rate of the /position_share messages"
+    )
+    eps: float = param(
+        0.1, range=(0.0, 0.999), help="particle weight allowed outside the uncertainty radius"
+    )
+    holo_robot: bool = param(False, help="the robot is holonomic")
+    controlled: bool = param(True, help="the robot avoids others (else they avoid it fully)")
+    base_frame: str = param("base_link", help="the robot's base frame (tf_prefix applied)")
+    global_frame: str = param("/map", help="the shared frame poses are published in")
+    name: str = param("", help="robot_id (empty: the tf_prefix, else the namespace)")
+    footprint: str | list = param("[]", help="robot polygon [[x, y], ...] in the base frame")
+    robot_radius: float = param(
+        0.2, unit="m", range=(0.0, None), help="circular robot when no footprint is given"
+    )
+
+
+class MePublisher(Node):
+    """Publishes this robot's id, pose, velocity and inflated footprint on /position_share."""
+
+    Params = MePublisherParams
+
+    def __init__(self, runtime, name: str = "me_publisher", namespace: str = "/", **kw: Any):
+        super().__init__(runtime, name, namespace, **kw)
+        p: MePublisherParams = self.params
+        fp_value = p.footprint
+        if isinstance(fp_value, str) and fp_value.strip() in ("", "[]"):
+            self.footprint = footprint_from_radius(p.robot_radius)
+        else:
+            self.footprint = footprint_from_param(fp_value, f"{self.full_name}/footprint")
+        self.robot_radius = footprint_radii(self.footprint)[1]
+        self.robot_id = p.name or self.tf_prefix or self.namespace.strip("/").replace("/", "_")
+        self.base_frame = resolve_frame_once(self.tf_prefix, p.base_frame)
+        self.global_frame = normalize_frame(p.global_frame)
+        self._particles: np.ndarray | None = None
+        self._body_vel = (0.0, 0.0, 0.0)
+        self._started = self.now()
+        self.pub = self.create_publisher(collvoid_msgs.PoseTwistWithCovariance, TOPIC, 10)
+        self.create_subscription(geometry_msgs.PoseArray, "particlecloud", self.on_cloud, 1)
+        self.create_subscription(nav_msgs.Odometry, "odom", self.on_odom, 1)
+        _ = self.tf_buffer
+        self.create_timer(1.0 / p.publish_me_frequency, self.publish_me)
+
+    def on_cloud(self, msg: Any) -> None:
+        self._particles = np.array(
+            [[q.position.x, q.position.y] for q in msg.poses], dtype=np.float64
+        ).reshape(-1, 2)
+
+    def on_odom(self, msg: Any) -> None:
+        t = msg.twist.twist
+        self._body_vel = (t.linear.x, t.linear.y, t.angular.z)
+
+    def uncertainty(self, x: float, y: float) -> float:
+        """The localization uncertainty radius at estimate (x, y), m (0 without a cloud)."""
+        if self._particles is None:
+            return 0.0
+        return uncertainty_radius(
+            self._particles, np.array([x, y]), self.params.eps, 2.0 * self.robot_radius
+        )
+
+    def publish_me(self) -> None:
+        try:
+            x, y, yaw = self.tf_buffer.lookup_pose2d(self.global_frame, self.base_frame, 0.0)
+        except TransformError as err:
+            if self.now() - self._started > TF_GRACE:
+                self._warn_once("tf", f"cannot share the robot's position yet: {err}")
+            return
+        unc = self.uncertainty(x, y)
+        fp = padded_footprint(self.footprint, unc) if unc > 0 else self.footprint
+        c, s = math.cos(yaw), math.sin(yaw)
+        bvx, bvy, bw = self._body_vel
+        vx, vy = c * bvx - s * bvy, s * bvx + c * bvy
+        msg = collvoid_msgs.PoseTwistWithCovariance(
+            robot_id=self.robot_id,
+            radius=footprint_radii(fp)[1],
+            holo_robot=self.params.holo_robot,
+            controlled=self.params.controlled,
+        )
+        msg.header.stamp = self.now_msg()
+        msg.header.frame_id = self.global_frame
+        msg.holonomic_velocity = geometry_msgs.Vector3(x=vx, y=vy)
+        q = quaternion_from_yaw(yaw)
+        msg.pose.pose = geometry_msgs.Pose(
+            position=geometry_msgs.Point(x=x, y=y),
+            orientation=geometry_msgs.Quaternion(x=q[0], y=q[1], z=q[2], w=q[3]),
+        )
+        if self._particles is not None and self._particles.shape[0] > 1:
+            cov = np.cov(self._particles.T)
+            msg.pose.covariance[[0, 1, 6, 7]] = cov.reshape(-1)
+        msg.twist.twist.linear = geometry_msgs.Vector3(x=bvx, y=bvy)
+        msg.twist.twist.angular = geometry_msgs.Vector3(z=bw)
+        msg.footprint.header = msg.header
+        msg.footprint.polygon.points = [
+            geometry_msgs.Point32(x=float(px), y=float(py)) for px, py in fp
+        ]
+        self.pub.publish(msg)

@@ -1,11 +1,14 @@
 """Joint transforms of a URDF tree: the kernel robot_state_publisher runs on each joint state.
 
-Pure NumPy over arrays of joints; quaternions are ``(x, y, z, w)``.
+Over arrays of joints (compiled); quaternions are ``(x, y, z, w)``.
 """
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+from numba import njit
 
 from fleetsim.description.model import Joint
 from fleetsim.tf.quaternions import quaternions_from_eulers
@@ -48,27 +51,42 @@ def child_transforms_from_joint_positions(
     -------
     translations : (J, 3) m, and rotations : (J, 4) ``(x, y, z, w)``: ``T_origin * T_motion``.
     """
-    q = np.where(kinds == FIXED, 0.0, np.asarray(positions, dtype=np.float64))
-    angle = np.where(kinds == REVOLUTE, q, 0.0)
-    shift = np.where(kinds == PRISMATIC, q, 0.0)
-    half = 0.5 * angle
-    motion = np.concatenate([axes * np.sin(half)[:, None], np.cos(half)[:, None]], axis=1)
-    # translation: origin + R_origin * (axis * shift)
-    v = axes * shift[:, None]
-    u, w = origin_quat[:, :3], origin_quat[:, 3:4]
-    t = 2.0 * np.cross(u, v)
-    rotated = v + w * t + np.cross(u, t)
-    trans = origin_xyz + rotated
-    # rotation: q_origin * q_motion (Hamilton product)
-    x1, y1, z1, w1 = origin_quat.T
-    x2, y2, z2, w2 = motion.T
-    rot = np.stack(
-        [
-            w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2,
-            w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2,
-            w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2,
-            w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2,
-        ],
-        axis=1,
+    return _child_transforms(
+        np.ascontiguousarray(origin_xyz, dtype=np.float64),
+        np.ascontiguousarray(origin_quat, dtype=np.float64),
+        np.ascontiguousarray(axes, dtype=np.float64),
+        np.ascontiguousarray(kinds, dtype=np.int8),
+        np.ascontiguousarray(positions, dtype=np.float64),
     )
+
+
+@njit(cache=True)
+def _child_transforms(origin_xyz, origin_quat, axes, kinds, positions):
+    """Compiled body of `child_transforms_from_joint_positions`: robot_state_publisher runs it
+    on every joint_states message of every robot, and as a dozen NumPy calls on a few joints it
+    cost ~0.15 ms in array overhead alone."""
+    n = origin_xyz.shape[0]
+    trans = np.empty((n, 3))
+    rot = np.empty((n, 4))
+    for j in range(n):
+        q = 0.0 if kinds[j] == FIXED else positions[j]
+        angle = q if kinds[j] == REVOLUTE else 0.0
+        shift = q if kinds[j] == PRISMATIC else 0.0
+        sh, ch = math.sin(0.5 * angle), math.cos(0.5 * angle)
+        ax, ay, az = axes[j, 0], axes[j, 1], axes[j, 2]
+        x2, y2, z2, w2 = ax * sh, ay * sh, az * sh, ch
+        # translation: origin + R_origin * (axis * shift), as v + w t + u x t with t = 2 u x v
+        vx, vy, vz = ax * shift, ay * shift, az * shift
+        x1, y1, z1, w1 = origin_quat[j, 0], origin_quat[j, 1], origin_quat[j, 2], origin_quat[j, 3]
+        tx = 2.0 * (y1 * vz - z1 * vy)
+        ty = 2.0 * (z1 * vx - x1 * vz)
+        tz = 2.0 * (x1 * vy - y1 * vx)
+        trans[j, 0] = origin_xyz[j, 0] + (vx + w1 * tx + (y1 * tz - z1 * ty))
+        trans[j, 1] = origin_xyz[j, 1] + (vy + w1 * ty + (z1 * tx - x1 * tz))
+        trans[j, 2] = origin_xyz[j, 2] + (vz + w1 * tz + (x1 * ty - y1 * tx))
+        # rotation: q_origin * q_motion (Hamilton product)
+        rot[j, 0] = w1 * x2 + x1 * w2 + y1 * z2 - z1 * y2
+        rot[j, 1] = w1 * y2 - x1 * z2 + y1 * w2 + z1 * x2
+        rot[j, 2] = w1 * z2 + x1 * y2 - y1 * x2 + z1 * w2
+        rot[j, 3] = w1 * w2 - x1 * x2 - y1 * y2 - z1 * z2
     return trans, rot

@@ -84,13 +84,8 @@ class RobotStatePublisher(Node):
             self._xyz[idx], self._quat[idx], self._axes[idx], self._kinds[idx], positions
         )
         return [
-            make_transform_stamped(
-                *self._frames[i],
-                stamp,
-                tuple(trans[k]),
-                tuple(rot[k]),
-            )
-            for k, i in enumerate(idx)
+            make_transform_stamped(*self._frames[i], stamp, t, q)
+            for i, t, q in zip(idx.tolist(), trans.tolist(), rot.tolist())
         ]
 
     def publish_fixed_transforms(self) -> None:

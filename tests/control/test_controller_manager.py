@@ -50,9 +50,18 @@ def test_each_namespace_gets_a_controller_manager_and_joint_states(hunters):
     assert "position_controllers/JointGroupPositionController" in types
 
 
+def test_the_hunter_feeds_its_joint_damping_forward(hunter_robot):
+    """ros_controllers.yaml's velocity_ff is each arm joint's URDF damping (N m s/rad), so a
+    planned velocity gets the torque the damping takes without the PID lagging for it."""
+    arm = hunter_config()["arm_group_controller"]
+    assert arm["velocity_ff"] == {j: hunter_robot.joints[j].dynamics.damping for j in ARM}
+    assert all(arm["gains"][j]["p"] == 10 and arm["gains"][j]["d"] == 0 for j in ARM)
+
+
 def test_the_manual_gains_reach_a_pose_and_settle(hunters):
-    """P = 10, D = 0 from ros_controllers.yaml: a 6 s move to cam_low on hunter1 while hunter2
-    goes home; both end SUCCESSFUL (at rest within the default 0.01 rad/s) near the pose."""
+    """P = 10, D = 0 from ros_controllers.yaml (plus an integral term that takes out the
+    gravity sag): a 6 s move to cam_low on hunter1 while hunter2 goes home; both end
+    SUCCESSFUL (at rest within the default 0.01 rad/s) near the pose."""
     hunters.rt.run(0.3)
     q0 = hunters.cm("hunter1").hw.positions(ARM)
     ts = np.linspace(0, 1, 31)

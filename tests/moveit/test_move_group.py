@@ -35,6 +35,16 @@ def camera_direction(h: Hunters, ns: str) -> np.ndarray:
     return base.T @ cam[:, 0]
 
 
+def measured_speeds(states: list) -> np.ndarray:
+    """(J,) the largest |velocity| each arm joint showed on /joint_states: the reported
+    velocities and the finite differences of the positions at the publish rate (50 Hz)."""
+    reported = np.abs(np.array([s.velocity for s in states])).max(axis=0)
+    t = np.array([s.header.stamp.to_sec() for s in states])
+    q = np.array([s.position for s in states])
+    differenced = np.abs(np.diff(q, axis=0) / np.diff(t)[:, None]).max(axis=0)
+    return np.maximum(reported, differenced)
+
+
 def test_each_named_pose_is_reached_within_the_speed_limits(one):
     arm = MoveGroupCommander("arm_group", ns="/hunter1", runtime=one.rt)
     states = []
@@ -59,8 +69,31 @@ def test_each_named_pose_is_reached_within_the_speed_limits(one):
             assert d[2] < -0.5, (name, d)
         else:
             assert d[2] > -0.5, (name, d)
-    speeds = np.abs(np.array([s.velocity for s in states]))
-    assert np.all(speeds.max(axis=0) <= VMAX * 1.05), speeds.max(axis=0)
+    speeds = measured_speeds(states)
+    assert np.all(speeds <= VMAX * 1.05), speeds / VMAX
+
+
+def test_measured_speeds_stay_within_half_the_limits(one):
+    """At scaling 0.5 the arm, not only the plan, keeps to 0.5 x max_velocity (+5 %): moves
+    that hold the pitch joints still (cam_low -> cam_low_left -> cam_low_back) and moves that
+    swing them (-> home_low -> cam_left). Under P-only gains the held joints dropped by one
+    gravity sag at the start of each move, at up to 1.7 x the scaled limit."""
+    arm = MoveGroupCommander("arm_group", ns="/hunter1", runtime=one.rt)
+    arm.set_named_target("cam_low")
+    assert arm.go()
+    states = []
+    sub = one.probe.create_subscription(
+        sensor_msgs.JointState, "/hunter1/joint_states", states.append
+    )
+    arm.set_max_velocity_scaling_factor(0.5)
+    for name in ("cam_low_left", "cam_low_back", "home_low", "cam_left"):
+        arm.set_named_target(name)
+        assert arm.go(), (name, arm.last_result())
+    sub.destroy()
+    speeds = measured_speeds(states)
+    assert np.all(speeds <= VMAX * 0.5 * 1.05), speeds / (VMAX * 0.5)
+    # the yaw ran at its limit, the elbow swung at a good part of its own
+    assert speeds[0] > VMAX[0] * 0.5 * 0.95 and speeds[2] > VMAX[2] * 0.5 * 0.5, speeds
 
 
 def test_half_speed_and_a_box_in_the_way(one):
@@ -87,12 +120,8 @@ def test_half_speed_and_a_box_in_the_way(one):
     assert arm.go()
     positions = [np.asarray(s.position) for s in states]
     assert all(ctx.scene.is_valid(q) for q in positions)  # the arm never entered the box
-    # the plan keeps to half the limits (measured speeds are checked at full scale above: at
-    # half scale the start of a move, where the controller joins its held setpoint to the
-    # measured start state the arm sags ~9 mrad below under P-only gains, briefly exceeds it)
-    planned = arm.last_result()[0].planned_trajectory.joint_trajectory.points
-    speeds = np.abs(np.array([p.velocities for p in planned])).max(axis=0)
-    assert np.all(speeds <= VMAX * 0.5 * 1.005), speeds
+    speeds = measured_speeds(states)
+    assert np.all(speeds <= VMAX * 0.5 * 1.05), speeds / (VMAX * 0.5)
     scene.remove_world_object("box")
     assert scene.get_known_object_names() == []
 
@@ -132,7 +161,7 @@ def test_position_target_and_kinematics_services(one):
     arm.set_position_target(target)
     assert arm.go()
     p = arm.get_current_pose().pose.position
-    assert np.linalg.norm(np.array([p.x, p.y, p.z]) - target) < 0.02  # P-only gains sag ~1 cm
+    assert np.linalg.norm(np.array([p.x, p.y, p.z]) - target) < 0.01
     fk = one.rt.graph.call_service(
         "/hunter1/compute_fk",
         moveit_msgs.GetPositionFK,

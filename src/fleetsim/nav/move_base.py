@@ -41,12 +41,12 @@ import numpy as np
 
 from fleetsim.errors import TransformError
 from fleetsim.msgs import geometry_msgs, move_base_msgs, nav_msgs, std_msgs
-from fleetsim.nav.controllers import TrajectoryPlanner
 from fleetsim.nav.costmap.costmap_ros import Costmap2DROS
 from fleetsim.nav.move_base_cycle import PLANNING, PLANNING_R, ExecuteCycle
 from fleetsim.nav.move_base_plugins import (
     global_planner,
     local_planner_namespace,
+    make_local_planner,
     recovery_behaviors,
 )
 from fleetsim.nav.move_base_support import (
@@ -114,6 +114,7 @@ class MoveBase(ExecuteCycle, Node):
         "NavfnROS",
         "TrajectoryPlannerROS",
         "DWAPlannerROS",
+        "CollvoidLocalPlanner",
         "conservative_reset",
         "aggressive_reset",
         "rotate_recovery",
@@ -134,10 +135,11 @@ class MoveBase(ExecuteCycle, Node):
         self.controller_name, planner_ns = local_planner_namespace(
             p.base_local_planner, ns, p.controller_frequency, where
         )
-        self.controller = TrajectoryPlanner.from_namespace(
-            self.local_costmap.costmap,
-            self.local_costmap.footprint,
+        self.controller = make_local_planner(
+            self,
+            self.controller_name,
             planner_ns,
+            self.local_costmap,
             f"{where}/{self.controller_name}",
         )
         self.recoveries = recovery_behaviors(

@@ -44,6 +44,7 @@ GLOBAL_PLANNERS = {"navfn/NavfnROS": "NavfnROS"}
 LOCAL_PLANNERS = {
     "base_local_planner/TrajectoryPlannerROS": "TrajectoryPlannerROS",
     "dwa_local_planner/DWAPlannerROS": "DWAPlannerROS",
+    "collvoid_local_planner/CollvoidLocalPlanner": "CollvoidLocalPlanner",
 }
 RECOVERY_TYPES = ("clear_costmap_recovery/ClearCostmapRecovery", "rotate_recovery/RotateRecovery")
 
@@ -122,6 +123,15 @@ def local_planner(value: str, ns: dict, controller_frequency: float, costmap_ros
         costmap_ros.costmap, costmap_ros.footprint, raw, f"{where}/{name}"
     )
     return name, planner
+
+
+def make_local_planner(node: Any, name: str, ns: dict, costmap_ros: Any, where: str) -> Any:
+    """The local planner plugin ``name`` (a `LOCAL_PLANNERS` value) on ``costmap_ros``."""
+    if name == "CollvoidLocalPlanner":  # it listens to /position_share through the node
+        from fleetsim.nav.controllers.collvoid_planner import CollvoidLocalPlanner
+
+        return CollvoidLocalPlanner.from_namespace(node, costmap_ros, ns, where)
+    return TrajectoryPlanner.from_namespace(costmap_ros.costmap, costmap_ros.footprint, ns, where)
 
 
 @dataclass

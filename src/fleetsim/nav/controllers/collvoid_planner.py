@@ -1,0 +1,292 @@
+"""``collvoid_local_planner/CollvoidLocalPlanner``: multi-robot collision avoidance in move_base.
+
+After collvoid (Claes, Hennes, Tuyls), each control cycle:
+
+1. the robot's own radius is its footprint's circumscribed radius (or ``footprint_radius``),
+   plus its localization uncertainty (amcl's ``particlecloud``, ``eps``), ``safety_margin`` and
+   the tracking error allowed for a differential drive (``min_error_holo`` growing to
+   ``max_error_holo`` at full speed);
+2. the preferred velocity points at a carrot ``carrot_distance`` m along the global plan, at
+   ``max_vel_x`` slowing to ``min_vel_x`` over the last metre; while another robot is ahead it
+   is turned by ``left_pref`` rad (negative: keep right), which breaks the symmetry of head-on
+   meetings that plain ORCA cannot;
+3. the `DeadlockRule` may make the robot yield: back off to the right, away from a robot with
+   priority, taking full responsibility for avoiding it;
+4. ORCA half-planes (`fleetsim.nav.multirobot.orca`): one per robot on ``/position_share``
+   within ``neighbor_dist`` (at most ``max_neighbors``, horizon ``time_horizon``, half the
+   responsibility, all of it for a robot that is not ``controlled``, stands still or is yielded
+   to), and one per static obstacle point of the local costmap (the nearest lethal cell per
+   bearing sector, horizon ``time_horizon_obst``, full responsibility, kept hard when the
+   program is infeasible);
+5. the linear program gives the holonomic velocity nearest the preferred one; a differential
+   drive tracks it (`tracking_command`, ``time_to_holo``) within ``acc_lim_x``/``acc_lim_theta``;
+6. within ``xy_goal_tolerance`` the robot stops and turns in place to the goal yaw, as
+   base_local_planner does.
+
+Neighbours arrive in the ``map`` frame; the local costmap's frame (often ``odom``) is reached
+through tf. Only ORCA is available: ``clearpath: true`` or ``orca: false`` is an error, and
+``type_vo`` (collvoid's choice of VO for its sampling and ClearPath solvers) has no effect.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from typing import Any
+
+import numpy as np
+
+from fleetsim.errors import ParameterError, TransformError
+from fleetsim.msgs import geometry_msgs
+from fleetsim.nav.controllers.base import EmptyPlan, LocalPlanner, VelocityCommand
+from fleetsim.nav.controllers.collvoid_params import CollvoidParams
+from fleetsim.nav.costmap.footprint import footprint_radii
+from fleetsim.nav.multirobot.deadlock import DeadlockRule
+from fleetsim.nav.multirobot.holonomic import (
+    obstacle_points,
+    plan_carrot,
+    preferred_velocity,
+    rotated,
+    tracking_command,
+)
+from fleetsim.nav.multirobot.orca import orca_halfplanes, orca_velocity
+from fleetsim.nav.multirobot.position_share import PositionShare
+from fleetsim.nav.multirobot.uncertainty import uncertainty_radius
+from fleetsim.runtime import load_params
+
+_log = logging.getLogger("fleetsim.nav.collvoid")
+MAP_FRAME = "map"
+#: m/s: a neighbour slower than this is treated as standing still (full responsibility)
+STILL_SPEED = 0.02
+#: bearing sectors for static obstacle points
+OBSTACLE_SECTORS = 24
+#: no truncation: the velocity obstacle's horizon, s
+UNTRUNCATED = 1e3
+
+
+def _clamp(v: float, lo: float, hi: float) -> float:
+    return max(lo, min(hi, v))
+
+
+class CollvoidLocalPlanner(LocalPlanner):
+    """ORCA among the robots on /position_share, for one move_base (see the module doc)."""
+
+    Params = CollvoidParams
+
+    def __init__(self, node: Any, costmap_ros: Any, params: CollvoidParams, where: str = ""):
+        p = self.params = params
+        where = where or "CollvoidLocalPlanner"
+        if p.clearpath or not p.orca:
+            raise ParameterError(
+                f"{where}: clearpath {str(p.clearpath).lower()}, orca {str(p.orca).lower()}: "
+                "only collvoid's ORCA solver is available; set orca: true and clearpath: false"
+            )
+        if p.type_vo != 0:
+            _log.warning("%s: type_vo %d has no effect with orca: true", where, p.type_vo)
+        self.node = node
+        self.costmap_ros = costmap_ros
+        self.costmap = costmap_ros.costmap
+        self.frame = costmap_ros.global_frame
+        self.robot_id = p.robot_id or node.tf_prefix or node.namespace.strip("/")
+        self.body_radius = p.footprint_radius or footprint_radii(costmap_ros.footprint)[1]
+        self.share = PositionShare(node)
+        self.deadlock = DeadlockRule(
+            self.robot_id, p.deadlock_time, p.deadlock_progress, p.deadlock_radius, p.yield_time
+        )
+        self._particles: np.ndarray | None = None
+        node.create_subscription(geometry_msgs.PoseArray, "particlecloud", self._on_cloud, 1)
+        self.dt = 1.0 / p.controller_frequency
+        self.horizon = p.time_horizon if p.use_truncation else UNTRUNCATED
+        self.horizon_obst = p.time_horizon_obst if p.use_truncation else UNTRUNCATED
+        self.plan = np.zeros((0, 3))
+        self.local_plan = np.zeros((0, 3))
+        self.reached_goal = False
+        self.xy_tolerance_latch = False
+        self.rotating_to_goal = False
+        self.last_cmd = (0.0, 0.0)
+        self.last_holo = np.zeros(2)
+        self.yielding_to: str | None = None
+        self.feasible = True
+
+    @classmethod
+    def from_namespace(cls, node: Any, costmap_ros: Any, ns: dict | None, where: str):
+        return cls(node, costmap_ros, load_params(CollvoidParams, ns, where, logger=_log), where)
+
+    def _on_cloud(self, msg: Any) -> None:
+        self._particles = np.array(
+            [[q.position.x, q.position.y] for q in msg.poses], dtype=np.float64
+        ).reshape(-1, 2)
+
+    # -- the plugin interface ------------------------------------------------------------------
+    def set_plan(self, plan: Any) -> None:
+        poses = np.asarray(getattr(plan, "poses", plan), dtype=np.float64)
+        if poses.ndim != 2 or poses.shape[1] not in (2, 3) or poses.shape[0] == 0:
+            raise EmptyPlan(f"set_plan: a plan must be (N, 3) x, y, yaw poses, got {poses.shape}")
+        if poses.shape[1] == 2:
+            poses = np.concatenate([poses, np.zeros((poses.shape[0], 1))], axis=1)
+        same_goal = self.plan.shape[0] > 0 and np.allclose(self.plan[-1], poses[-1], atol=1e-6)
+        self.plan = poses
+        if not same_goal:
+            self.reached_goal = False
+            self.xy_tolerance_latch = False
+            self.deadlock.reset(self.node.now())
+
+    def is_goal_reached(self) -> bool:
+        return self.reached_goal
+
+    def compute_velocity_commands(self, pose, velocity) -> VelocityCommand:
+        p = self.params
+        x, y, yaw = (float(v) for v in pose)
+        if self.plan.shape[0] == 0:
+            raise EmptyPlan("CollvoidLocalPlanner: no plan; call set_plan first")
+        xy = np.array([x, y])
+        gx, gy, gyaw = self.plan[-1]
+        if self.xy_tolerance_latch or math.hypot(gx - x, gy - y) <= p.xy_goal_tolerance:
+            if p.latch_xy_goal_tolerance:
+                self.xy_tolerance_latch = True
+            return self._at_goal(yaw, float(velocity[2]), gyaw)
+        self.rotating_to_goal = False
+        carrot, _, remaining = plan_carrot(self.plan[:, :2], xy, p.carrot_distance)
+        vel_body = np.array([float(velocity[0]), float(velocity[1])])
+        vel = rotated(vel_body, yaw)
+        holo = self.holonomic_velocity(xy, yaw, vel, carrot, remaining)
+        return self._track(holo, (x, y, yaw), velocity)
+
+    # -- the cycle -----------------------------------------------------------------------------
+    def own_radius(self, speed: float, map_xy: np.ndarray) -> float:
+        """Own safety radius: body + uncertainty + margin + allowed tracking error, m."""
+        p = self.params
+        unc = 0.0
+        if self._particles is not None and self._particles.shape[0] > 1:
+            unc = uncertainty_radius(self._particles, map_xy, p.eps, 2.0 * self.body_radius)
+        err = p.min_error_holo
+        if not p.holonomic_robot:
+            err += (p.max_error_holo - p.min_error_holo) * min(1.0, speed / p.max_vel_x)
+        return self.body_radius + unc + p.safety_margin + err
+
+    def _map_to_local(self) -> tuple[float, float, float]:
+        if self.frame == MAP_FRAME:
+            return 0.0, 0.0, 0.0
+        return self.node.tf_buffer.lookup_pose2d(self.frame, MAP_FRAME, 0.0)
+
+    def holonomic_velocity(self, xy, yaw, vel, carrot, remaining) -> np.ndarray:
+        """The ORCA velocity for this cycle, (2,) m/s in the local costmap's frame."""
+        p, now = self.params, self.node.now()
+        try:
+            tx, ty, tyaw = self._map_to_local()
+        except TransformError:
+            tx = ty = tyaw = None
+        pref = preferred_velocity(carrot, xy, remaining, p.max_vel_x, p.min_vel_x)
+        pos = np.zeros((0, 2))
+        nvel = np.zeros((0, 2))
+        radii = np.zeros(0)
+        resp = np.zeros(0)
+        ids: list[str] = []
+        speed = float(np.hypot(*vel))
+        map_xy = xy
+        if tx is not None:
+            map_xy = rotated(xy - [tx, ty], -tyaw)
+            near = self.share.table.near(
+                now, (map_xy[0], map_xy[1]), p.neighbor_dist, p.max_neighbors, self.robot_id
+            )
+            ids = near.ids
+            cr, sr = math.cos(tyaw), math.sin(tyaw)
+            rot = np.array([[cr, -sr], [sr, cr]])
+            pos = near.positions @ rot.T + [tx, ty]
+            nvel = near.velocities @ rot.T
+            radii = near.radii
+            still = np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED
+            resp = np.where(~near.controlled | still, 1.0, 0.5)
+        own_r = self.own_radius(speed, map_xy)
+        dist = np.hypot(pos[:, 0] - xy[0], pos[:, 1] - xy[1])
+        self.yielding_to = self.deadlock.update(now, remaining, dict(zip(ids, dist.tolist())))
+        if self.yielding_to is not None:
+            k = ids.index(self.yielding_to)
+            resp[k] = 1.0
+            away = xy - pos[k]
+            away = away / max(float(np.hypot(*away)), 1e-9)
+            pref = rotated(away, -math.pi / 3) * (0.5 * p.max_vel_x)
+        elif ids:
+            ahead = ((pos - xy) @ pref > 0) & (dist <= own_r + radii + p.max_vel_x * self.horizon)
+            if ahead.any():
+                pref = rotated(pref, p.left_pref)
+        lines_p, lines_d = [], []
+        obst = obstacle_points(
+            self.costmap.costs,
+            (self.costmap.origin_x, self.costmap.origin_y),
+            self.costmap.resolution,
+            xy,
+            self.body_radius + p.max_vel_x * self.horizon_obst + 0.3,
+            OBSTACLE_SECTORS,
+        )
+        cell_r = self.costmap.resolution * 0.71
+        if obst.shape[0]:
+            lp, ld = orca_halfplanes(
+                obst - xy,
+                np.broadcast_to(vel, obst.shape),
+                np.full(obst.shape[0], self.body_radius + cell_r),
+                vel,
+                self.horizon_obst,
+                self.dt,
+                1.0,
+            )
+            lines_p.append(lp)
+            lines_d.append(ld)
+        if ids:
+            lp, ld = orca_halfplanes(
+                pos - xy, vel - nvel, own_r + radii, vel, self.horizon, self.dt, resp
+            )
+            lines_p.append(lp)
+            lines_d.append(ld)
+        if not lines_p:
+            self.feasible = True
+            return pref
+        holo, self.feasible = orca_velocity(
+            np.concatenate(lines_p), np.concatenate(lines_d), p.max_vel_x, pref, obst.shape[0]
+        )
+        self.last_holo = holo
+        return holo
+
+    def _track(self, holo: np.ndarray, pose, velocity) -> VelocityCommand:
+        p, yaw = self.params, pose[2]
+        if p.holonomic_robot:
+            body = rotated(holo, -yaw)
+            cmd = (float(body[0]), float(body[1]), 0.0)
+        else:
+            v, w = tracking_command(holo, yaw, p.time_to_holo, p.max_vel_x, p.max_vel_theta)
+            cmd = (v, 0.0, w)
+        v0, vy0, w0 = (float(c) for c in velocity)
+        dv, dw = p.acc_lim_x * self.dt, p.acc_lim_theta * self.dt
+        dvy = p.acc_lim_y * self.dt
+        vx = _clamp(cmd[0], v0 - dv, v0 + dv)
+        vy = _clamp(cmd[1], vy0 - dvy, vy0 + dvy)
+        w = _clamp(cmd[2], w0 - dw, w0 + dw)
+        self.local_plan = self._rollout(pose, vx, vy, w)
+        return VelocityCommand(vx, vy, w)
+
+    @staticmethod
+    def _rollout(pose, vx: float, vy: float, w: float, steps: int = 10) -> np.ndarray:
+        """The command held for one second, (steps, 3) poses in the local frame (local_plan)."""
+        dt = 1.0 / (steps - 1)
+        out = np.empty((steps, 3))
+        x, y, th = pose
+        for k in range(steps):
+            out[k] = x, y, th
+            c, s = math.cos(th), math.sin(th)
+            x, y, th = x + (c * vx - s * vy) * dt, y + (s * vx + c * vy) * dt, th + w * dt
+        return out
+
+    def _at_goal(self, yaw: float, w0: float, goal_yaw: float) -> VelocityCommand:
+        p = self.params
+        ang = math.remainder(goal_yaw - yaw, 2 * math.pi)
+        if abs(ang) <= p.yaw_goal_tolerance:
+            self.rotating_to_goal = False
+            self.xy_tolerance_latch = False
+            self.reached_goal = True
+            self.local_plan = np.zeros((0, 3))
+            return VelocityCommand()
+        self.rotating_to_goal = True
+        v = _clamp(abs(ang), p.min_in_place_vel_theta, p.max_vel_theta)
+        v = min(v, math.sqrt(2 * p.acc_lim_theta * abs(ang)), abs(w0) + p.acc_lim_theta * self.dt)
+        v = max(v, p.min_in_place_vel_theta)
+        return VelocityCommand(0.0, 0.0, math.copysign(v, ang))

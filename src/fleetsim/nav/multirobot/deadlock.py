@@ -1,0 +1,77 @@
+"""The rule above ORCA that ends deadlocks: no-progress detection, then a priority decision that
+every robot computes the same way.
+
+ORCA alone stops in symmetric meetings and in passages too narrow for two (the reference
+measurement with RVO2: exact head-on pairs and 0.6 m corridors never finish). Each robot runs a
+`DeadlockRule`:
+
+1. progress is the remaining distance to the goal; when it has not shrunk by
+   ``deadlock_progress`` m for ``deadlock_time`` s while another robot is within
+   ``deadlock_radius`` m, the robot is *stuck*;
+2. a stuck robot looks at the robots around it: priority goes by robot id (natural order, so
+   ``lizi2`` before ``lizi10``); every robot sees the same ids, so all reach the same verdict
+   without talking. If one of them has priority over it, it *yields* to the nearest such robot
+   for ``yield_time`` s: it backs away from it, off to its right, and takes full
+   responsibility for avoiding it (the priority robot keeps its half and drives on);
+3. after yielding, the progress clock restarts, so a robot that is still stuck yields again.
+
+The robot with the highest priority among those stuck never yields, so a group always has one
+robot that keeps going.
+"""
+
+from __future__ import annotations
+
+import re
+from dataclasses import dataclass
+
+
+def priority_key(robot_id: str) -> tuple:
+    """Natural sort key: lower sorts first and has priority (``lizi2`` < ``lizi10``)."""
+    return tuple(int(t) if t.isdigit() else t for t in re.split(r"(\d+)", robot_id))
+
+
+@dataclass
+class DeadlockRule:
+    """One robot's deadlock state (see the module doc)."""
+
+    robot_id: str
+    deadlock_time: float = 5.0
+    deadlock_progress: float = 0.2
+    deadlock_radius: float = 2.0
+    yield_time: float = 4.0
+
+    def __post_init__(self) -> None:
+        self.reset(0.0)
+
+    def reset(self, now: float, remaining: float = float("inf")) -> None:
+        """A new goal: forget progress and any yielding."""
+        self.best = remaining
+        self.best_time = now
+        self.yield_to: str | None = None
+        self.yield_until = -float("inf")
+        self.yields = 0
+
+    def update(self, now: float, remaining: float, nearby: dict[str, float]) -> str | None:
+        """The robot to yield to this cycle, or None.
+
+        remaining : m to the goal; nearby : robot id -> distance (m) of the robots around.
+        """
+        if remaining < self.best - self.deadlock_progress:
+            self.best, self.best_time = remaining, now
+        if self.yield_to is not None:
+            if now < self.yield_until and self.yield_to in nearby:
+                return self.yield_to
+            self.yield_to = None
+            self.best, self.best_time = remaining, now
+        close = {k: d for k, d in nearby.items() if d <= self.deadlock_radius}
+        if not close or now - self.best_time < self.deadlock_time:
+            return None
+        mine = priority_key(self.robot_id)
+        higher = [k for k in close if priority_key(k) < mine]
+        if not higher:
+            self.best, self.best_time = remaining, now  # we keep the right of way
+            return None
+        self.yield_to = min(higher, key=lambda k: close[k])
+        self.yield_until = now + self.yield_time
+        self.yields += 1
+        return self.yield_to

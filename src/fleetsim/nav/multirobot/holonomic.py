@@ -1,0 +1,122 @@
+"""Kernels between a path, a holonomic ORCA velocity and a differential-drive base.
+
+* `preferred_velocity`: where the robot wants to go, a carrot on the global plan;
+* `obstacle_points`: static obstacles of the local costmap as the nearest lethal cell per
+  bearing sector, the points ORCA keeps clear of with full responsibility;
+* `tracking_command`: a differential-drive (v, w) that tracks a holonomic velocity within
+  ``time_to_holo`` (collvoid's NH-ORCA idea, Alonso-Mora et al. 2010: turn at
+  ``heading error / time_to_holo`` and drive at the speed whose arc best matches the
+  holonomic displacement); the tracking error this leaves is bounded by ``max_error_holo``,
+  which the planner adds to the robot's radius.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
+
+
+def plan_carrot(
+    plan_xy: np.ndarray, xy: np.ndarray, lookahead: float
+) -> tuple[np.ndarray, int, float]:
+    """The plan point ``lookahead`` m along the plan past the point nearest ``xy``.
+
+    plan_xy : (N, 2) plan points, m. Returns (carrot (2,), index of the nearest point,
+    path length from that point to the plan's end, m).
+    """
+    d = np.hypot(plan_xy[:, 0] - xy[0], plan_xy[:, 1] - xy[1])
+    i = int(np.argmin(d))
+    seg = np.hypot(*np.diff(plan_xy[i:], axis=0).T) if plan_xy.shape[0] - i > 1 else np.zeros(0)
+    along = np.concatenate([[0.0], np.cumsum(seg)])
+    j = i + int(np.searchsorted(along, lookahead, side="left"))
+    j = min(j, plan_xy.shape[0] - 1)
+    return plan_xy[j], i, float(along[-1])
+
+
+def preferred_velocity(
+    carrot: np.ndarray, xy: np.ndarray, remaining: float, max_speed: float, min_speed: float
+) -> np.ndarray:
+    """(2,) m/s towards ``carrot``: ``max_speed``, slowing to ``min_speed`` over the last metre
+    of the ``remaining`` path (m)."""
+    to = np.asarray(carrot, dtype=np.float64) - xy
+    n = float(np.hypot(*to))
+    if n < 1e-9:
+        return np.zeros(2)
+    speed = min(max_speed, max(min_speed, max_speed * remaining))
+    return to / n * speed
+
+
+def rotated(v: np.ndarray, angle: float) -> np.ndarray:
+    c, s = math.cos(angle), math.sin(angle)
+    return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])
+
+
+def obstacle_points(
+    costs: np.ndarray,
+    origin: tuple[float, float],
+    resolution: float,
+    xy: np.ndarray,
+    reach: float,
+    sectors: int = 24,
+) -> np.ndarray:
+    """The nearest lethal cell centre in each of ``sectors`` bearings within ``reach`` m.
+
+    costs : (H, W) uint8 costmap; origin : its lower-left corner, m; xy : (2,) robot, m.
+    Returns (M, 2) points in the costmap frame, M <= sectors, nearest first.
+    """
+    ox, oy = origin
+    c0 = max(int((xy[0] - reach - ox) / resolution), 0)
+    c1 = min(int((xy[0] + reach - ox) / resolution) + 1, costs.shape[1])
+    r0 = max(int((xy[1] - reach - oy) / resolution), 0)
+    r1 = min(int((xy[1] + reach - oy) / resolution) + 1, costs.shape[0])
+    if c1 <= c0 or r1 <= r0:
+        return np.zeros((0, 2))
+    rows, cols = np.nonzero(costs[r0:r1, c0:c1] >= LETHAL_OBSTACLE)
+    if rows.size == 0:
+        return np.zeros((0, 2))
+    px = ox + (cols + c0 + 0.5) * resolution
+    py = oy + (rows + r0 + 0.5) * resolution
+    dx, dy = px - xy[0], py - xy[1]
+    d = np.hypot(dx, dy)
+    keep = d <= reach
+    dx, dy, d, px, py = dx[keep], dy[keep], d[keep], px[keep], py[keep]
+    if d.size == 0:
+        return np.zeros((0, 2))
+    sector = ((np.arctan2(dy, dx) + math.pi) / (2 * math.pi) * sectors).astype(int) % sectors
+    order = np.lexsort((d, sector))
+    first = np.ones(order.size, dtype=bool)
+    first[1:] = sector[order][1:] != sector[order][:-1]
+    pick = order[first]
+    pick = pick[np.argsort(d[pick], kind="stable")]
+    return np.stack([px[pick], py[pick]], axis=1)
+
+
+def tracking_command(
+    v_holo: np.ndarray,
+    yaw: float,
+    time_to_holo: float,
+    max_vel_x: float,
+    max_vel_theta: float,
+) -> tuple[float, float]:
+    """(v m/s, w rad/s) of a differential drive tracking the holonomic velocity ``v_holo``.
+
+    Heading error θ: turn at θ / time_to_holo (clamped to max_vel_theta); drive at
+    ``|v_holo| θ sin θ / (2 (1 - cos θ))``, the speed whose arc over the turn ends where the
+    holonomic motion would (NH-ORCA), i.e. |v_holo| when θ = 0 and 0 from θ = π/2 on (turn in
+    place first).
+    """
+    speed = float(np.hypot(*v_holo))
+    if speed < 1e-4:
+        return 0.0, 0.0
+    theta = math.remainder(math.atan2(v_holo[1], v_holo[0]) - yaw, 2 * math.pi)
+    w = max(-max_vel_theta, min(max_vel_theta, theta / time_to_holo))
+    if abs(theta) >= math.pi / 2:
+        return 0.0, w
+    if abs(theta) < 1e-6:
+        v = speed
+    else:
+        v = speed * theta * math.sin(theta) / (2.0 * (1.0 - math.cos(theta)))
+    return min(max(v, 0.0), max_vel_x), w

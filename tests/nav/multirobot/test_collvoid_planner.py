@@ -1,0 +1,181 @@
+"""CollvoidLocalPlanner in a kinematic loop (unicycles, a shared costmap in the map frame, the
+robots' states on /position_share): swaps and crossings without contact, walls respected,
+deadlocks broken by priority, bad parameters refused, move_base finds the plugin by name."""
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from fleetsim.errors import ParameterError
+from fleetsim.msgs import collvoid_msgs, geometry_msgs
+from fleetsim.msgs.builtin_interfaces import Time
+from fleetsim.nav.controllers.collvoid_planner import CollvoidLocalPlanner
+from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE, Costmap2D
+from fleetsim.nav.move_base_plugins import LOCAL_PLANNERS
+from fleetsim.nav.multirobot.deadlock import DeadlockRule, priority_key
+from fleetsim.nav.multirobot.holonomic import obstacle_points, tracking_command
+from fleetsim.runtime import Node, Runtime
+
+LIZI = np.array([[-0.19, -0.16], [-0.19, 0.16], [0.19, 0.16], [0.19, -0.16]])
+BODY = math.hypot(0.19, 0.16)
+LIMITS = {"max_vel_x": 0.5, "min_vel_x": 0.1, "xy_goal_tolerance": 0.2, "yaw_goal_tolerance": 3.2}
+
+
+def empty_map(walls=()):
+    cm = Costmap2D(400, 400, 0.05, -10.0, -10.0)
+    for x0, y0, x1, y1 in walls:
+        c0, c1 = int((x0 + 10) / 0.05), int((x1 + 10) / 0.05)
+        r0, r1 = int((y0 + 10) / 0.05), int((y1 + 10) / 0.05)
+        cm.costs[r0:r1, c0:c1] = LETHAL_OBSTACLE
+    return cm
+
+
+class Fleet:
+    """N unicycles, each with its own node and planner, sharing positions every cycle."""
+
+    def __init__(self, starts, goals, walls=(), **params):
+        self.rt = Runtime()
+        self.cm = empty_map(walls)
+        self.pub = Node(self.rt, "sim", "/").create_publisher(
+            collvoid_msgs.PoseTwistWithCovariance, "/position_share"
+        )
+        self.state = np.array(starts, dtype=float)  # (N, 3)
+        self.vel = np.zeros((len(starts), 3))
+        self.goals = goals
+        self.planners = []
+        for i, (g, s) in enumerate(zip(goals, starts)):
+            node = Node(self.rt, "move_base", f"/robot{i + 1}")
+            costmap_ros = SimpleNamespace(costmap=self.cm, footprint=LIZI, global_frame="map")
+            pl = CollvoidLocalPlanner.from_namespace(
+                node, costmap_ros, {**LIMITS, **params}, f"robot{i + 1}"
+            )
+            line = np.linspace(s[:2], g[:2], 50)
+            pl.set_plan(np.c_[line, np.full(50, g[2])])
+            self.planners.append(pl)
+        self.min_gap = math.inf
+        self.min_wall = math.inf
+        self.paths = np.zeros(len(starts))
+
+    def share(self):
+        for i, (x, y, yaw) in enumerate(self.state):
+            m = collvoid_msgs.PoseTwistWithCovariance(robot_id=f"robot{i + 1}", radius=BODY)
+            m.header.stamp = Time.from_sec(self.rt.now())
+            m.pose.pose.position = geometry_msgs.Point(x=x, y=y)
+            m.pose.pose.orientation = geometry_msgs.Quaternion(
+                z=math.sin(yaw / 2), w=math.cos(yaw / 2)
+            )
+            v = self.vel[i, 0]
+            m.holonomic_velocity = geometry_msgs.Vector3(x=v * math.cos(yaw), y=v * math.sin(yaw))
+            m.footprint.polygon.points = [geometry_msgs.Point32(x=a, y=b) for a, b in LIZI]
+            self.pub.publish(m)
+
+    def run(self, seconds, dt=0.1):
+        for _ in range(int(seconds / dt)):
+            self.share()
+            self.rt.run(duration=dt)
+            for i, pl in enumerate(self.planners):
+                if pl.is_goal_reached():
+                    self.vel[i] = 0
+                    continue
+                cmd = pl.compute_velocity_commands(tuple(self.state[i]), tuple(self.vel[i]))
+                self.vel[i] = (cmd.vx, cmd.vy, cmd.vtheta)
+            x, y, yaw = self.state.T
+            v, w = self.vel[:, 0], self.vel[:, 2]
+            self.state = np.stack(
+                [x + v * np.cos(yaw) * dt, y + v * np.sin(yaw) * dt, yaw + w * dt], 1
+            )
+            self.paths += np.abs(v) * dt
+            xy = self.state[:, :2]
+            d = np.linalg.norm(xy[:, None] - xy[None], axis=-1)
+            d[np.diag_indices(len(xy))] = np.inf
+            self.min_gap = min(self.min_gap, float(d.min()) - 2 * BODY)
+            if all(pl.is_goal_reached() for pl in self.planners):
+                return True
+        return False
+
+
+def test_head_on_swap_in_the_open_without_contact():
+    f = Fleet([(-3, 0, 0), (3, 0, math.pi)], [(3, 0, 0), (-3, 0, math.pi)])
+    assert f.run(40.0)
+    assert f.min_gap > 0.0
+    assert np.all(f.paths < 6.0 * 1.3)
+
+
+def test_crossing_four_robots_without_contact():
+    starts = [(-3, 0, 0), (3, 0, math.pi), (0, -3, math.pi / 2), (0, 3, -math.pi / 2)]
+    goals = [(3, 0, 0), (-3, 0, 0), (0, 3, 0), (0, -3, 0)]
+    f = Fleet(starts, goals)
+    assert f.run(60.0)
+    assert f.min_gap > 0.0
+
+
+def test_corridor_swap_keeps_off_the_walls():
+    walls = [(-8, 1.0, 8, 1.2), (-8, -1.2, 8, -1.0)]  # a 2 m wide corridor
+    f = Fleet([(-4, 0, 0), (4, 0, math.pi)], [(4, 0, 0), (-4, 0, math.pi)], walls=walls)
+    assert f.run(60.0)
+    assert f.min_gap > 0.0
+    assert np.all(np.abs(f.state[:, 1]) < 1.0 - BODY)
+
+
+def test_without_side_preference_the_exact_swap_needs_the_deadlock_rule():
+    f = Fleet(
+        [(-3, 0, 0), (3, 0, math.pi)], [(3, 0, 0), (-3, 0, math.pi)], left_pref=0.0,
+        deadlock_time=3.0,
+    )  # fmt: skip
+    assert f.run(60.0)
+    assert f.min_gap > 0.0
+    assert f.planners[1].deadlock.yields >= 1 and f.planners[0].deadlock.yields == 0
+
+
+def test_deadlock_rule_yields_to_the_lower_id_only_after_no_progress():
+    rule = DeadlockRule("lizi10", deadlock_time=5.0, deadlock_progress=0.2, yield_time=4.0)
+    assert rule.update(0.0, 5.0, {"lizi2": 1.0}) is None
+    assert rule.update(4.9, 4.95, {"lizi2": 1.0}) is None
+    assert rule.update(5.1, 4.95, {"lizi2": 1.0, "lizi11": 0.5}) == "lizi2"
+    assert rule.update(8.0, 4.95, {"lizi2": 1.0}) == "lizi2"  # still yielding
+    assert rule.update(9.2, 4.95, {"lizi2": 1.0}) is None  # done; the clock restarts
+    top = DeadlockRule("lizi2")
+    top.update(0.0, 5.0, {"lizi10": 1.0})
+    assert top.update(6.0, 5.0, {"lizi10": 1.0}) is None  # priority: never yields
+    assert priority_key("lizi2") < priority_key("lizi10")
+
+
+def test_tracking_turns_first_then_drives_along_the_arc():
+    assert tracking_command(np.array([0.0, 0.4]), 0.0, 0.4, 0.5, 1.0) == (0.0, 1.0)
+    v, w = tracking_command(np.array([0.4, 0.0]), 0.0, 0.4, 0.5, 1.0)
+    assert (v, w) == (pytest.approx(0.4), 0.0)
+    v, w = tracking_command(
+        np.array([0.4 * math.cos(0.3), 0.4 * math.sin(0.3)]), 0.0, 0.4, 0.5, 1.0
+    )
+    assert 0.0 < v < 0.4 and w == pytest.approx(0.75)
+
+
+def test_obstacle_points_are_the_nearest_lethal_cell_per_sector():
+    cm = empty_map([(1.0, -5, 1.05, 5)])  # a wall at x = 1
+    pts = obstacle_points(cm.costs, (cm.origin_x, cm.origin_y), 0.05, np.zeros(2), 2.0, 24)
+    assert pts[0][0] == pytest.approx(1.025) and abs(pts[0][1]) < 0.03
+    assert np.all(pts[:, 0] == pytest.approx(1.025))
+    sectors = ((np.arctan2(pts[:, 1], pts[:, 0]) + math.pi) / (2 * math.pi) * 24).astype(int)
+    assert len(set(sectors.tolist())) == len(pts)  # one point per bearing sector
+    # the wall spans bearings -63..63 deg within 2 m: about a third of the 24 sectors
+    assert 7 <= len(pts) <= 10
+    assert len(pts) <= 24 and np.all(np.hypot(*pts.T) <= 2.0)
+
+
+@pytest.mark.parametrize(
+    "params, words",
+    [({"clearpath": True}, "only collvoid's ORCA solver"), ({"orca": False}, "orca false"),
+     ({"type_vo": 5}, "type_vo"), ({"time_horizon": 0.0}, "time_horizon")],
+)  # fmt: skip
+def test_bad_parameters_are_refused_by_name(params, words):
+    rt = Runtime()
+    node = Node(rt, "move_base", "/r")
+    cmr = SimpleNamespace(costmap=empty_map(), footprint=LIZI, global_frame="map")
+    with pytest.raises((ParameterError, ValueError), match=words):
+        CollvoidLocalPlanner.from_namespace(node, cmr, params, "r/CollvoidLocalPlanner")
+
+
+def test_move_base_knows_the_plugin_by_its_ros_name():
+    assert LOCAL_PLANNERS["collvoid_local_planner/CollvoidLocalPlanner"] == "CollvoidLocalPlanner"

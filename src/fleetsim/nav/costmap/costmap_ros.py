@@ -110,6 +110,8 @@ class Costmap2DROS:
             elif isinstance(layer, ObstacleLayer):
                 for source in layer.buffers:
                     self._subs.append(self.sources.subscribe(layer, source))
+            elif hasattr(layer, "connect"):  # layers fed from topics (robots_layer)
+                layer.connect(self)
         if p.update_frequency > 0:
             node.create_timer(1.0 / p.update_frequency, self.update)
         if p.publish_frequency > 0:

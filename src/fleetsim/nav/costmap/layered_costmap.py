@@ -31,6 +31,7 @@ from fleetsim.nav.costmap.footprint import (
 from fleetsim.nav.costmap.inflation_layer import InflationLayer
 from fleetsim.nav.costmap.layer import Bounds, Layer
 from fleetsim.nav.costmap.obstacle_layer import ObstacleLayer
+from fleetsim.nav.costmap.robots_layer import RobotsLayer
 from fleetsim.nav.costmap.static_layer import StaticLayer
 from fleetsim.nav.costmap.voxel_layer import VoxelLayer
 from fleetsim.nav.errors import CostmapError
@@ -45,6 +46,7 @@ LAYER_TYPES: dict[str, type[Layer]] = {
     "costmap_2d::ObstacleLayer": ObstacleLayer,
     "costmap_2d::VoxelLayer": VoxelLayer,
     "costmap_2d::InflationLayer": InflationLayer,
+    "fleetsim::RobotsLayer": RobotsLayer,
 }
 
 

@@ -1,0 +1,127 @@
+"""The robots layer: other robots' footprints from ``/position_share`` as lethal cells.
+
+Nav2 issue 1318 proposed a ``RobotsLayer`` fed by the robots' shared footprints, because a
+laser mounted above (or below) the other robots' bodies does not see them; collvoid's
+position_share_controller does the same job by publishing ``stationary_robots``. As collvoid,
+only robots slower than ``still_speed`` are marked (moving robots are the local planner's
+business, and marking them would make the global planner chase their wake), each footprint
+scaled by ``static_scale``. Put it before the inflation layer so their footprints are inflated
+like any obstacle::
+
+    plugins:
+      - {name: static_layer, type: costmap_2d::StaticLayer}
+      - {name: robots_layer, type: fleetsim::RobotsLayer}
+      - {name: inflation_layer, type: costmap_2d::InflationLayer}
+
+The layer keeps no grid of its own: each update it clears where robots were last marked (by
+widening the bounds, so the layers below rewrite those cells) and marks where they are now. The
+robot's own id (``robot_id``, else its tf_prefix) is skipped. Shared poses are in ``map``; a
+costmap in another frame reaches it through tf.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from fleetsim.errors import TransformError
+from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
+from fleetsim.nav.costmap.footprint import polygon_cells
+from fleetsim.nav.costmap.layer import Bounds, Layer
+from fleetsim.runtime import param
+
+_log = logging.getLogger("fleetsim.nav.costmap")
+MAP_FRAME = "map"
+
+
+@dataclass(frozen=True)
+class RobotsLayerParams:
+    """``robots_layer`` parameters."""
+
+    enabled: bool = param(True, help="mark other robots at all")
+    still_speed: float = param(
+        0.05, unit="m/s", range=(0.0, None), help="robots slower than this are marked"
+    )
+    static_scale: float = param(
+        0.95, range=(0.0, None), help="scale of the marked footprints (collvoid's)"
+    )
+    max_distance: float = param(
+        50.0, unit="m", range=(0.0, None), help="robots farther from this one are not marked"
+    )
+    robot_id: str = param("", help="this robot's id on /position_share (empty: tf_prefix)")
+
+
+class RobotsLayer(Layer):
+    """Other robots' footprints, from /position_share (see the module doc)."""
+
+    Params = RobotsLayerParams
+
+    def __init__(self, name: str, params: RobotsLayerParams | None = None) -> None:
+        super().__init__(name)
+        self.params = params or RobotsLayerParams()
+        self.enabled = self.params.enabled
+        self.table: Any = None  # a NeighbourTable, once connected
+        self.now = lambda: 0.0
+        self.to_frame = lambda: (0.0, 0.0, 0.0)  # map pose in the costmap's frame
+        self.robot_id = self.params.robot_id
+        self.polygons: list[np.ndarray] = []  # marked now, costmap frame
+        self._last: list[np.ndarray] = []
+
+    def connect(self, costmap_ros: Any) -> None:
+        """Listen to /position_share through the costmap's node (Costmap2DROS calls this)."""
+        from fleetsim.nav.multirobot.position_share import PositionShare
+
+        node = costmap_ros.node
+        self.table = PositionShare(node).table
+        self.now = node.now
+        self.robot_id = self.params.robot_id or node.tf_prefix or node.namespace.strip("/")
+        frame = costmap_ros.global_frame
+        if frame != MAP_FRAME:
+            self.to_frame = lambda: node.tf_buffer.lookup_pose2d(frame, MAP_FRAME, 0.0)
+
+    def set_robots(self, polygons: list[np.ndarray]) -> None:
+        """Mark these (K, 2) polygons (costmap frame) at the next update (no subscription)."""
+        self.table = None
+        self.polygons = [np.asarray(p, dtype=np.float64) for p in polygons]
+
+    def _polygons_now(self, robot_x: float, robot_y: float) -> list[np.ndarray]:
+        if self.table is None:
+            return self.polygons
+        p = self.params
+        try:
+            tx, ty, tyaw = self.to_frame()
+        except TransformError:
+            return []
+        c, s = np.cos(tyaw), np.sin(tyaw)
+        rot = np.array([[c, -s], [s, c]])
+        out = []
+        for r in self.table.fresh(self.now()):
+            if r.robot_id == self.robot_id or np.hypot(r.vx, r.vy) >= p.still_speed:
+                continue
+            poly = r.polygon()
+            centre = np.array([r.x, r.y])
+            poly = centre + (poly - centre) * p.static_scale
+            poly = poly @ rot.T + [tx, ty]
+            if np.hypot(*(poly.mean(axis=0) - [robot_x, robot_y])) <= p.max_distance:
+                out.append(poly)
+        return out
+
+    def update_bounds(self, robot_x: float, robot_y: float, robot_yaw: float, bounds: Bounds):
+        if not self.enabled:
+            return
+        self.polygons = self._polygons_now(robot_x, robot_y)
+        for poly in (*self._last, *self.polygons):
+            lo, hi = poly.min(axis=0), poly.max(axis=0)
+            bounds.include(lo[0], lo[1], hi[0], hi[1])
+        self._last = list(self.polygons)
+
+    def update_costs(self, master, x0: int, y0: int, xn: int, yn: int) -> None:
+        if not self.enabled:
+            return
+        for poly in self.polygons:
+            rows, cols = polygon_cells(master, poly)
+            keep = (cols >= x0) & (cols < xn) & (rows >= y0) & (rows < yn)
+            master.costs[rows[keep], cols[keep]] = LETHAL_OBSTACLE

@@ -1,0 +1,94 @@
+"""robots_layer: still robots from /position_share become inflated lethal footprints, moving
+ones and the robot itself do not, and a robot that leaves is cleared."""
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+
+from fleetsim.msgs import collvoid_msgs, geometry_msgs
+from fleetsim.msgs.builtin_interfaces import Time
+from fleetsim.nav.costmap.costmap_2d import INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE
+from fleetsim.nav.costmap.layered_costmap import LayeredCostmap
+from fleetsim.runtime import Node, Runtime
+
+SQUARE = [[-0.2, -0.2], [-0.2, 0.2], [0.2, 0.2], [0.2, -0.2]]
+PARAMS = {
+    "global_frame": "/map",
+    "width": 10.0,
+    "height": 10.0,
+    "resolution": 0.05,
+    "footprint": [[-0.2, -0.2], [-0.2, 0.2], [0.2, 0.2], [0.2, -0.2]],
+    "plugins": [
+        {"name": "robots_layer", "type": "fleetsim::RobotsLayer"},
+        {"name": "inflation_layer", "type": "costmap_2d::InflationLayer"},
+    ],
+    "inflation_layer": {"inflation_radius": 0.5},
+}
+
+
+def shared(rid, x, y, t, vx=0.0):
+    msg = collvoid_msgs.PoseTwistWithCovariance(robot_id=rid, radius=0.3)
+    msg.header.stamp = Time.from_sec(t)
+    msg.pose.pose.position = geometry_msgs.Point(x=x, y=y)
+    msg.holonomic_velocity.x = vx
+    msg.footprint.polygon.points = [geometry_msgs.Point32(x=a, y=b) for a, b in SQUARE]
+    return msg
+
+
+def cost_at(cm, x, y):
+    m = cm.costmap
+    return int(m.costs[int((y - m.origin_y) / m.resolution), int((x - m.origin_x) / m.resolution)])
+
+
+def test_still_robots_are_marked_and_inflated_moving_ones_and_self_are_not():
+    rt = Runtime()
+    rt.params.set("/lizi1/tf_prefix", "lizi1")
+    node = Node(rt, "move_base", "/lizi1")
+    cm = LayeredCostmap.from_params(PARAMS, "/lizi1/move_base/global_costmap")
+    layer = cm.layer("robots_layer")
+    layer.connect(SimpleNamespace(node=node, global_frame="map"))
+    pub = Node(rt, "talker", "/").create_publisher(
+        collvoid_msgs.PoseTwistWithCovariance, "/position_share"
+    )
+    pub.publish(shared("lizi2", 3.0, 3.0, 0.0))  # parked
+    pub.publish(shared("lizi3", 7.0, 7.0, 0.0, vx=0.4))  # driving
+    pub.publish(shared("lizi1", 5.0, 5.0, 0.0))  # this robot
+    rt.run(duration=0.05)
+    cm.update_map(5.0, 5.0, 0.0)
+    assert cost_at(cm, 3.0, 3.0) == LETHAL_OBSTACLE
+    assert cost_at(cm, 3.0 + 0.19 * 0.95, 3.0) == LETHAL_OBSTACLE
+    assert cost_at(cm, 3.0 + 0.3, 3.0) >= INSCRIBED_INFLATED_OBSTACLE - 60  # inflated around
+    assert cost_at(cm, 3.0 + 0.9, 3.0) == 0
+    assert cost_at(cm, 7.0, 7.0) == 0 and cost_at(cm, 5.0, 5.0) == 0
+    # lizi2 drives off: its old cells are cleared at the next update
+    pub.publish(shared("lizi2", 3.0, 3.0, 0.1, vx=0.3))
+    rt.run(duration=0.05)
+    cm.update_map(5.0, 5.0, 0.0)
+    assert cost_at(cm, 3.0, 3.0) == 0
+
+
+def test_a_silent_robot_is_dropped_after_two_seconds():
+    rt = Runtime()
+    node = Node(rt, "move_base", "/lizi1")
+    cm = LayeredCostmap.from_params(PARAMS, "/lizi1/move_base/global_costmap")
+    cm.layer("robots_layer").connect(SimpleNamespace(node=node, global_frame="map"))
+    pub = Node(rt, "talker", "/").create_publisher(
+        collvoid_msgs.PoseTwistWithCovariance, "/position_share"
+    )
+    pub.publish(shared("lizi2", 3.0, 3.0, 0.0))
+    rt.run(duration=1.0)
+    cm.update_map(5.0, 5.0, 0.0)
+    assert cost_at(cm, 3.0, 3.0) == LETHAL_OBSTACLE
+    rt.run(duration=1.5)
+    cm.update_map(5.0, 5.0, 0.0)
+    assert cost_at(cm, 3.0, 3.0) == 0
+
+
+def test_set_robots_marks_given_polygons():
+    cm = LayeredCostmap.from_params(PARAMS, "gc")
+    poly = np.array(SQUARE) + np.array([2.0, 8.0])
+    cm.layer("robots_layer").set_robots([poly])
+    cm.update_map(5.0, 5.0, 0.0)
+    assert cost_at(cm, 2.0, 8.0) == LETHAL_OBSTACLE
+    assert math.isclose(cost_at(cm, 8.0, 2.0), 0)

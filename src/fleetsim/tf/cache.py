@@ -52,16 +52,18 @@ def checked_value(parent: str, child: str, translation: Any, rotation: Any) -> T
         For values that are not numbers or not finite, or a quaternion whose squared norm is
         more than ``QUATERNION_NORM2_TOLERANCE`` away from 1.
     """
+    # every transform of every robot passes here (odometry at 100 Hz each): plain unpacking
+    # and one sum for the finiteness check (``all`` over a generator only when it fails)
     try:
-        x, y, z = (float(v) for v in translation)
-        qx, qy, qz, qw = (float(v) for v in rotation)
+        x, y, z = map(float, translation)
+        qx, qy, qz, qw = map(float, rotation)
     except (TypeError, ValueError):
         raise TransformError(
             f"transform {parent!r} -> {child!r}: translation must be 3 numbers and rotation 4 "
             f"numbers (x, y, z, w), got {translation!r} and {rotation!r}"
         ) from None
     value = (x, y, z, qx, qy, qz, qw)
-    if not all(math.isfinite(v) for v in value):
+    if not math.isfinite(x + y + z + qx + qy + qz + qw) and not all(map(math.isfinite, value)):
         raise TransformError(
             f"transform {parent!r} -> {child!r} has a non-finite value: translation "
             f"{(x, y, z)}, rotation {(qx, qy, qz, qw)}"

@@ -1,6 +1,8 @@
 """move_group in the simulator: the hunter's nine named poses, obstacles, bad requests, two
 hunters at once, and fake execution without physics."""
 
+import logging
+
 import numpy as np
 import pytest
 
@@ -96,7 +98,7 @@ def test_measured_speeds_stay_within_half_the_limits(one):
     assert speeds[0] > VMAX[0] * 0.5 * 0.95 and speeds[2] > VMAX[2] * 0.5 * 0.5, speeds
 
 
-def test_half_speed_and_a_box_in_the_way(one):
+def test_half_speed_and_a_box_in_the_way(one, caplog):
     arm = MoveGroupCommander("arm_group", ns="/hunter1", runtime=one.rt)
     scene = PlanningSceneInterface(ns="/hunter1", runtime=one.rt)
     arm.set_named_target("cam_low")
@@ -117,13 +119,28 @@ def test_half_speed_and_a_box_in_the_way(one):
     one.probe.create_subscription(sensor_msgs.JointState, "/hunter1/joint_states", states.append)
     arm.set_max_velocity_scaling_factor(0.5)
     arm.set_named_target("cam_low_back")
-    assert arm.go()
+    caplog.clear()
+    with caplog.at_level(logging.INFO):
+        assert arm.go()
+    # the plan says which planner found it (no ompl_planning.yaml here: RRTConnect) ...
+    assert "geometric::RRTConnect found a path" in caplog.text
+    planned = arm.last_result()[0].planning_time
+    assert 0 < planned < 5.0
     positions = [np.asarray(s.position) for s in states]
     assert all(ctx.scene.is_valid(q) for q in positions)  # the arm never entered the box
     speeds = measured_speeds(states)
     assert np.all(speeds <= VMAX * 0.5 * 1.05), speeds / (VMAX * 0.5)
     scene.remove_world_object("box")
     assert scene.get_known_object_names() == []
+    # ... and that none ran when the straight motion is free
+    arm.set_named_target("cam_low")
+    caplog.clear()
+    with caplog.at_level(logging.INFO):
+        assert arm.go()
+    assert (
+        "straight joint-space motion is collision-free, so geometric::RRTConnect was not run"
+        in (caplog.text)
+    )
 
 
 def test_bad_requests_are_refused_with_their_reason(one):

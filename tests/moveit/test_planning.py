@@ -74,10 +74,16 @@ def test_a_box_in_the_way_is_gone_around(arm):
             np.array([1.0, 0, 0, 0]),
         )
     ]
+    free = plan_path(start, goal, lim.lower, lim.upper, scene.is_valid, "RRTConnect", 5.0, 1, 7)
+    assert free.planner == "" and len(free.path) == 2  # straight and free: no planner ran
+    ran = plan_path(start, goal, lim.lower, lim.upper, scene.is_valid, "RRT", try_straight=False)
+    assert ran.planner == "RRT"
+    np.testing.assert_allclose(ran.path[[0, -1]], [start, goal], atol=1e-9)
     scene.add_object("box", box)
     try:
         assert not scene.is_valid(0.5 * (start + goal))
         plan = plan_path(start, goal, lim.lower, lim.upper, scene.is_valid, "RRTConnect", 5.0, 1, 7)
+        assert plan.planner == "RRTConnect" and plan.planning_time > 0
         dense = np.concatenate(
             [np.linspace(a, b, 50) for a, b in zip(plan.path[:-1], plan.path[1:], strict=True)]
         )

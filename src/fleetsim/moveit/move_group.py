@@ -186,7 +186,7 @@ class MoveGroup(Node):
             ctx = self.pipeline.context(req.group_name)
             start = self._start(req)
             self._sync_world()
-            traj, dt = self.pipeline.plan(req, start)
+            plan = self.pipeline.plan(req, start)
         except PlanFailure as e:
             self.get_logger().error("%s", e)
             res.error_code.val = e.code
@@ -197,10 +197,23 @@ class MoveGroup(Node):
             return res, str(e)
         res.trajectory_start.joint_state.name = list(ctx.joints)
         res.trajectory_start.joint_state.position = start
-        res.trajectory, res.planning_time = traj, dt
+        res.trajectory, res.planning_time = plan.trajectory, plan.planning_time
         res.error_code.val = E.SUCCESS
+        if plan.planner:
+            self.get_logger().info(
+                "%s: geometric::%s found a path in %.1f ms (%.1f ms with goal and timing)",
+                req.group_name, plan.planner, 1e3 * plan.path_time, 1e3 * plan.planning_time,
+            )  # fmt: skip
+        else:
+            self.get_logger().info(
+                "%s: the straight joint-space motion is collision-free, so geometric::%s was "
+                "not run (%.1f ms with goal and timing)",
+                req.group_name, plan.requested, 1e3 * plan.planning_time,
+            )  # fmt: skip
         self.display_pub.publish(
-            moveit_msgs.DisplayTrajectory(trajectory=[traj], trajectory_start=res.trajectory_start)
+            moveit_msgs.DisplayTrajectory(
+                trajectory=[plan.trajectory], trajectory_start=res.trajectory_start
+            )
         )
         return res, ""
 

@@ -10,13 +10,14 @@ from __future__ import annotations
 
 import math
 import time
+from dataclasses import dataclass
 
 import numpy as np
 
 from fleetsim.errors import PlanningError
 from fleetsim.moveit.collision import CollisionScene
 from fleetsim.moveit.kinematics import Kinematics
-from fleetsim.moveit.planner import PlanFailure, plan_path
+from fleetsim.moveit.planner import ALIASES, PlanFailure, plan_path
 from fleetsim.moveit.robot_model import RobotModel
 from fleetsim.moveit.timing import time_parameterize
 from fleetsim.msgs import moveit_msgs, trajectory_msgs
@@ -25,6 +26,28 @@ from fleetsim.msgs.builtin_interfaces import Duration
 E = moveit_msgs.MoveItErrorCodes
 START_STATE_MAX_BOUNDS_ERROR = 0.1  # rad: FixStartStateBounds pulls this much back inside
 IK_ATTEMPTS = 20
+
+
+@dataclass
+class PlanResult:
+    """A planned, timed trajectory and what it took.
+
+    Attributes
+    ----------
+    trajectory : moveit_msgs RobotTrajectory.
+    planning_time : s (wall), the whole request: goal IK, path planning, time parameterisation
+        (MoveIt's ``planning_time`` also counts its request adapters).
+    planner : the OMPL planner that found the path, or "" when the straight joint-space
+        motion was free and none ran.
+    path_time : s (wall) spent on the path alone (the OMPL solve, or the straight-line check).
+    requested : the planner the request asked for (its planner_id, else the group's default).
+    """
+
+    trajectory: object
+    planning_time: float
+    planner: str
+    path_time: float
+    requested: str
 
 
 class GroupContext:
@@ -124,8 +147,8 @@ class PlanningPipeline:
         return ctx.kin.position_ik(link, target, seeds, tolerance, valid=ctx.scene.is_valid)
 
     # ------------------------------------------------------------------ planning
-    def plan(self, req, start: np.ndarray):
-        """``(RobotTrajectory, planning_time)`` for a MotionPlanRequest from ``start`` (J,)."""
+    def plan(self, req, start: np.ndarray) -> PlanResult:
+        """The timed trajectory for a MotionPlanRequest from ``start`` (J,)."""
         t0 = time.perf_counter()
         ctx = self.context(req.group_name)
         lim = ctx.limits
@@ -168,7 +191,13 @@ class PlanningPipeline:
             )
             for k in range(len(t))
         ]  # fmt: skip
-        return traj, time.perf_counter() - t0
+        return PlanResult(
+            traj,
+            time.perf_counter() - t0,
+            p.planner,
+            p.planning_time,
+            ALIASES.get(planner, planner),
+        )
 
 
 def _scaling(v: float) -> float:

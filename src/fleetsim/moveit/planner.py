@@ -5,7 +5,9 @@ The state space is the group's joints within their bounds; a state is valid when
 (``longest_valid_segment_fraction``, finer than MoveIt's 1 %: 0.018 rad for the hunter, so that
 its 34 mm tip plate cannot step through an obstacle between two checks). The planner is the
 request's, else the group's ``default_planner_config`` from ompl_planning.yaml, else RRTConnect.
-The solution is simplified (shortcutting) and returned as waypoints. Failures are typed.
+The solution is simplified (shortcutting) and returned as waypoints. When the straight motion
+from start to goal is free, it is returned without running a planner, and the plan says so
+(``Plan.planner`` empty). Failures are typed.
 """
 
 from __future__ import annotations
@@ -48,7 +50,11 @@ ALIASES = {"KPIECE": "KPIECE1", "BKPIECE": "BKPIECE1", "LBKPIECE": "LBKPIECE1"}
 class Plan:
     path: np.ndarray  # (N, J) waypoints, rad
     planning_time: float  # s (wall)
-    planner: str
+    planner: str  # the OMPL planner that found the path; "" when none ran (STRAIGHT_LINE)
+
+
+#: how a plan whose straight joint-space motion was free (and no OMPL planner ran) is named
+STRAIGHT_LINE = "straight joint-space motion (no OMPL planner run)"
 
 
 def motion_is_valid(a, b, lower, upper, is_valid) -> bool:
@@ -74,8 +80,12 @@ def plan_path(
     timeout: float = 5.0,
     attempts: int = 1,
     seed: int | None = None,
+    try_straight: bool = True,
 ) -> Plan:
     """A collision-free joint path from ``start`` to ``goal`` (J,), simplified.
+
+    With ``try_straight`` a free straight motion is returned without running the planner
+    (``Plan.planner`` ""); without it the planner always runs, as in MoveIt.
 
     Raises ``PlanFailure`` with START_STATE_IN_COLLISION, GOAL_IN_COLLISION or PLANNING_FAILED.
     """
@@ -104,10 +114,10 @@ def plan_path(
         raise PlanFailure(E.GOAL_IN_COLLISION, "the goal state is in collision")
     n = len(start)
     t0 = time.perf_counter()
-    if motion_is_valid(start, goal, lower, upper, is_valid):
+    if try_straight and motion_is_valid(start, goal, lower, upper, is_valid):
         # the straight joint-space motion is free: what RRTConnect plus shortcutting would
         # return, without growing trees (a fleetsim shortcut; MoveIt always runs the planner)
-        return Plan(np.array([start, goal], float), time.perf_counter() - t0, name)
+        return Plan(np.array([start, goal], float), time.perf_counter() - t0, "")
     space = ob.RealVectorStateSpace(n)
     bounds = ob.RealVectorBounds(n)
     for i in range(n):

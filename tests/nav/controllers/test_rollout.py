@@ -8,6 +8,7 @@ from hypothesis import strategies as st
 from fleetsim.nav.controllers.map_grid import densified_plan
 from fleetsim.nav.controllers.rollout import (
     footprint_cost_bounds,
+    footprint_cost_bounds_near,
     num_steps_of,
     reach_offsets,
     trajectory_costs,
@@ -41,6 +42,27 @@ def test_bounds_match_brute_force(seed, radius, shape):
     costs = rng.integers(0, 256, shape).astype(np.uint8)
     offsets = reach_offsets(outline_points(footprint_from_radius(radius), 0.05), 0.05)
     assert np.array_equal(footprint_cost_bounds(costs, offsets), bounds_reference(costs, offsets))
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    seed=st.integers(0, 2**31),
+    shape=st.tuples(st.integers(1, 40), st.integers(1, 40)),
+    centre=st.tuples(st.integers(-5, 45), st.integers(-5, 45)),
+    radius=st.integers(0, 12),
+)
+def test_bounds_near_a_cell_are_exact_there_and_never_too_low(seed, shape, centre, radius):
+    """Within ``radius`` of the cell the windowed bounds equal the full ones; elsewhere they
+    may only be higher (a higher bound only sends the pose to the exact footprint check)."""
+    rng = np.random.default_rng(seed)
+    costs = rng.integers(0, 256, shape).astype(np.uint8)
+    offsets = reach_offsets(outline_points(footprint_from_radius(0.2), 0.05), 0.05)
+    full = footprint_cost_bounds(costs, offsets)
+    near = footprint_cost_bounds_near(costs, offsets, centre[0], centre[1], radius)
+    assert (near >= full).all()
+    rows = slice(max(centre[1] - radius, 0), max(centre[1] + radius + 1, 0))
+    cols = slice(max(centre[0] - radius, 0), max(centre[0] + radius + 1, 0))
+    assert np.array_equal(near[rows, cols], full[rows, cols])
 
 
 @settings(max_examples=40, deadline=None)

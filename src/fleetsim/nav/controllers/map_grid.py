@@ -91,13 +91,47 @@ def plan_cells_in_map(costmap: Costmap2D, plan_xy: np.ndarray) -> np.ndarray:
     Cells that are NO_INFORMATION count as outside (MapGrid::setTargetCells). Returns (K, 2)
     int64 (column, row), in plan order; empty when the plan never enters the map.
     """
-    dense = densified_plan(plan_xy, costmap.resolution)
-    cells, inside = costmap.cells_of(dense)
-    ok = inside.copy()
-    ok[inside] = costmap.costs[cells[inside, 1], cells[inside, 0]] != NO_INFORMATION
-    if not ok.any():
+    p = np.ascontiguousarray(plan_xy, dtype=np.float64)
+    return _plan_cells(p, costmap.origin_x, costmap.origin_y, costmap.resolution, costmap.costs)
+
+
+@njit(cache=True)
+def _plan_cells(p, ox, oy, res, costs):
+    """Compiled `plan_cells_in_map` (the points of `densified_plan`, computed alike): it runs
+    on every control cycle of every robot, where the NumPy version's dozen small-array calls
+    cost ~40 us."""
+    h, w = costs.shape
+    n_pts = p.shape[0]
+    if n_pts == 0:
         return np.empty((0, 2), np.int64)
-    first = int(np.argmax(ok))
-    rest = ok[first:]
-    stop = first + (int(np.argmin(rest)) if not rest.all() else rest.shape[0])
-    return np.ascontiguousarray(cells[first:stop])
+    total = 1
+    for i in range(n_pts - 1):
+        dx, dy = p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1]
+        total += max(1, int(np.ceil(np.hypot(dx, dy) / res)))
+    out = np.empty((total, 2), np.int64)
+    k = 0
+    started = False
+    for i in range(n_pts):
+        last = i == n_pts - 1
+        n = 1
+        dx = dy = 0.0
+        if not last:
+            dx, dy = p[i + 1, 0] - p[i, 0], p[i + 1, 1] - p[i, 1]
+            n = max(1, int(np.ceil(np.hypot(dx, dy) / res)))
+        for j in range(n):
+            if last:
+                x, y = p[i, 0], p[i, 1]
+            else:
+                t = j / n
+                x, y = p[i, 0] + dx * t, p[i, 1] + dy * t
+            cx = int(np.floor((x - ox) / res))
+            cy = int(np.floor((y - oy) / res))
+            ok = 0 <= cx < w and 0 <= cy < h and costs[cy, cx] != NO_INFORMATION
+            if ok:
+                started = True
+                out[k, 0] = cx
+                out[k, 1] = cy
+                k += 1
+            elif started:
+                return out[:k].copy()
+    return out[:k].copy()

@@ -91,6 +91,30 @@ def footprint_cost_bounds(costs, offsets):
     return out
 
 
+def footprint_cost_bounds_near(costs, offsets, cx: int, cy: int, radius: int):
+    """`footprint_cost_bounds`, exact for the cells within ``radius`` cells (each axis) of cell
+    ``(cx, cy)`` and 255 (NO_INFORMATION: "check the footprint") elsewhere.
+
+    The rollouts of one control cycle stay within their top speed times ``sim_time`` of the
+    robot, a fraction of the local map; a bound of 255 only sends a pose to the exact footprint
+    check, so the costs are the same whatever ``radius`` is, and this costs the window's share.
+    """
+    h, w = costs.shape
+    k = 0
+    for i in range(offsets.shape[0]):
+        k = max(k, abs(int(offsets[i, 0])), abs(int(offsets[i, 1])))
+    r0, r1 = max(cy - radius - k, 0), min(cy + radius + k + 1, h)
+    c0, c1 = max(cx - radius - k, 0), min(cx + radius + k + 1, w)
+    out = np.full((h, w), 255, dtype=np.uint8)
+    if r1 <= r0 or c1 <= c0:
+        return out
+    sub = footprint_cost_bounds(np.ascontiguousarray(costs[r0:r1, c0:c1]), offsets)
+    # rows/columns of the block whose reach leaves it where the grid goes on are padded with
+    # 255 by the kernel: too high, which only costs a footprint check; keep them as they are
+    out[r0:r1, c0:c1] = sub
+    return out
+
+
 @njit(cache=True, inline="always")
 def _new_velocity(vg, vi, a_max, dt):
     if vg - vi >= 0:

@@ -26,6 +26,7 @@ import math
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from fleetsim.nav.controllers.base import (
     EmptyPlan,
@@ -35,7 +36,7 @@ from fleetsim.nav.controllers.base import (
 )
 from fleetsim.nav.controllers.map_grid import distances_from_targets, plan_cells_in_map
 from fleetsim.nav.controllers.rollout import (
-    footprint_cost_bounds,
+    footprint_cost_bounds_near,
     num_steps_of,
     reach_offsets,
     trajectory_costs,
@@ -176,13 +177,13 @@ class TrajectoryPlanner(LocalPlanner):
                 self.xy_tolerance_latch = False
                 self.reached_goal = True
                 return VelocityCommand()
-            self._update_maps(local, (x, y, yaw))
+            self._update_maps(local, (x, y, yaw), vel)
             stopped = abs(vel[2]) <= 1e-2 and abs(vel[0]) <= 1e-2 and abs(vel[1]) <= 1e-2
             if not self.rotating_to_goal and not stopped:
                 return self._stop_with_acc_limits((x, y, yaw), vel)
             self.rotating_to_goal = True
             return self._rotate_to_goal((x, y, yaw), vel, gyaw)
-        self._update_maps(local, (x, y, yaw))
+        self._update_maps(local, (x, y, yaw), vel)
         best, cost = self._find_best((x, y, yaw), vel)
         if cost < 0:
             self.local_plan = np.zeros((0, 3))
@@ -216,7 +217,9 @@ class TrajectoryPlanner(LocalPlanner):
         self.plan = self.plan[int(np.argmin(d2g)) :]
         return local[k:]
 
-    def _update_maps(self, local: np.ndarray, pose: tuple[float, float, float]) -> None:
+    def _update_maps(
+        self, local: np.ndarray, pose: tuple[float, float, float], vel=(0.0, 0.0, 0.0)
+    ) -> None:
         m = self.costmap
         no_cells = np.zeros(m.costs.shape, dtype=bool)
         polygon = footprint_at(self.footprint, *pose)
@@ -231,18 +234,27 @@ class TrajectoryPlanner(LocalPlanner):
         goal = targets[-1:] if targets.shape[0] else targets
         self.goal_dist = distances_from_targets(m.costs, goal, no_cells)
         self.final_goal = self.plan[-1, :2].copy()
-        self.cost_bounds = footprint_cost_bounds(m.costs, self.reach)
+        # rollouts reach at most the top speed times sim_time from the robot (+ a cell or two)
+        p = self.params
+        top = max(abs(p.max_vel_x), abs(p.min_vel_x), abs(p.escape_vel), math.hypot(vel[0], vel[1]))
+        if p.holonomic_robot and p.y_vels:
+            top = max(top, max(abs(float(v)) for v in p.y_vels))
+        radius = math.ceil(top * p.sim_time / m.resolution) + 2
+        cx = math.floor((pose[0] - m.origin_x) / m.resolution)
+        cy = math.floor((pose[1] - m.origin_y) / m.resolution)
+        self.cost_bounds = footprint_cost_bounds_near(m.costs, self.reach, cx, cy, radius)
 
     def _obstacle_near(self, polygon: np.ndarray) -> bool:
         """Whether a cell the MapGrid treats as an obstacle (cost >= INSCRIBED) lies in the
         polygon's bounding box, grown by a cell (the only cells `polygon_cells` can return)."""
         m = self.costmap
-        cells, _ = m.cells_of(polygon)
-        x0 = max(int(cells[:, 0].min()) - 1, 0)
-        x1 = min(int(cells[:, 0].max()) + 2, m.size_x)
-        y0 = max(int(cells[:, 1].min()) - 1, 0)
-        y1 = min(int(cells[:, 1].max()) + 2, m.size_y)
-        return bool(x1 > x0 and y1 > y0 and m.costs[y0:y1, x0:x1].max() >= 253)
+        return _obstacle_in_box(
+            np.ascontiguousarray(polygon, dtype=np.float64),
+            m.origin_x,
+            m.origin_y,
+            m.resolution,
+            m.costs,
+        )
 
     # -- scoring ----------------------------------------------------------------------------------
     def _score(self, samples: np.ndarray, pose, vel) -> np.ndarray:
@@ -314,3 +326,23 @@ class TrajectoryPlanner(LocalPlanner):
         if cost < 0:
             self.local_plan = np.zeros((0, 3))
         return (vx, vy, vth), cost
+
+
+@njit(cache=True)
+def _obstacle_in_box(polygon, ox, oy, res, costs):
+    """`TrajectoryPlanner._obstacle_near`'s test, compiled (it runs every control cycle)."""
+    h, w = costs.shape
+    x0 = y0 = 1 << 62
+    x1 = y1 = -(1 << 62)
+    for i in range(polygon.shape[0]):
+        cx = math.floor((polygon[i, 0] - ox) / res)
+        cy = math.floor((polygon[i, 1] - oy) / res)
+        x0, x1 = min(x0, cx), max(x1, cx)
+        y0, y1 = min(y0, cy), max(y1, cy)
+    x0, x1 = max(x0 - 1, 0), min(x1 + 2, w)
+    y0, y1 = max(y0 - 1, 0), min(y1 + 2, h)
+    for y in range(y0, y1):
+        for x in range(x0, x1):
+            if costs[y, x] >= 253:
+                return True
+    return False

@@ -100,9 +100,7 @@ def footprint_cost_bounds_near(costs, offsets, cx: int, cy: int, radius: int):
     check, so the costs are the same whatever ``radius`` is, and this costs the window's share.
     """
     h, w = costs.shape
-    k = 0
-    for i in range(offsets.shape[0]):
-        k = max(k, abs(int(offsets[i, 0])), abs(int(offsets[i, 1])))
+    k = int(np.abs(offsets).max()) if offsets.shape[0] else 0
     r0, r1 = max(cy - radius - k, 0), min(cy + radius + k + 1, h)
     c0, c1 = max(cx - radius - k, 0), min(cx + radius + k + 1, w)
     out = np.full((h, w), 255, dtype=np.uint8)

@@ -1,5 +1,6 @@
-"""robots_layer: still robots from /position_share become inflated lethal footprints, moving
-ones and the robot itself do not, and a robot that leaves is cleared."""
+"""robots_layer: still robots from /position_share become high-cost footprints (padded by this
+robot's inscribed radius), moving ones and the robot itself do not, a robot that leaves is
+cleared, and navfn plans around a parked robot but still through one standing on the goal."""
 
 import math
 from types import SimpleNamespace
@@ -56,10 +57,10 @@ def test_still_robots_are_marked_and_inflated_moving_ones_and_self_are_not():
     pub.publish(shared("lizi1", 5.0, 5.0, 0.0))  # this robot
     rt.run(duration=0.05)
     cm.update_map(5.0, 5.0, 0.0)
-    assert cost_at(cm, 3.0, 3.0) == LETHAL_OBSTACLE
-    assert cost_at(cm, 3.0 + 0.19 * 0.95, 3.0) == LETHAL_OBSTACLE
-    assert cost_at(cm, 3.0 + 0.3, 3.0) >= INSCRIBED_INFLATED_OBSTACLE - 60  # inflated around
-    assert cost_at(cm, 3.0 + 0.9, 3.0) == 0
+    assert cost_at(cm, 3.0, 3.0) == 252
+    # the square's half-width 0.2 x 0.95, padded by this robot's inscribed radius 0.2
+    assert cost_at(cm, 3.0 + 0.36, 3.0) == 252
+    assert cost_at(cm, 3.0 + 0.45, 3.0) == 0  # below lethal: not inflated
     assert cost_at(cm, 7.0, 7.0) == 0 and cost_at(cm, 5.0, 5.0) == 0
     # lizi2 drives off: its old cells are cleared at the next update
     pub.publish(shared("lizi2", 3.0, 3.0, 0.1, vx=0.3))
@@ -79,16 +80,40 @@ def test_a_silent_robot_is_dropped_after_two_seconds():
     pub.publish(shared("lizi2", 3.0, 3.0, 0.0))
     rt.run(duration=1.0)
     cm.update_map(5.0, 5.0, 0.0)
-    assert cost_at(cm, 3.0, 3.0) == LETHAL_OBSTACLE
+    assert cost_at(cm, 3.0, 3.0) == 252
     rt.run(duration=1.5)
     cm.update_map(5.0, 5.0, 0.0)
     assert cost_at(cm, 3.0, 3.0) == 0
 
 
-def test_set_robots_marks_given_polygons():
-    cm = LayeredCostmap.from_params(PARAMS, "gc")
+def test_set_robots_marks_given_polygons_lethal_ones_inflated():
+    params = {**PARAMS, "robots_layer": {"cost": LETHAL_OBSTACLE}}
+    cm = LayeredCostmap.from_params(params, "gc")
     poly = np.array(SQUARE) + np.array([2.0, 8.0])
     cm.layer("robots_layer").set_robots([poly])
     cm.update_map(5.0, 5.0, 0.0)
     assert cost_at(cm, 2.0, 8.0) == LETHAL_OBSTACLE
+    assert cost_at(cm, 2.0 + 0.3, 8.0) == INSCRIBED_INFLATED_OBSTACLE  # within inscribed r
+    assert 0 < cost_at(cm, 2.0 + 0.55, 8.0) < INSCRIBED_INFLATED_OBSTACLE  # inflated
     assert math.isclose(cost_at(cm, 8.0, 2.0), 0)
+
+
+def test_navfn_plans_around_a_parked_robot_and_through_one_on_the_goal():
+    from fleetsim.nav.costmap.costmap_2d import Costmap2D
+    from fleetsim.nav.planners import NavFn, NavfnParams
+
+    params = {**PARAMS, "width": 6.0, "height": 2.0}
+    cm = LayeredCostmap.from_params(params, "gc")
+    layer = cm.layer("robots_layer")
+    # a 2 m wide strip, a robot parked in its middle at (3, 0.6): room to pass above it
+    layer.set_robots([np.array(SQUARE) + np.array([3.0, 0.6])])
+    cm.update_map(0.0, 0.0, 0.0)
+    assert isinstance(cm.costmap, Costmap2D)
+    planner = NavFn(cm.costmap, NavfnParams(), "map")
+    path = planner.create_plan((0.5, 0.6, 0.0), (5.5, 0.6, 0.0)).poses
+    near = np.hypot(path[:, 0] - 3.0, path[:, 1] - 0.6).min()
+    assert near > 0.3  # around it
+    layer.set_robots([np.array(SQUARE) + np.array([5.5, 0.6])])  # now on the goal
+    cm.update_map(0.0, 0.0, 0.0)
+    path = planner.create_plan((0.5, 0.6, 0.0), (5.5, 0.6, 0.0)).poses
+    assert np.hypot(*(path[-1, :2] - [5.5, 0.6])) < 0.1

@@ -19,7 +19,10 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    bearing sector, horizon ``time_horizon_obst``, full responsibility, kept hard when the
    program is infeasible);
 5. the linear program gives the holonomic velocity nearest the preferred one; a differential
-   drive tracks it (`tracking_command`, ``time_to_holo``) within ``acc_lim_x``/``acc_lim_theta``;
+   drive tracks it (`tracking_command`, ``time_to_holo``) within ``acc_lim_x``/``acc_lim_theta``,
+   its forward speed cut to what the same half-planes admit along its heading
+   (`speed_along_heading`), so that turning towards a safe velocity never drives it somewhere
+   unsafe;
 6. within ``xy_goal_tolerance`` the robot stops and turns in place to the goal yaw, as
    base_local_planner does.
 
@@ -47,6 +50,7 @@ from fleetsim.nav.multirobot.holonomic import (
     plan_carrot,
     preferred_velocity,
     rotated,
+    speed_along_heading,
     tracking_command,
 )
 from fleetsim.nav.multirobot.orca import orca_halfplanes, orca_velocity
@@ -106,6 +110,7 @@ class CollvoidLocalPlanner(LocalPlanner):
         self.last_cmd = (0.0, 0.0)
         self.last_holo = np.zeros(2)
         self.yielding_to: str | None = None
+        self.lines = (np.zeros((0, 2)), np.zeros((0, 2)), 0)  # this cycle's half-planes
         self.feasible = True
 
     @classmethod
@@ -206,10 +211,8 @@ class CollvoidLocalPlanner(LocalPlanner):
             away = xy - pos[k]
             away = away / max(float(np.hypot(*away)), 1e-9)
             pref = rotated(away, -math.pi / 3) * (0.5 * p.max_vel_x)
-        elif ids:
-            ahead = ((pos - xy) @ pref > 0) & (dist <= own_r + radii + p.max_vel_x * self.horizon)
-            if ahead.any():
-                pref = rotated(pref, p.left_pref)
+        elif ids and ((pos - xy) @ pref > 0).any():  # a robot ahead within neighbor_dist
+            pref = rotated(pref, p.left_pref)
         lines_p, lines_d = [], []
         obst = obstacle_points(
             self.costmap.costs,
@@ -238,11 +241,17 @@ class CollvoidLocalPlanner(LocalPlanner):
             )
             lines_p.append(lp)
             lines_d.append(ld)
+        self.lines = (
+            np.concatenate(lines_p) if lines_p else np.zeros((0, 2)),
+            np.concatenate(lines_d) if lines_d else np.zeros((0, 2)),
+            obst.shape[0],
+        )
         if not lines_p:
             self.feasible = True
+            self.last_holo = pref
             return pref
         holo, self.feasible = orca_velocity(
-            np.concatenate(lines_p), np.concatenate(lines_d), p.max_vel_x, pref, obst.shape[0]
+            self.lines[0], self.lines[1], p.max_vel_x, pref, obst.shape[0]
         )
         self.last_holo = holo
         return holo
@@ -254,6 +263,7 @@ class CollvoidLocalPlanner(LocalPlanner):
             cmd = (float(body[0]), float(body[1]), 0.0)
         else:
             v, w = tracking_command(holo, yaw, p.time_to_holo, p.max_vel_x, p.max_vel_theta)
+            v = speed_along_heading(*self.lines, yaw, v, p.max_vel_x)
             cmd = (v, 0.0, w)
         v0, vy0, w0 = (float(c) for c in velocity)
         dv, dw = p.acc_lim_x * self.dt, p.acc_lim_theta * self.dt

@@ -5,8 +5,14 @@ laser mounted above (or below) the other robots' bodies does not see them; collv
 position_share_controller does the same job by publishing ``stationary_robots``. As collvoid,
 only robots slower than ``still_speed`` are marked (moving robots are the local planner's
 business, and marking them would make the global planner chase their wake), each footprint
-scaled by ``static_scale``. Put it before the inflation layer so their footprints are inflated
-like any obstacle::
+scaled by ``static_scale`` and padded by this robot's inscribed radius (costmap_2d's
+padFootprint), so that a plan keeps this robot's body clear of theirs.
+
+The cells get ``cost`` (default 252, just below costmap_2d's inscribed cost), not a lethal
+one: navfn then plans around a parked robot where there is room, and still finds a plan when a
+robot stands on the goal or in a passage with no way round (as in a swap, where every goal is
+another robot's start) - the local planner deals with that robot when it is reached. A lethal
+cost (``cost: 254``) would also be inflated by an inflation layer after this one::
 
     plugins:
       - {name: static_layer, type: costmap_2d::StaticLayer}
@@ -21,19 +27,16 @@ costmap in another frame reaches it through tf.
 
 from __future__ import annotations
 
-import logging
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from fleetsim.errors import TransformError
-from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
-from fleetsim.nav.costmap.footprint import polygon_cells
+from fleetsim.nav.costmap.footprint import padded_footprint, polygon_cells
 from fleetsim.nav.costmap.layer import Bounds, Layer
 from fleetsim.runtime import param
 
-_log = logging.getLogger("fleetsim.nav.costmap")
 MAP_FRAME = "map"
 
 
@@ -52,6 +55,7 @@ class RobotsLayerParams:
         50.0, unit="m", range=(0.0, None), help="robots farther from this one are not marked"
     )
     robot_id: str = param("", help="this robot's id on /position_share (empty: tf_prefix)")
+    cost: int = param(252, range=(1, 254), help="cost of the cells under a marked robot")
 
 
 class RobotsLayer(Layer):
@@ -69,6 +73,7 @@ class RobotsLayer(Layer):
         self.robot_id = self.params.robot_id
         self.polygons: list[np.ndarray] = []  # marked now, costmap frame
         self._last: list[np.ndarray] = []
+        self._grow = 0.0
 
     def connect(self, costmap_ros: Any) -> None:
         """Listen to /position_share through the costmap's node (Costmap2DROS calls this)."""
@@ -95,19 +100,21 @@ class RobotsLayer(Layer):
             tx, ty, tyaw = self.to_frame()
         except TransformError:
             return []
-        c, s = np.cos(tyaw), np.sin(tyaw)
-        rot = np.array([[c, -s], [s, c]])
+        rot = np.array([[np.cos(tyaw), -np.sin(tyaw)], [np.sin(tyaw), np.cos(tyaw)]])
         out = []
         for r in self.table.fresh(self.now()):
             if r.robot_id == self.robot_id or np.hypot(r.vx, r.vy) >= p.still_speed:
                 continue
-            poly = r.polygon()
-            centre = np.array([r.x, r.y])
-            poly = centre + (poly - centre) * p.static_scale
+            body = padded_footprint(r.footprint * p.static_scale, self._grow)
+            c, s = np.cos(r.yaw), np.sin(r.yaw)
+            poly = body @ np.array([[c, s], [-s, c]]) + [r.x, r.y]
             poly = poly @ rot.T + [tx, ty]
             if np.hypot(*(poly.mean(axis=0) - [robot_x, robot_y])) <= p.max_distance:
                 out.append(poly)
         return out
+
+    def on_footprint_changed(self) -> None:
+        self._grow = self.layered.inscribed_radius if self.layered is not None else 0.0
 
     def update_bounds(self, robot_x: float, robot_y: float, robot_yaw: float, bounds: Bounds):
         if not self.enabled:
@@ -124,4 +131,5 @@ class RobotsLayer(Layer):
         for poly in self.polygons:
             rows, cols = polygon_cells(master, poly)
             keep = (cols >= x0) & (cols < xn) & (rows >= y0) & (rows < yn)
-            master.costs[rows[keep], cols[keep]] = LETHAL_OBSTACLE
+            r, c = rows[keep], cols[keep]
+            master.costs[r, c] = np.maximum(master.costs[r, c], self.params.cost)

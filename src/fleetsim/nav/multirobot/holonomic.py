@@ -7,7 +7,11 @@
   ``time_to_holo`` (collvoid's NH-ORCA idea, Alonso-Mora et al. 2010: turn at
   ``heading error / time_to_holo`` and drive at the speed whose arc best matches the
   holonomic displacement); the tracking error this leaves is bounded by ``max_error_holo``,
-  which the planner adds to the robot's radius.
+  which the planner adds to the robot's radius;
+* `speed_along_heading`: the forward speed nearest the tracking one that the ORCA half-planes
+  admit for motion along the robot's heading (a 1-D linear program). While the base turns
+  towards the holonomic velocity it moves along its heading, not along that velocity; without
+  this check the arc can lead into a wall or a neighbour that the holonomic velocity avoided.
 """
 
 from __future__ import annotations
@@ -120,3 +124,44 @@ def tracking_command(
     else:
         v = speed * theta * math.sin(theta) / (2.0 * (1.0 - math.cos(theta)))
     return min(max(v, 0.0), max_vel_x), w
+
+
+def speed_interval(
+    points: np.ndarray, directions: np.ndarray, heading: np.ndarray, max_speed: float
+) -> tuple[float, float]:
+    """[lo, hi] of speeds v in [0, max_speed] with v * heading inside every half-plane.
+
+    points, directions : (L, 2) half-planes (permitted side: left of the direction);
+    heading : (2,) unit vector. lo > hi when no such speed exists.
+    """
+    a = directions[:, 0] * heading[1] - directions[:, 1] * heading[0]  # det(d, u)
+    b = directions[:, 0] * points[:, 1] - directions[:, 1] * points[:, 0]  # det(d, p)
+    # permitted: det(d, p - v u) = b - v a <= 0
+    lo, hi = 0.0, max_speed
+    pos, neg, flat = a > 1e-12, a < -1e-12, np.abs(a) <= 1e-12
+    if pos.any():
+        lo = max(lo, float(np.max(b[pos] / a[pos])))
+    if neg.any():
+        hi = min(hi, float(np.min(b[neg] / a[neg])))
+    if flat.any() and float(np.max(b[flat])) > 1e-12:
+        return 1.0, 0.0
+    return lo, hi
+
+
+def speed_along_heading(
+    points: np.ndarray,
+    directions: np.ndarray,
+    num_obstacle_lines: int,
+    yaw: float,
+    wanted: float,
+    max_speed: float,
+) -> float:
+    """The forward speed (m/s) nearest ``wanted`` whose motion along ``yaw`` all half-planes
+    admit; if none does, the one the static-obstacle half-planes (the first
+    ``num_obstacle_lines``) admit; if none does either, 0."""
+    u = np.array([math.cos(yaw), math.sin(yaw)])
+    for count in (points.shape[0], num_obstacle_lines):
+        lo, hi = speed_interval(points[:count], directions[:count], u, max_speed)
+        if lo <= hi:
+            return min(max(wanted, lo), hi)
+    return 0.0

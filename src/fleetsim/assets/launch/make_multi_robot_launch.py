@@ -1,0 +1,129 @@
+"""Write the multi-robot avoidance scenarios ``swap_corridor.launch`` and ``circle.launch``.
+
+* ``swap_corridor`` (world ``corridor``: 12 m long, 2 m wide, free x 1..13, y 1..3): arg
+  ``robots`` 2 or 4. With 2, lizi1 at the west end and lizi2 at the east end exchange places;
+  with 4, two robots queue at each end (1.2 m apart) and each goes to the start of its
+  counterpart at the other end.
+* ``circle`` (world ``open_room``): arg ``robots`` 8 or 16 on a circle of 6 m diameter around
+  (7, 7), facing its centre; each goes to the antipodal point.
+
+Both take ``planner`` (``collvoid``, default: collvoid_local_planner/CollvoidLocalPlanner with
+position sharing and a robots layer; ``trajectory``: plain TrajectoryPlannerROS, the robots
+unaware of each other), ``localization`` (fake | amcl) and ``start_delay``. Pass criterion
+(checked by tests/scenarios/test_multi_robot_scenarios.py and benchmarks/multi_robot.py): every
+robot reaches its goal, no contact between robots or with a wall.
+
+Run ``python make_multi_robot_launch.py [OUTDIR]`` to rewrite them (deterministic).
+"""
+
+from __future__ import annotations
+
+import math
+import sys
+from pathlib import Path
+
+CORRIDOR_Y = 2.0  # m, the corridor's centre line
+CIRCLE_CENTRE = (7.0, 7.0)
+CIRCLE_RADIUS = 3.0  # m (a 6 m circle)
+
+
+def swap_corridor_robots(n: int) -> list[tuple[float, float, float, float, float, float]]:
+    """(x, y, yaw, goal x, goal y, goal yaw) of lizi1..n for ``robots`` n (2 or 4)."""
+    west, east = [2.0, 3.2], [12.0, 10.8]
+    out = []
+    for k in range(n // 2):
+        out.append((west[k], CORRIDOR_Y, 0.0, east[k], CORRIDOR_Y, 0.0))
+        out.append((east[k], CORRIDOR_Y, math.pi, west[k], CORRIDOR_Y, math.pi))
+    return out
+
+
+def circle_robots(n: int) -> list[tuple[float, float, float, float, float, float]]:
+    """Robots on the circle, each facing the centre and sent to its antipode."""
+    cx, cy = CIRCLE_CENTRE
+    out = []
+    for k in range(n):
+        a = 2 * math.pi * k / n
+        x, y = cx + CIRCLE_RADIUS * math.cos(a), cy + CIRCLE_RADIUS * math.sin(a)
+        heading = math.remainder(a + math.pi, 2 * math.pi)
+        out.append((x, y, heading, 2 * cx - x, 2 * cy - y, heading))
+    return out
+
+
+def _group(k: int, robot: tuple, minimum: int) -> str:
+    x, y, yaw, gx, gy, gyaw = (round(v, 4) for v in robot)
+    return f"""
+  <group ns="lizi{k}" if="$(eval int(robots) >= {minimum})">
+    <include file="$(find fleetsim_launch)/include/mr_robot.launch">
+      <arg name="robot_name" value="lizi{k}"/>
+      <arg name="x" value="{x}"/> <arg name="y" value="{y}"/> <arg name="yaw" value="{yaw}"/>
+      <arg name="goal_x" value="{gx}"/> <arg name="goal_y" value="{gy}"/>
+      <arg name="goal_yaw" value="{gyaw}"/>
+      <arg name="planner" value="$(arg planner)"/>
+      <arg name="localization" value="$(arg localization)"/>
+      <arg name="start_delay" value="$(arg start_delay)"/>
+    </include>
+  </group>"""
+
+
+def scenario(name: str, doc: str, world: str, counts: tuple[int, int], robots: list) -> str:
+    small, large = counts
+    # an unknown name in $(eval) is a launch error that names it: robots_must_be_2_or_4
+    bad = f"robots_must_be_{small}_or_{large}"
+    check = f"$(eval robots if int(robots) in ({small}, {large}) else {bad})"
+    groups = "".join(_group(k + 1, r, small if k < small else large) for k, r in enumerate(robots))
+    return f"""<launch>
+  <!-- {doc}
+       Written by make_multi_robot_launch.py (see its docstring); pass criterion: every robot
+       reaches its goal without touching another robot or a wall. -->
+  <master auto="start"/>
+  <arg name="robots" default="{small}" doc="{small} or {large} robots"/>
+  <arg name="planner" default="collvoid"
+       doc="collvoid (ORCA, position sharing) | trajectory (plain TrajectoryPlannerROS)"/>
+  <arg name="localization" default="fake" doc="fake | amcl"/>
+  <arg name="start_delay" default="2.0" doc="sim seconds before the goals go out"/>
+  <arg name="map" default="$(find fleetsim_maps)/{world}.yaml"/>
+  <arg name="gui" default="true" doc="open the live view when run with --viz"/>
+  <arg name="robots_checked" value="{check}"/>
+
+  <param name="/use_sim_time" value="true"/>
+  <node pkg="map_server" type="map_server" name="map_server" args="$(arg map)">
+    <param name="frame_id" value="/map"/>
+  </node>
+  <include file="$(find gazebo_ros)/launch/empty_world.launch">
+    <arg name="world_name" value="$(arg map)"/>
+    <arg name="gui" value="$(arg gui)"/>
+  </include>
+{groups}
+</launch>
+"""
+
+
+def write(outdir: Path) -> list[Path]:
+    files = {
+        "swap_corridor.launch": scenario(
+            "swap_corridor",
+            "Robots exchange the ends of a 12 m long, 2 m wide corridor (robots:=2 or 4).",
+            "corridor",
+            (2, 4),
+            swap_corridor_robots(4),
+        ),
+        "circle.launch": scenario(
+            "circle",
+            "Robots on a 6 m circle each drive to the antipodal point (robots:=8 or 16).",
+            "open_room",
+            (8, 16),
+            circle_robots(16)[::2] + circle_robots(16)[1::2],
+        ),
+    }
+    out = []
+    for name, text in files.items():
+        p = outdir / name
+        p.write_text(text)
+        out.append(p)
+    return out
+
+
+if __name__ == "__main__":
+    target = Path(sys.argv[1]) if len(sys.argv) > 1 else Path(__file__).resolve().parent
+    for p in write(target):
+        print(p)

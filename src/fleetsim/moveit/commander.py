@@ -16,9 +16,11 @@ from typing import Any
 import numpy as np
 
 from fleetsim.errors import PlanningError
-from fleetsim.msgs import geometry_msgs, moveit_msgs, shape_msgs, std_msgs
+from fleetsim.moveit.goal_constraints import joint_goal, pose_goal
+from fleetsim.msgs import geometry_msgs, moveit_msgs, std_msgs
 from fleetsim.runtime import Node
 from fleetsim.runtime import names as rnames
+from fleetsim.tf.quaternions import quaternion_from_euler
 
 E = moveit_msgs.MoveItErrorCodes
 _ids = itertools.count(1)
@@ -38,6 +40,9 @@ class _Client:
     def wait(self, until, timeout: float) -> None:
         if not until():
             self.runtime.run(duration=timeout, until=until)
+
+    def call(self, name: str, srv_type, request):
+        return self.runtime.graph.call_service(rnames.join(self.ns, name), srv_type, request)
 
 
 class MoveGroupCommander:
@@ -79,12 +84,13 @@ class MoveGroupCommander:
         self._joints = self._model.active_joints(name)
         self._target = self.get_current_joint_values_or_zero()
         self._pose_target: np.ndarray | None = None
+        self._orientation_target: np.ndarray | None = None  # x y z w, with _pose_target
         self._remembered: dict[str, np.ndarray] = {}
         self._vs, self._as = self._model.default_scaling()
         self._planning_time = 5.0
         self._attempts = 1
         self._planner_id = ""
-        self._joint_tol, self._pos_tol = 1e-4, 1e-4
+        self._joint_tol, self._pos_tol, self._orient_tol = 1e-4, 1e-4, 1e-3
         self._ee = self._model.end_effector_link(name)
         node = self._c.node
         self._move = node.create_action_client(moveit_msgs.MoveGroup, "move_group")
@@ -179,8 +185,7 @@ class MoveGroupCommander:
                     )
                 q[self._joints.index(j)] = v
         elif isinstance(arg1, geometry_msgs.Pose | geometry_msgs.PoseStamped):
-            pose = arg1.pose if isinstance(arg1, geometry_msgs.PoseStamped) else arg1
-            self.set_position_target([pose.position.x, pose.position.y, pose.position.z])
+            self.set_pose_target(arg1)  # MoveIt solves IK for the pose, then plans in joints
             return
         elif hasattr(arg1, "name") and hasattr(arg1, "position"):  # JointState
             self.set_joint_value_target(dict(zip(arg1.name, arg1.position, strict=False)))
@@ -205,32 +210,41 @@ class MoveGroupCommander:
         return [float(v) for v in self._target]
 
     def set_position_target(self, xyz, end_effector_link: str = "") -> None:
+        """The end effector's position, any orientation (the target for arms with fewer than
+        six joints, such as the hunter's)."""
         if not (end_effector_link or self._ee):
             raise MoveItCommanderException("There is no end effector to set the pose for")
         if end_effector_link:
             self._ee = end_effector_link
         self._pose_target = np.asarray(xyz, float)[:3]
+        self._orientation_target = None
 
     def set_pose_target(self, pose, end_effector_link: str = "") -> None:
-        """Position-only for groups with fewer than six joints (the orientation is dropped,
-        as a 4-joint arm cannot follow it)."""
+        """Position and orientation (a Pose, PoseStamped, [x, y, z, roll, pitch, yaw] or
+        [x, y, z, qx, qy, qz, qw]). The orientation is kept: a group with fewer than six joints
+        reaches only the orientations its joints can make, and planning to any other fails
+        with NO_IK_SOLUTION saying so (use ``set_position_target`` for the position alone)."""
         if isinstance(pose, geometry_msgs.PoseStamped):
             pose = pose.pose
         if isinstance(pose, geometry_msgs.Pose):
             xyz = [pose.position.x, pose.position.y, pose.position.z]
+            o = pose.orientation
+            quat = np.array([o.x, o.y, o.z, o.w], float)
         else:
-            values = list(pose)
-            if len(values) not in (6, 7):
+            values = np.asarray(list(pose), float)
+            if values.shape not in ((6,), (7,)):
                 raise MoveItCommanderException(
                     "Expected [x, y, z, r, p, y] or [x, y, z, qx, qy, qz, qw]"
                 )
             xyz = values[:3]
-        if len(self._joints) >= 6:
-            self._mg.get_logger().warning("orientation targets are not supported; position only")
+            quat = values[3:] if values.size == 7 else quaternion_from_euler(*values[3:])
+        if not np.linalg.norm(quat) > 0 or not np.all(np.isfinite(quat)):
+            raise MoveItCommanderException(f"the pose's orientation {list(quat)} is not a rotation")
         self.set_position_target(xyz, end_effector_link)
+        self._orientation_target = quat / np.linalg.norm(quat)
 
     def clear_pose_targets(self) -> None:
-        self._pose_target = None
+        self._pose_target = self._orientation_target = None
 
     # ------------------------------------------------------------------ settings
     def set_max_velocity_scaling_factor(self, value: float) -> None:
@@ -271,6 +285,12 @@ class MoveGroupCommander:
     def set_goal_position_tolerance(self, value: float) -> None:
         self._pos_tol = float(value)
 
+    def set_goal_orientation_tolerance(self, value: float) -> None:
+        self._orient_tol = float(value)
+
+    def get_goal_orientation_tolerance(self) -> float:
+        return self._orient_tol
+
     def get_goal_joint_tolerance(self) -> float:
         return self._joint_tol
 
@@ -284,26 +304,13 @@ class MoveGroupCommander:
             num_planning_attempts=self._attempts, allowed_planning_time=self._planning_time,
             max_velocity_scaling_factor=self._vs, max_acceleration_scaling_factor=self._as,
         )  # fmt: skip
-        c = moveit_msgs.Constraints()
         if self._pose_target is not None:
-            sphere = shape_msgs.SolidPrimitive(
-                type=shape_msgs.SolidPrimitive.SPHERE, dimensions=np.array([self._pos_tol])
-            )
-            at = geometry_msgs.Pose(position=geometry_msgs.Point(*self._pose_target))
-            region = moveit_msgs.BoundingVolume(primitives=[sphere], primitive_poses=[at])
-            c.position_constraints = [
-                moveit_msgs.PositionConstraint(
-                    link_name=self._ee, constraint_region=region, weight=1.0
-                )
-            ]
+            c = pose_goal(
+                self._ee, self._pose_target, self._orientation_target, self._pos_tol,
+                self._orient_tol,
+            )  # fmt: skip
         else:
-            c.joint_constraints = [
-                moveit_msgs.JointConstraint(
-                    joint_name=j, position=float(v), tolerance_above=self._joint_tol,
-                    tolerance_below=self._joint_tol, weight=1.0,
-                )
-                for j, v in zip(self._joints, self._target, strict=True)
-            ]  # fmt: skip
+            c = joint_goal(self._joints, self._target, self._joint_tol)
         req.goal_constraints = [c]
         return req
 
@@ -354,6 +361,34 @@ class MoveGroupCommander:
         h = self._send(self._exec, moveit_msgs.ExecuteTrajectoryGoal(trajectory=traj), wait)
         self._last = h
         return not wait or (h.result is not None and h.result.error_code.val == E.SUCCESS)
+
+    def compute_cartesian_path(
+        self, waypoints, eef_step: float, jump_threshold=0.0, avoid_collisions=True,
+        path_constraints=None,
+    ):  # fmt: skip
+        """``(RobotTrajectory, fraction)``: the end effector along straight lines from where it
+        is through ``waypoints`` (Poses in the planning frame) in steps of ``eef_step`` m;
+        fraction is -1.0 on an error, as MoveIt's. Both moveit_commander signatures: up to
+        1.1.14 ``(waypoints, eef_step, jump_threshold, avoid_collisions)``, from 1.1.15
+        ``(waypoints, eef_step, avoid_collisions)``. Arms with fewer than six joints follow the
+        waypoints' positions only (``fleetsim.moveit.cartesian``)."""
+        if isinstance(jump_threshold, bool):  # the 1.1.15 signature
+            jump_threshold, avoid_collisions = 0.0, jump_threshold
+        if path_constraints is not None:
+            raise MoveItCommanderException("path constraints are not supported by fleetsim")
+        if not eef_step > 0:
+            raise MoveItCommanderException(f"eef_step must be > 0 m, got {eef_step}")
+        poses = [w.pose if isinstance(w, geometry_msgs.PoseStamped) else w for w in waypoints]
+        if not all(isinstance(w, geometry_msgs.Pose) for w in poses):
+            raise MoveItCommanderException("waypoints must be geometry_msgs Poses")
+        req = moveit_msgs.GetCartesianPathRequest(
+            group_name=self._name, link_name=self._ee, waypoints=poses, max_step=float(eef_step),
+            jump_threshold=float(jump_threshold), avoid_collisions=bool(avoid_collisions),
+        )  # fmt: skip
+        res = self._c.call("compute_cartesian_path", moveit_msgs.GetCartesianPath, req)
+        if res.error_code.val != E.SUCCESS:
+            return res.solution, -1.0
+        return res.solution, float(res.fraction)
 
     def stop(self) -> None:
         self._event.publish(std_msgs.String("stop"))

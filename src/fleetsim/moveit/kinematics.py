@@ -2,9 +2,12 @@
 
 The robot is built by the simulator's own robot builder into a private ``Engine`` at the
 origin, so every pose here is in the robot's root link frame (``base_link``, MoveIt's planning
-frame) and the link bodies are the simulator's. IK is position-only damped least squares on
-``mj_jacBody``, the 30-line method the hunter needs (four joints cannot reach a full 6-D pose);
-mink would add a QP solver dependency for tasks this arm does not have.
+frame) and the link bodies are the simulator's. IK is damped least squares on ``mj_jacBody``:
+position-only (``position_ik``), or position and orientation (``pose_ik``, the rotation error
+as an axis-angle vector weighted as metres at ``ROTATION_WEIGHT`` m/rad). A 4-joint arm as the
+hunter's reaches a full 6-D pose only where the orientation is one its joints can make, so
+``pose_ik`` simply finds no solution elsewhere. mink would add a QP solver dependency for tasks
+these arms do not have.
 """
 
 from __future__ import annotations
@@ -15,6 +18,7 @@ import numpy as np
 from fleetsim.errors import PlanningError, did_you_mean
 
 MODEL = "robot"
+ROTATION_WEIGHT = 0.1  # m per rad: a 0.01 rad orientation error weighs as 1 mm
 
 
 class Kinematics:
@@ -77,23 +81,66 @@ class Kinematics:
     ) -> np.ndarray | None:
         """Joint values (J,) putting ``link``'s origin at ``target`` (3,) m (root frame) within
         ``tolerance``, from the first seed that converges (and passes ``valid(q)``), else None."""
+        return self.pose_ik(link, target, None, seeds, tolerance, 0.0, iterations, damping, valid)
+
+    def pose_ik(
+        self,
+        link: str,
+        position: np.ndarray,
+        orientation: np.ndarray | None,
+        seeds: list[np.ndarray],
+        tolerance: float = 1e-3,
+        angle_tolerance: float = 1e-3,
+        iterations: int = 100,
+        damping: float = 1e-3,
+        valid=None,
+    ) -> np.ndarray | None:
+        """Joint values (J,) putting ``link`` at ``position`` (3,) m within ``tolerance`` and,
+        unless ``orientation`` is None, turned to ``orientation`` (4,) x y z w (root frame)
+        within ``angle_tolerance`` rad; from the first seed that converges (and passes
+        ``valid(q)``), else None."""
         bid = self.body_id(link)
         jacp = np.zeros((3, self.model.nv))
+        jacr = np.zeros((3, self.model.nv)) if orientation is not None else None
+        R_goal = None
+        if orientation is not None:
+            x, y, z, w = np.asarray(orientation, float) / np.linalg.norm(orientation)
+            R_goal = np.zeros(9)
+            mujoco.mju_quat2Mat(R_goal, np.array([w, x, y, z]))
+            R_goal = R_goal.reshape(3, 3)
         Rinv, tinv = None, None
+        n = 3 if orientation is None else 6
         for seed in seeds:
             q = np.clip(np.asarray(seed, float), self.lower, self.upper)
             for _ in range(iterations):
                 self.set(q)
                 if Rinv is None:
                     Rinv, tinv = self._root_inverse()
-                err = target - (Rinv @ self.data.xpos[bid] + tinv)
-                if np.linalg.norm(err) < tolerance:
+                err = position - (Rinv @ self.data.xpos[bid] + tinv)
+                done = np.linalg.norm(err) < tolerance
+                if R_goal is not None:
+                    R = Rinv @ self.data.xmat[bid].reshape(3, 3)
+                    rot = _rotation_vector(R_goal @ R.T)  # root frame
+                    done = done and np.linalg.norm(rot) < angle_tolerance
+                    err = np.concatenate([err, ROTATION_WEIGHT * rot])
+                if done:
                     if valid is None or valid(q):
                         return q
                     break
                 mujoco.mj_comPos(self.model, self.data)  # the Jacobian needs cdof
-                mujoco.mj_jacBody(self.model, self.data, jacp, None, bid)
+                mujoco.mj_jacBody(self.model, self.data, jacp, jacr, bid)
                 J = Rinv @ jacp[:, self.dadr]
-                dq = J.T @ np.linalg.solve(J @ J.T + damping * np.eye(3), err)
+                if jacr is not None:
+                    J = np.vstack([J, ROTATION_WEIGHT * (Rinv @ jacr[:, self.dadr])])
+                dq = J.T @ np.linalg.solve(J @ J.T + damping * np.eye(n), err)
                 q = np.clip(q + dq, self.lower, self.upper)
         return None
+
+
+def _rotation_vector(R: np.ndarray) -> np.ndarray:
+    """(3,) axis * angle (rad) of the rotation matrix ``R`` (3, 3)."""
+    quat = np.zeros(4)
+    mujoco.mju_mat2Quat(quat, R.reshape(9))
+    vel = np.zeros(3)
+    mujoco.mju_quat2Vel(vel, quat, 1.0)
+    return vel

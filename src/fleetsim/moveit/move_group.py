@@ -6,16 +6,18 @@ namespace ``controller_list`` (or ``moveit_controller_manager`` =
 ``moveit_fake_controller_manager/MoveItFakeControllerManager`` for fake execution),
 ``<group>/default_planner_config`` (ompl_planning.yaml), ``allow_trajectory_execution`` and
 ``trajectory_execution/*``. Serves MoveIt's interfaces in its namespace: actions ``move_group``
-and ``execute_trajectory``; services ``plan_kinematic_path``, ``compute_ik``, ``compute_fk``,
-``get_planning_scene``, ``apply_planning_scene``; topics ``joint_states`` (in),
-``planning_scene`` (in), ``trajectory_execution_event`` (in, "stop"),
-``~display_planned_path`` (out). World geometry and other robots come from the simulator when
-one runs; planning-scene objects are added with ``apply_planning_scene`` or ``planning_scene``.
+and ``execute_trajectory``; services ``plan_kinematic_path``, ``get_planning_scene``,
+``apply_planning_scene``, and ``compute_ik``, ``compute_fk``, ``compute_cartesian_path``
+(``kinematics_services``); topics ``joint_states`` (in), ``planning_scene`` (in),
+``trajectory_execution_event`` (in, "stop"), ``~display_planned_path`` (out). World geometry
+and other robots come from the simulator when one runs; planning-scene objects are added with
+``apply_planning_scene`` or ``planning_scene``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 
 import mujoco
 import numpy as np
@@ -24,9 +26,10 @@ from fleetsim.description.srdf import parse_srdf
 from fleetsim.description.urdf import parse_urdf
 from fleetsim.errors import FleetsimError, PlanningError
 from fleetsim.moveit.execution import ExecutionManager
+from fleetsim.moveit.kinematics_services import compute_cartesian_path, compute_fk, compute_ik
 from fleetsim.moveit.pipeline import PlanFailure, PlanningPipeline
 from fleetsim.moveit.robot_model import RobotModel
-from fleetsim.msgs import geometry_msgs, moveit_msgs, sensor_msgs, shape_msgs, std_msgs
+from fleetsim.msgs import moveit_msgs, sensor_msgs, shape_msgs, std_msgs
 from fleetsim.runtime import Node, param
 
 E = moveit_msgs.MoveItErrorCodes
@@ -99,8 +102,13 @@ class MoveGroup(Node):
             preempt_callback=lambda: self._preempt(self.exec_action),
         )  # fmt: skip
         self.create_service(moveit_msgs.GetMotionPlan, "plan_kinematic_path", self._srv_plan)
-        self.create_service(moveit_msgs.GetPositionIK, "compute_ik", self._srv_ik)
-        self.create_service(moveit_msgs.GetPositionFK, "compute_fk", self._srv_fk)
+        self.create_service(moveit_msgs.GetPositionIK, "compute_ik", partial(compute_ik, self))
+        self.create_service(moveit_msgs.GetPositionFK, "compute_fk", partial(compute_fk, self))
+        self.create_service(
+            moveit_msgs.GetCartesianPath,
+            "compute_cartesian_path",
+            partial(compute_cartesian_path, self),
+        )
         self.create_service(moveit_msgs.GetPlanningScene, "get_planning_scene", self._srv_get_scene)
         self.create_service(moveit_msgs.ApplyPlanningScene, "apply_planning_scene", self._srv_apply)
         self.get_logger().info("You can start planning now!")
@@ -148,7 +156,7 @@ class MoveGroup(Node):
             )
         return np.array([self.joint_positions.get(j, 0.0) for j in joints])
 
-    def _start(self, req) -> np.ndarray:
+    def start_state(self, req) -> np.ndarray:
         q = self.current(req.group_name)
         js = req.start_state.joint_state
         if len(js.name) and not req.start_state.is_diff:
@@ -158,7 +166,7 @@ class MoveGroup(Node):
                     q[joints.index(n)] = v
         return q
 
-    def _sync_world(self) -> None:
+    def sync_world(self) -> None:
         """Copy the simulator's world near this robot into each group's collision scene."""
         from fleetsim.sim.node import Simulator
 
@@ -184,8 +192,8 @@ class MoveGroup(Node):
         res = moveit_msgs.MotionPlanResponse(group_name=req.group_name)
         try:
             ctx = self.pipeline.context(req.group_name)
-            start = self._start(req)
-            self._sync_world()
+            start = self.start_state(req)
+            self.sync_world()
             plan = self.pipeline.plan(req, start)
         except PlanFailure as e:
             self.get_logger().error("%s", e)
@@ -276,54 +284,6 @@ class MoveGroup(Node):
     def _on_event(self, msg) -> None:
         if msg.data == "stop":
             self.execution.stop("stopped by trajectory_execution_event", E.PREEMPTED)
-
-    # ------------------------------------------------------------------ kinematics services
-    def _srv_ik(self, req):
-        r = req.ik_request
-        res = moveit_msgs.GetPositionIKResponse()
-        try:
-            ctx = self.pipeline.context(r.group_name)
-            start = self._start(
-                moveit_msgs.MotionPlanRequest(group_name=r.group_name, start_state=r.robot_state)
-            )
-            p = r.pose_stamped.pose.position
-            q = self.pipeline.ik(ctx, r.ik_link_name or ctx.tip, np.array([p.x, p.y, p.z]), start)
-        except PlanFailure as e:
-            res.error_code.val = e.code
-            return res
-        except PlanningError:
-            res.error_code.val = E.INVALID_LINK_NAME
-            return res
-        if q is None:
-            res.error_code.val = E.NO_IK_SOLUTION
-            return res
-        res.solution.joint_state.name = list(ctx.joints)
-        res.solution.joint_state.position = q
-        res.error_code.val = E.SUCCESS
-        return res
-
-    def _srv_fk(self, req):
-        res = moveit_msgs.GetPositionFKResponse(fk_link_names=list(req.fk_link_names))
-        group = self.model.group_names[0]
-        ctx = self.pipeline.context(group)
-        q = self._start(
-            moveit_msgs.MotionPlanRequest(group_name=group, start_state=req.robot_state)
-        )
-        try:
-            for link in req.fk_link_names:
-                pos, quat = ctx.kin.link_pose(q, link)
-                ps = geometry_msgs.PoseStamped()
-                ps.header.frame_id = self.frame(self.model.robot.root_link())
-                ps.header.stamp = self.now_msg()
-                ps.pose.position = geometry_msgs.Point(*pos)
-                ps.pose.orientation = geometry_msgs.Quaternion(*quat)
-                res.pose_stamped.append(ps)
-        except PlanningError:
-            res.error_code.val = E.INVALID_LINK_NAME
-            res.pose_stamped = []
-            return res
-        res.error_code.val = E.SUCCESS
-        return res
 
     # ------------------------------------------------------------------ planning scene
     def _on_scene(self, msg) -> None:

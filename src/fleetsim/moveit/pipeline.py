@@ -116,35 +116,93 @@ class PlanningPipeline:
             except PlanningError as e:
                 raise PlanFailure(E.INVALID_GOAL_CONSTRAINTS, str(e)) from None
             return q
-        if c.position_constraints:
-            pc = c.position_constraints[0]
-            link = pc.link_name or ctx.tip
-            region = pc.constraint_region
-            if not region.primitive_poses:
-                raise PlanFailure(E.INVALID_GOAL_CONSTRAINTS, "position constraint has no region")
-            p = region.primitive_poses[0].position
-            target = np.array([p.x, p.y, p.z])
-            tol = region.primitives[0].dimensions[0] if region.primitives else 1e-3
-            try:
-                q = self.ik(ctx, link, target, start, tolerance=max(float(tol), 1e-4))
-            except PlanningError as e:
-                raise PlanFailure(E.INVALID_LINK_NAME, str(e)) from None
-            if q is None:
-                raise PlanFailure(
-                    E.NO_IK_SOLUTION,
-                    f"no collision-free IK solution puts '{link}' at "
-                    f"({target[0]:.3f}, {target[1]:.3f}, {target[2]:.3f}) in the planning frame",
-                )
-            return q
+        if c.position_constraints or c.orientation_constraints:
+            return self._pose_goal(ctx, c, start)
         raise PlanFailure(
-            E.INVALID_GOAL_CONSTRAINTS, "the goal has no joint or position constraint"
+            E.INVALID_GOAL_CONSTRAINTS, "the goal has no joint, position or orientation constraint"
         )
 
-    def ik(self, ctx: GroupContext, link: str, target, start, tolerance=1e-3):
+    def _pose_goal(self, ctx: GroupContext, c, start: np.ndarray) -> np.ndarray:
+        """Joint values for a position constraint, with an orientation constraint on the same
+        link if one is given (MoveIt's pose goal), through IK."""
+        if not c.position_constraints:
+            raise PlanFailure(
+                E.INVALID_GOAL_CONSTRAINTS,
+                "an orientation constraint without a position constraint: fleetsim's IK needs "
+                "the link's position too (set_pose_target gives both)",
+            )
+        pc = c.position_constraints[0]
+        link = pc.link_name or ctx.tip
+        region = pc.constraint_region
+        if not region.primitive_poses:
+            raise PlanFailure(E.INVALID_GOAL_CONSTRAINTS, "position constraint has no region")
+        p = region.primitive_poses[0].position
+        target = np.array([p.x, p.y, p.z])
+        tol = region.primitives[0].dimensions[0] if region.primitives else 1e-3
+        quat, angle_tol = None, 1e-3
+        if c.orientation_constraints:
+            oc = c.orientation_constraints[0]
+            if (oc.link_name or ctx.tip) != link:
+                raise PlanFailure(
+                    E.INVALID_GOAL_CONSTRAINTS,
+                    f"the orientation constraint is on '{oc.link_name}', the position constraint "
+                    f"on '{link}': a pose goal constrains one link",
+                )
+            o = oc.orientation
+            quat = np.array([o.x, o.y, o.z, o.w])
+            if not np.linalg.norm(quat) > 0:
+                raise PlanFailure(
+                    E.INVALID_GOAL_CONSTRAINTS, "the orientation constraint's quaternion is zero"
+                )
+            tols = [
+                t
+                for t in (
+                    oc.absolute_x_axis_tolerance,
+                    oc.absolute_y_axis_tolerance,
+                    oc.absolute_z_axis_tolerance,
+                )
+                if t > 0
+            ]
+            angle_tol = max(min(tols), 1e-4) if tols else 1e-3
+        try:
+            q = self.ik(
+                ctx, link, target, start, tolerance=max(float(tol), 1e-4),
+                orientation=quat, angle_tolerance=angle_tol,
+            )  # fmt: skip
+        except PlanningError as e:
+            raise PlanFailure(E.INVALID_LINK_NAME, str(e)) from None
+        if q is not None:
+            return q
+        where = f"({target[0]:.3f}, {target[1]:.3f}, {target[2]:.3f})"
+        if quat is None:
+            raise PlanFailure(
+                E.NO_IK_SOLUTION,
+                f"no collision-free IK solution puts '{link}' at {where} in the planning frame",
+            )
+        q_txt = ", ".join(f"{v:.3f}" for v in quat / np.linalg.norm(quat))
+        few = (
+            f"; group '{ctx.group}' has {len(ctx.joints)} joints, fewer than the 6 an arbitrary "
+            "orientation needs: give a position target (set_position_target) or an orientation "
+            "the arm can make"
+            if len(ctx.joints) < 6
+            else ""
+        )
+        raise PlanFailure(
+            E.NO_IK_SOLUTION,
+            f"no collision-free IK solution puts '{link}' at {where} turned to "
+            f"(x y z w) ({q_txt}) in the planning frame{few}",
+        )
+
+    def ik(
+        self, ctx: GroupContext, link: str, target, start, tolerance=1e-3,
+        orientation=None, angle_tolerance=1e-3,
+    ):  # fmt: skip
         seeds = [start] + [
             self.rng.uniform(ctx.limits.lower, ctx.limits.upper) for _ in range(IK_ATTEMPTS)
         ]
-        return ctx.kin.position_ik(link, target, seeds, tolerance, valid=ctx.scene.is_valid)
+        return ctx.kin.pose_ik(
+            link, target, orientation, seeds, tolerance, angle_tolerance, valid=ctx.scene.is_valid
+        )
 
     # ------------------------------------------------------------------ planning
     def plan(self, req, start: np.ndarray) -> PlanResult:
@@ -180,6 +238,17 @@ class PlanningPipeline:
         path = p.path
         if np.abs(path[-1] - goal).max() > 1e-6:
             path = np.vstack([path, goal])
+        return PlanResult(
+            self.timed_trajectory(ctx, path, vs, acs),
+            time.perf_counter() - t0,
+            p.planner,
+            p.planning_time,
+            ALIASES.get(planner, planner),
+        )
+
+    def timed_trajectory(self, ctx: GroupContext, path: np.ndarray, vs: float, acs: float):
+        """A RobotTrajectory through ``path`` (N, J) within the group's limits x scaling."""
+        lim = ctx.limits
         t, pos, vel, acc = time_parameterize(path, lim.max_velocity, lim.max_acceleration, vs, acs)
         traj = moveit_msgs.RobotTrajectory()
         jt = traj.joint_trajectory
@@ -191,13 +260,7 @@ class PlanningPipeline:
             )
             for k in range(len(t))
         ]  # fmt: skip
-        return PlanResult(
-            traj,
-            time.perf_counter() - t0,
-            p.planner,
-            p.planning_time,
-            ALIASES.get(planner, planner),
-        )
+        return traj
 
 
 def _scaling(v: float) -> float:

@@ -152,6 +152,9 @@ class RemoteSession:
         pub = self.client.publisher(names.join(self.ns, name), msg_type)
         return pub
 
+    def call(self, name: str, srv_type, request):
+        return self.client.call_service(names.join(self.ns, name), request, srv_type)
+
     def wait(self, until, timeout: float) -> None:
         deadline = _wall.monotonic() + timeout
         while not until():

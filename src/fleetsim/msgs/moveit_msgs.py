@@ -1,6 +1,7 @@
 """moveit_msgs (1.x layout, the fields fleetsim's move_group reads and fills): error codes, robot
 state and trajectories, constraints, motion plan request/response, planning scene, and the
-move_group / execute_trajectory actions with the planning, IK, FK and scene services."""
+move_group / execute_trajectory actions with the planning, IK, FK, Cartesian path and scene
+services."""
 
 from __future__ import annotations
 
@@ -327,4 +328,32 @@ class ApplyPlanningSceneResponse:
 
 ApplyPlanningScene = make_srv_type(
     "moveit_msgs/srv/ApplyPlanningScene", ApplyPlanningSceneRequest, ApplyPlanningSceneResponse
+)
+
+
+@message("moveit_msgs/srv/GetCartesianPath_Request")
+class GetCartesianPathRequest:
+    header: Header
+    start_state: RobotState
+    group_name: string
+    link_name: string
+    waypoints: Seq[Pose]
+    max_step: float64
+    jump_threshold: float64
+    prismatic_jump_threshold: float64
+    revolute_jump_threshold: float64
+    avoid_collisions: bool_
+    path_constraints: Constraints
+
+
+@message("moveit_msgs/srv/GetCartesianPath_Response")
+class GetCartesianPathResponse:
+    start_state: RobotState
+    solution: RobotTrajectory
+    fraction: float64
+    error_code: MoveItErrorCodes
+
+
+GetCartesianPath = make_srv_type(
+    "moveit_msgs/srv/GetCartesianPath", GetCartesianPathRequest, GetCartesianPathResponse
 )

@@ -81,5 +81,10 @@ def test_commander_from_another_process_over_the_bridge(served):
         assert ok and code.val == 1 and traj.joint_trajectory.joint_names[0] == "arm_joint_01"
         with pytest.raises(FleetsimError, match="no named state 'up'"):
             arm.set_named_target("up")
+        # move_group's compute_cartesian_path service, called over the bridge
+        lower = arm.get_current_pose().pose
+        lower.position.z -= 0.03
+        traj, fraction = arm.compute_cartesian_path([lower], 0.01, 0.0)
+        assert fraction == pytest.approx(1.0) and len(traj.joint_trajectory.points) >= 2
     finally:
         arm._c.close()

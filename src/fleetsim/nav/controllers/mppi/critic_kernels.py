@@ -1,0 +1,280 @@
+"""Compiled scores of MPPI's critics, each over the whole batch.
+
+Shapes: ``poses``, ``vels`` (B, T, 3) the sampled trajectories' poses (x, y, yaw; m, rad) and
+state velocities (vx, vy, wz; m/s, rad/s); ``path`` (N, 3); ``costs`` the (H, W) uint8 costmap.
+Each returns (B,) raw terms; the critic weighs them and raises them to its power.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+from numba import njit
+
+COLLISION = -1.0
+
+
+@njit(cache=True, inline="always")
+def _wrap(a):
+    return (a + math.pi) % (2.0 * math.pi) - math.pi
+
+
+@njit(cache=True)
+def pose_cost(costs, ox, oy, res, outline, footprint_from, x, y, c, s):
+    """The cost of one pose (heading cos ``c``, sin ``s``): its centre cell's, or the highest
+    under its footprint outline when the centre's is at least ``footprint_from`` (< 0: never).
+    `COLLISION` for a lethal cell (or an inscribed one, by the centre alone) or off the grid;
+    NO_INFORMATION (255) is passable (Nav2 with unknown space tracked)."""
+    h, w = costs.shape
+    fx = (x - ox) / res
+    fy = (y - oy) / res
+    if fx < 0.0 or fy < 0.0 or fx >= w or fy >= h:
+        return COLLISION
+    v = costs[int(fy), int(fx)]
+    if v == 254:
+        return COLLISION
+    if footprint_from < 0.0:
+        return COLLISION if v == 253 else float(v)
+    worst = float(v)
+    if v < footprint_from or v == 255:
+        return worst
+    for k in range(outline.shape[0]):
+        fx = (x + c * outline[k, 0] - s * outline[k, 1] - ox) / res
+        fy = (y + s * outline[k, 0] + c * outline[k, 1] - oy) / res
+        if fx < 0.0 or fy < 0.0 or fx >= w or fy >= h:
+            return COLLISION
+        u = costs[int(fy), int(fx)]
+        if u == 254:
+            return COLLISION
+        if u != 255 and u > worst:
+            worst = float(u)
+    return worst
+
+
+@njit(cache=True)
+def cost_terms(
+    poses,
+    headings,
+    costs,
+    ox,
+    oy,
+    res,
+    outline,
+    footprint_from,
+    step,
+    near_collision,
+    critical,
+    near_goal,
+):
+    """CostCritic: per trajectory, the sum over every ``step``-th pose of its cost (or
+    ``critical`` from ``near_collision`` up; cell costs skipped when ``near_goal``), over the
+    poses checked; and whether it collides. Returns ((B,) terms, (B,) bool collided)."""
+    nb, nt = poses.shape[0], poses.shape[1]
+    out = np.zeros(nb)
+    hit = np.zeros(nb, dtype=np.bool_)
+    n = (nt + step - 1) // step
+    for b in range(nb):
+        acc = 0.0
+        for t in range(0, nt, step):
+            c = pose_cost(
+                costs,
+                ox,
+                oy,
+                res,
+                outline,
+                footprint_from,
+                poses[b, t, 0],
+                poses[b, t, 1],
+                headings[b, t, 0],
+                headings[b, t, 1],
+            )
+            if c == COLLISION:
+                hit[b] = True
+                break
+            if c >= near_collision:
+                acc += critical
+            elif not near_goal:
+                acc += c
+        out[b] = acc / n
+    return out, hit
+
+
+@njit(cache=True)
+def obstacle_terms(
+    poses,
+    headings,
+    costs,
+    ox,
+    oy,
+    res,
+    outline,
+    footprint_from,
+    inscribed,
+    scaling,
+    margin,
+    inflation_radius,
+    near_goal,
+):
+    """ObstaclesCritic: per trajectory the critical term (sum of ``margin - distance`` where
+    the distance to the nearest obstacle, recovered from the cost, is below ``margin``), the
+    repulsive term (mean of ``inflation_radius - distance`` elsewhere in inflated space; none
+    when ``near_goal``) and whether it collides. Returns three (B,) arrays."""
+    nb, nt = poses.shape[0], poses.shape[1]
+    critical = np.zeros(nb)
+    repulsive = np.zeros(nb)
+    hit = np.zeros(nb, dtype=np.bool_)
+    log253 = math.log(253.0)
+    for b in range(nb):
+        for t in range(nt):
+            c = pose_cost(
+                costs,
+                ox,
+                oy,
+                res,
+                outline,
+                footprint_from,
+                poses[b, t, 0],
+                poses[b, t, 1],
+                headings[b, t, 0],
+                headings[b, t, 1],
+            )
+            if c == COLLISION:
+                hit[b] = True
+                break
+            if c <= 0.0:
+                continue
+            dist = (scaling * inscribed - math.log(min(c, 253.0)) + log253) / scaling
+            if dist < margin:
+                critical[b] += margin - dist
+            elif not near_goal:
+                repulsive[b] += max(inflation_radius - dist, 0.0)
+        repulsive[b] /= nt
+    return critical, repulsive, hit
+
+
+@njit(cache=True)
+def constraint_terms(vels, vx_min, vx_max, vy_max, model, min_turning_r, dt):
+    """ConstraintCritic: per trajectory, time-integrated velocity beyond the limits (and, for
+    Ackermann, turning radius below ``min_turning_r``)."""
+    nb, nt = vels.shape[0], vels.shape[1]
+    out = np.zeros(nb)
+    for b in range(nb):
+        acc = 0.0
+        for t in range(nt):
+            vx, vy, wz = vels[b, t, 0], vels[b, t, 1], vels[b, t, 2]
+            acc += max(vx - vx_max, 0.0) + max(vx_min - vx, 0.0)
+            if model == 1:
+                acc += max(abs(vy) - vy_max, 0.0)
+            if model == 2 and abs(wz) > 1e-9:
+                acc += max(min_turning_r - abs(vx / wz), 0.0)
+        out[b] = acc * dt
+    return out
+
+
+@njit(cache=True)
+def goal_terms(poses, gx, gy):
+    """GoalCritic: the mean distance (m) of each trajectory's poses to the goal."""
+    nb, nt = poses.shape[0], poses.shape[1]
+    out = np.zeros(nb)
+    for b in range(nb):
+        acc = 0.0
+        for t in range(nt):
+            acc += math.hypot(poses[b, t, 0] - gx, poses[b, t, 1] - gy)
+        out[b] = acc / nt
+    return out
+
+
+@njit(cache=True)
+def goal_angle_terms(poses, gyaw):
+    """GoalAngleCritic: the mean |yaw error| (rad) of each trajectory to the goal yaw."""
+    nb, nt = poses.shape[0], poses.shape[1]
+    out = np.zeros(nb)
+    for b in range(nb):
+        acc = 0.0
+        for t in range(nt):
+            acc += abs(_wrap(poses[b, t, 2] - gyaw))
+        out[b] = acc / nt
+    return out
+
+
+@njit(cache=True)
+def path_align_terms(poses, path, valid, step, use_orientations):
+    """PathAlignCritic: the mean distance (m) of every ``step``-th pose to the nearest valid
+    path point, searched forwards from the previous pose's (plus the yaw error to that
+    point's yaw with ``use_orientations``)."""
+    nb, nt, n = poses.shape[0], poses.shape[1], path.shape[0]
+    out = np.zeros(nb)
+    for b in range(nb):
+        j = 0
+        acc = 0.0
+        count = 0
+        for t in range(step - 1, nt, step):
+            x, y = poses[b, t, 0], poses[b, t, 1]
+            d = (path[j, 0] - x) ** 2 + (path[j, 1] - y) ** 2
+            while j + 1 < n:
+                dn = (path[j + 1, 0] - x) ** 2 + (path[j + 1, 1] - y) ** 2
+                if dn > d:
+                    break
+                j += 1
+                d = dn
+            if valid[j]:
+                acc += math.sqrt(d)
+                if use_orientations:
+                    acc += abs(_wrap(poses[b, t, 2] - path[j, 2]))
+                count += 1
+        out[b] = acc / count if count > 0 else 0.0
+    return out
+
+
+@njit(cache=True)
+def path_follow_terms(poses, tx, ty):
+    """PathFollowCritic: the distance (m) of each trajectory's last pose to the target."""
+    nb, nt = poses.shape[0], poses.shape[1]
+    out = np.zeros(nb)
+    for b in range(nb):
+        out[b] = math.hypot(poses[b, nt - 1, 0] - tx, poses[b, nt - 1, 1] - ty)
+    return out
+
+
+@njit(cache=True)
+def path_angle_terms(poses, tx, ty, forward_preference):
+    """PathAngleCritic: the mean |angle| (rad) between each pose's heading and the direction
+    to the target point (either heading, without ``forward_preference``)."""
+    nb, nt = poses.shape[0], poses.shape[1]
+    out = np.zeros(nb)
+    for b in range(nb):
+        acc = 0.0
+        for t in range(nt):
+            a = abs(_wrap(math.atan2(ty - poses[b, t, 1], tx - poses[b, t, 0]) - poses[b, t, 2]))
+            if not forward_preference:
+                a = min(a, math.pi - a)
+            acc += a
+        out[b] = acc / nt
+    return out
+
+
+@njit(cache=True)
+def reverse_terms(vels, dt):
+    """PreferForwardCritic: the distance (m) each trajectory drives backwards."""
+    nb, nt = vels.shape[0], vels.shape[1]
+    out = np.zeros(nb)
+    for b in range(nb):
+        acc = 0.0
+        for t in range(nt):
+            acc += max(-vels[b, t, 0], 0.0)
+        out[b] = acc * dt
+    return out
+
+
+@njit(cache=True)
+def twirl_terms(vels):
+    """TwirlingCritic: the mean |wz| (rad/s) of each trajectory."""
+    nb, nt = vels.shape[0], vels.shape[1]
+    out = np.zeros(nb)
+    for b in range(nb):
+        acc = 0.0
+        for t in range(nt):
+            acc += abs(vels[b, t, 2])
+        out[b] = acc / nt
+    return out

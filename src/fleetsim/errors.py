@@ -74,6 +74,10 @@ class LaunchError(FleetsimError):
     """A launch file that cannot be read or run."""
 
 
+class BatchError(FleetsimError):
+    """A batch experiment that cannot run: a bad spec, sweep or results folder."""
+
+
 class TransportError(FleetsimError):
     """Cross-process transport problems: no simulation running, a peer that does not answer."""
 

@@ -7,7 +7,8 @@
 * ``circle`` (world ``open_room``): arg ``robots`` 8 or 16 on a circle of 6 m diameter around
   (7, 7), facing its centre; each goes to the antipodal point.
 
-Both take ``planner`` (``collvoid``, default: collvoid_local_planner/CollvoidLocalPlanner with
+Both take ``solo`` (run only the named robot: the reference for makespan and path length),
+``planner`` (``collvoid``, default: collvoid_local_planner/CollvoidLocalPlanner with
 position sharing and a robots layer; ``trajectory``: plain TrajectoryPlannerROS, the robots
 unaware of each other), ``localization`` (fake | amcl) and ``start_delay``. Pass criterion
 (checked by tests/scenarios/test_multi_robot_scenarios.py and benchmarks/multi_robot.py): every
@@ -52,7 +53,7 @@ def circle_robots(n: int) -> list[tuple[float, float, float, float, float, float
 def _group(k: int, robot: tuple, minimum: int) -> str:
     x, y, yaw, gx, gy, gyaw = (round(v, 4) for v in robot)
     return f"""
-  <group ns="lizi{k}" if="$(eval int(robots) >= {minimum})">
+  <group ns="lizi{k}" if="$(eval int(robots) >= {minimum} and solo in ('', 'lizi{k}'))">
     <include file="$(find fleetsim_launch)/include/mr_robot.launch">
       <arg name="robot_name" value="lizi{k}"/>
       <arg name="x" value="{x}"/> <arg name="y" value="{y}"/> <arg name="yaw" value="{yaw}"/>
@@ -81,6 +82,7 @@ def scenario(name: str, doc: str, world: str, counts: tuple[int, int], robots: l
        doc="collvoid (ORCA, position sharing) | trajectory (plain TrajectoryPlannerROS)"/>
   <arg name="localization" default="fake" doc="fake | amcl"/>
   <arg name="start_delay" default="2.0" doc="sim seconds before the goals go out"/>
+  <arg name="solo" default="" doc="run only this robot (e.g. lizi3): its time and path alone"/>
   <arg name="map" default="$(find fleetsim_maps)/{world}.yaml"/>
   <arg name="gui" default="true" doc="open the live view when run with --viz"/>
   <arg name="robots_checked" value="{check}"/>

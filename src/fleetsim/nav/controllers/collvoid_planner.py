@@ -7,9 +7,10 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    the tracking error allowed for a differential drive (``min_error_holo`` growing to
    ``max_error_holo`` at full speed);
 2. the preferred velocity points at a carrot ``carrot_distance`` m along the global plan, at
-   ``max_vel_x`` slowing to ``min_vel_x`` over the last metre; while another robot is ahead it
-   is turned by ``left_pref`` rad (negative: keep right), which breaks the symmetry of head-on
-   meetings that plain ORCA cannot;
+   ``max_vel_x``, slowing at a quarter of ``acc_lim_x`` (not below ``min_vel_x``) to stop at
+   the goal; while another robot is ahead, nearer than the goal, it is turned by ``left_pref``
+   rad (negative: keep right), which breaks the symmetry of head-on meetings that plain ORCA
+   cannot;
 3. the `DeadlockRule` may make the robot yield: back off to the right, away from a robot with
    priority, taking full responsibility for avoiding it;
 4. ORCA half-planes (`fleetsim.nav.multirobot.orca`): one per robot on ``/position_share``
@@ -64,6 +65,8 @@ MAP_FRAME = "map"
 STILL_SPEED = 0.02
 #: bearing sectors for static obstacle points
 OBSTACLE_SECTORS = 24
+#: share of acc_lim_x used to slow down towards the goal
+DECELERATION = 0.25
 #: no truncation: the velocity obstacle's horizon, s
 UNTRUNCATED = 1e3
 
@@ -181,7 +184,9 @@ class CollvoidLocalPlanner(LocalPlanner):
             tx, ty, tyaw = self._map_to_local()
         except TransformError:
             tx = ty = tyaw = None
-        pref = preferred_velocity(carrot, xy, remaining, p.max_vel_x, p.min_vel_x)
+        pref = preferred_velocity(
+            carrot, xy, remaining, p.max_vel_x, p.min_vel_x, DECELERATION * p.acc_lim_x
+        )
         pos = np.zeros((0, 2))
         nvel = np.zeros((0, 2))
         radii = np.zeros(0)
@@ -211,8 +216,8 @@ class CollvoidLocalPlanner(LocalPlanner):
             away = xy - pos[k]
             away = away / max(float(np.hypot(*away)), 1e-9)
             pref = rotated(away, -math.pi / 3) * (0.5 * p.max_vel_x)
-        elif ids and ((pos - xy) @ pref > 0).any():  # a robot ahead within neighbor_dist
-            pref = rotated(pref, p.left_pref)
+        elif ids and (((pos - xy) @ pref > 0) & (dist < remaining + own_r)).any():
+            pref = rotated(pref, p.left_pref)  # a robot ahead, between us and the goal
         lines_p, lines_d = [], []
         obst = obstacle_points(
             self.costmap.costs,

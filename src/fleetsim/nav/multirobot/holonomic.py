@@ -41,15 +41,20 @@ def plan_carrot(
 
 
 def preferred_velocity(
-    carrot: np.ndarray, xy: np.ndarray, remaining: float, max_speed: float, min_speed: float
+    carrot: np.ndarray,
+    xy: np.ndarray,
+    remaining: float,
+    max_speed: float,
+    min_speed: float,
+    deceleration: float,
 ) -> np.ndarray:
-    """(2,) m/s towards ``carrot``: ``max_speed``, slowing to ``min_speed`` over the last metre
-    of the ``remaining`` path (m)."""
+    """(2,) m/s towards ``carrot``: ``max_speed``, or the speed from which ``deceleration``
+    (m/s^2) stops the robot within the ``remaining`` path (m), but at least ``min_speed``."""
     to = np.asarray(carrot, dtype=np.float64) - xy
     n = float(np.hypot(*to))
     if n < 1e-9:
         return np.zeros(2)
-    speed = min(max_speed, max(min_speed, max_speed * remaining))
+    speed = min(max_speed, max(min_speed, math.sqrt(2.0 * deceleration * remaining)))
     return to / n * speed
 
 

@@ -115,6 +115,7 @@ class MoveBase(ExecuteCycle, Node):
         "TrajectoryPlannerROS",
         "DWAPlannerROS",
         "CollvoidLocalPlanner",
+        "MPPIController",
         "conservative_reset",
         "aggressive_reset",
         "rotate_recovery",

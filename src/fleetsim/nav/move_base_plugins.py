@@ -10,6 +10,8 @@
   critics; names with no counterpart are dropped with a warning.
   ``controller_frequency`` is searched upwards, so move_base's own value is used unless the
   planner's namespace sets one.
+  ``nav2_mppi_controller::MPPIController`` (or ``nav2_mppi_controller/MPPIController``) ->
+  `fleetsim.nav.controllers.mppi.MPPIController` reading ``~MPPIController/``.
 * ``recovery_behaviors``: a list of ``{name, type}`` (types
   ``clear_costmap_recovery/ClearCostmapRecovery``, ``rotate_recovery/RotateRecovery``), each
   reading ``~<name>/``; when unset, move_base's defaults: ``conservative_reset`` (reset_distance
@@ -45,6 +47,8 @@ LOCAL_PLANNERS = {
     "base_local_planner/TrajectoryPlannerROS": "TrajectoryPlannerROS",
     "dwa_local_planner/DWAPlannerROS": "DWAPlannerROS",
     "collvoid_local_planner/CollvoidLocalPlanner": "CollvoidLocalPlanner",
+    "nav2_mppi_controller::MPPIController": "MPPIController",
+    "nav2_mppi_controller/MPPIController": "MPPIController",
 }
 RECOVERY_TYPES = ("clear_costmap_recovery/ClearCostmapRecovery", "rotate_recovery/RotateRecovery")
 
@@ -131,6 +135,10 @@ def make_local_planner(node: Any, name: str, ns: dict, costmap_ros: Any, where: 
         from fleetsim.nav.controllers.collvoid_planner import CollvoidLocalPlanner
 
         return CollvoidLocalPlanner.from_namespace(node, costmap_ros, ns, where)
+    if name == "MPPIController":  # its noise comes from the runtime's generator
+        from fleetsim.nav.controllers.mppi import MPPIController
+
+        return MPPIController.from_namespace(node, costmap_ros, ns, where)
     return TrajectoryPlanner.from_namespace(costmap_ros.costmap, costmap_ros.footprint, ns, where)
 
 

@@ -1,0 +1,177 @@
+"""MPPI critics: each one's sign and scale on crafted trajectories."""
+
+import math
+
+import numpy as np
+import pytest
+
+from fleetsim.nav.controllers.mppi import critic_params as cp
+from fleetsim.nav.controllers.mppi.critics import CRITICS, CriticData
+from fleetsim.nav.controllers.mppi.kernels import DIFF_DRIVE
+from fleetsim.nav.costmap import Costmap2D
+from fleetsim.nav.costmap.footprint import footprint_from_radius, outline_points
+
+DT = 0.05
+
+
+def straight(y0, yaw=0.0, n=20, v=0.5, x0=0.0):
+    """(n, 3) poses along +x (or along ``yaw``) from (x0, y0)."""
+    s = v * DT * np.arange(1, n + 1)
+    return np.stack([x0 + s * math.cos(yaw), y0 + s * math.sin(yaw), np.full(n, yaw)], axis=1)
+
+
+def data_for(trajs, vels=None, robot=(0.0, 0.0, 0.0), goal=(5.0, 0.0, 0.0), path=None, m=None):
+    poses = np.ascontiguousarray(np.stack(trajs), dtype=float)
+    b, t = poses.shape[:2]
+    if vels is None:
+        vels = np.zeros((b, t, 3))
+        vels[:, :, 0] = 0.5
+    if path is None:
+        xs = np.arange(0.0, 1.51, 0.05)
+        path = np.stack([xs, np.zeros_like(xs), np.zeros_like(xs)], axis=1)
+    m = m or Costmap2D(200, 100, 0.05, -2.5, -2.5)
+    return CriticData(
+        poses=poses,
+        headings=np.stack([np.cos(poses[..., 2]), np.sin(poses[..., 2])], axis=-1),
+        vels=np.ascontiguousarray(vels, dtype=float),
+        robot=np.array(robot, float),
+        goal=np.array(goal, float),
+        path=path,
+        blocked=np.zeros(path.shape[0], bool),
+        furthest=path.shape[0] - 1,
+        dt=DT,
+        limits=(-0.35, 0.5, 0.5, 1.9),
+        model=DIFF_DRIVE,
+        min_turning_r=0.2,
+        costmap=m,
+        outline=outline_points(footprint_from_radius(0.2), 0.05),
+        footprint_from=1.0,
+        inscribed_radius=0.2,
+        costs=np.zeros(b),
+    )
+
+
+def score(name, data, **params):
+    cls = CRITICS[name]
+    cls(cls.Params(**params)).score(data)
+    return data.costs
+
+
+def test_constraint_critic_charges_velocity_beyond_the_limits():
+    vels = np.zeros((2, 20, 3))
+    vels[0, :, 0] = 0.5
+    vels[1, :, 0] = 0.7
+    c = score("ConstraintCritic", data_for([straight(0)] * 2, vels))
+    assert c[0] == 0.0 and c[1] == pytest.approx(4.0 * 0.2 * DT * 20)
+
+
+def test_cost_critic_prefers_free_space_and_charges_collisions():
+    m = Costmap2D(200, 100, 0.05, -2.5, -2.5)
+    m.costs[55:60, :] = 100  # y 0.25..0.5: inflated, not lethal
+    m.costs[70:75, :] = 254  # y 1.0..1.25: lethal
+    trajs = [straight(-0.5), straight(0.3), straight(1.1)]
+    d = data_for(trajs, m=m)
+    c = score("CostCritic", d, trajectory_point_step=1)
+    assert c[0] == 0.0
+    assert c[1] == pytest.approx(3.81 / 254.0 * 100.0)
+    assert c[2] == pytest.approx(1e6) and not d.fail
+    d = data_for([straight(1.1)] * 2, m=m)
+    score("CostCritic", d)
+    assert d.fail  # every sample collides
+    # with the footprint: a centre in free space whose outline touches the lethal row
+    d = data_for([straight(0.85)], m=m)
+    m.costs[66:70, :] = 50
+    assert score("CostCritic", d, consider_footprint=True)[0] == pytest.approx(1e6)
+    d = data_for([straight(0.85)], m=m)
+    assert score("CostCritic", d, consider_footprint=False)[0] < 1.0
+
+
+def test_obstacles_critic_repels_from_inflation_and_charges_collisions():
+    m = Costmap2D(200, 100, 0.05, -2.5, -2.5)
+    m.costs[55:60, :] = 30
+    m.costs[60:65, :] = 200
+    m.costs[70:75, :] = 254
+    d = data_for([straight(-0.5), straight(0.3), straight(0.6), straight(1.1)], m=m)
+    c = score("ObstaclesCritic", d)
+    assert c[0] == 0.0 and 0.0 < c[1] < c[2] < 1e4 and c[3] >= 1e4
+
+
+def test_goal_critics_score_only_near_the_goal():
+    trajs = [straight(0.0), straight(0.5)]
+    far = data_for(trajs, goal=(5.0, 0.0, 0.0))
+    assert np.all(score("GoalCritic", far) == 0.0)
+    near = data_for(trajs, goal=(1.0, 0.0, 0.0))
+    c = score("GoalCritic", near)
+    mean0 = np.mean(np.hypot(trajs[0][:, 0] - 1.0, trajs[0][:, 1]))
+    assert c[0] == pytest.approx(5.0 * mean0) and c[1] > c[0]
+    near = data_for([straight(0.0, 0.1), straight(0.0, 0.5)], goal=(0.3, 0.0, 0.0))
+    c = score("GoalAngleCritic", near)
+    assert c[0] == pytest.approx(3.0 * 0.1) and c[1] == pytest.approx(3.0 * 0.5)
+    assert np.all(score("GoalAngleCritic", data_for(trajs)) == 0.0)
+
+
+def test_path_align_critic_charges_distance_from_the_path():
+    # 1 m/s: the poses fall on the path's 5 cm points (the distance is to the nearest point)
+    d = data_for([straight(0.0, v=1.0), straight(0.1, v=1.0), straight(-0.3, v=1.0)])
+    c = score("PathAlignCritic", d, trajectory_point_step=1)
+    assert c[0] == pytest.approx(0.0, abs=1e-12)
+    assert c[1] == pytest.approx(10.0 * 0.1) and c[2] == pytest.approx(10.0 * 0.3)
+    d = data_for([straight(0.1)])
+    d.furthest = 5  # not yet tracking the path: offset_from_furthest 20
+    assert score("PathAlignCritic", d)[0] == 0.0
+    d = data_for([straight(0.1)])
+    d.blocked[:5] = True  # 5 of 31 points blocked > 7 %
+    assert score("PathAlignCritic", d)[0] == 0.0
+
+
+def test_path_follow_critic_pulls_towards_a_point_ahead():
+    d = data_for([straight(0.0), straight(0.4)])
+    d.furthest = 10
+    c = score("PathFollowCritic", d)
+    target = d.path[16]
+    ends = d.poses[:, -1, :2]
+    assert c == pytest.approx(5.0 * np.hypot(*(ends - target[:2]).T))
+    assert c[0] < c[1]
+    d.blocked[16:20] = True  # a blocked target moves on past the obstacle
+    d.costs[:] = 0.0
+    c2 = score("PathFollowCritic", d)
+    assert c2[0] == pytest.approx(5.0 * np.hypot(*(ends[0] - d.path[20, :2])))
+
+
+def test_path_angle_critic_turns_a_robot_facing_away():
+    toward = data_for([straight(0.0, 0.0), straight(0.0, 1.2)], robot=(0.0, 0.0, 0.0))
+    assert np.all(score("PathAngleCritic", toward) == 0.0)  # robot already faces the path
+    away = data_for([straight(0.0, 0.0), straight(0.0, 1.2)], robot=(0.0, 0.0, 1.5))
+    c = score("PathAngleCritic", away)
+    assert 0.0 <= c[0] < c[1]
+    c = score("PathAngleCritic", data_for([straight(0.0, math.pi)], robot=(0.0, 0.0, math.pi)),
+              forward_preference=False)  # fmt: skip
+    assert c[0] == 0.0  # reversing along the path is fine without a forward preference
+
+
+def test_prefer_forward_and_twirling_critics():
+    vels = np.zeros((2, 20, 3))
+    vels[0, :, 0] = 0.3
+    vels[1, :, 0] = -0.2
+    vels[1, :, 2] = 0.5
+    d = data_for([straight(0.0)] * 2, vels)
+    c = score("PreferForwardCritic", d)
+    assert c[0] == 0.0 and c[1] == pytest.approx(5.0 * 0.2 * 20 * DT)
+    d = data_for([straight(0.0)] * 2, vels)
+    c = score("TwirlingCritic", d)
+    assert c[0] == 0.0 and c[1] == pytest.approx(10.0 * 0.5)
+    d = data_for([straight(0.0)] * 2, vels)
+    c = score("TwirlingCritic", d, cost_power=2)
+    assert c[1] == pytest.approx((10.0 * 0.5) ** 2)
+
+
+def test_every_critic_has_nav2_defaults_declared():
+    assert set(CRITICS) == {
+        "ConstraintCritic", "CostCritic", "ObstaclesCritic", "GoalCritic", "GoalAngleCritic",
+        "PathAlignCritic", "PathFollowCritic", "PathAngleCritic", "PreferForwardCritic",
+        "TwirlingCritic",
+    }  # fmt: skip
+    assert cp.CostCriticParams().critical_cost == 300.0
+    assert cp.CostCriticParams().collision_cost == 1e6
+    assert cp.PathAlignCriticParams().max_path_occupancy_ratio == 0.07
+    assert cp.GoalCriticParams().threshold_to_consider == 1.4

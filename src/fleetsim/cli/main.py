@@ -38,6 +38,7 @@ SUBAPPS = [
     ("fleetsim.cli.tools", "node_app", "node", "Nodes: list them, or run one in this process."),
     ("fleetsim.cli.tools", "tf_app", "tf", "tf of a running simulation: echo, tree."),
     ("fleetsim.cli.arm", "app", "arm", "Arms: planning groups, named poses, move_group goals."),
+    ("fleetsim.cli.batch", "app", "batch", "Sweeps of scenarios, args and seeds on Ray; reports."),
 ]
 # modules with a register(app) function that add single commands
 COMMANDS = ["fleetsim.cli.render", "fleetsim.cli.launch", "fleetsim.cli.tools"]

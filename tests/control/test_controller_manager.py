@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 
 from fleetsim.control.spawner import Spawner
+from fleetsim.control.trajectory import sample
 from fleetsim.errors import ControlError
 from fleetsim.msgs import control_msgs, sensor_msgs, trajectory_msgs
 from fleetsim.msgs import controller_manager_msgs as cmm
@@ -81,6 +82,31 @@ def test_the_manual_gains_reach_a_pose_and_settle(hunters):
     np.testing.assert_allclose(hunters.cm("hunter1").hw.positions(ARM), CAM_LOW, atol=0.01)
     np.testing.assert_allclose(hunters.cm("hunter2").hw.positions(ARM), HOME, atol=0.01)
     assert np.abs(hunters.cm("hunter1").hw.velocities(ARM)).max() < 0.01
+
+
+def test_a_new_trajectory_joins_from_the_desired_state(hunters):
+    """As ros_controllers' JTC: on start the controller holds the measured position; a goal
+    arriving mid-trajectory is bridged from the current trajectory's desired state (not from
+    where the lagging arm is), so the setpoint never jumps."""
+    hunters.rt.run(0.3)
+    jtc = hunters.cm("hunter1").controllers["arm_group_controller"]
+    hw = hunters.cm("hunter1").hw
+    assert len(jtc.traj.times) == 1  # holding where the arm was when it started
+    np.testing.assert_allclose(jtc.traj.positions[0], hw.positions(ARM), atol=0.02)
+    action = "/hunter1/arm_group_controller/follow_joint_trajectory"
+    q0 = hw.positions(ARM)
+    hunters.follow(action, ARM, [(2.0, CAM_LOW, [0.0] * 4)])
+    hunters.rt.run(1.0)
+    first = jtc.traj
+    hunters.follow(action, ARM, [(2.0, HOME, [0.0] * 4)])
+    hunters.rt.run(0.02)
+    bridge = jtc.traj
+    assert bridge is not first
+    t = float(bridge.times[0])
+    desired = sample(first, t)[0]
+    np.testing.assert_allclose(bridge.positions[0], desired, atol=1e-12)
+    assert np.abs(desired - hw.positions(ARM)).max() > 1e-3  # the arm lags: joining from it
+    assert np.abs(desired - q0).max() > 0.1  # would jump the setpoint
 
 
 def test_goal_rejections_and_tolerance_violations(hunters):

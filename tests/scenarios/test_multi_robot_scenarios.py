@@ -1,0 +1,123 @@
+"""Multi-robot collision avoidance, whole system (issue 18): the shipped scenarios swap_corridor
+and circle in their short versions, the lesson's three lizis swapping starts in Willow, a robot
+publishing garbage on /position_share, and the plain planner's failure the new one fixes.
+
+Pass criterion (as the scenarios' own): every robot reaches its goal (ground truth confirms it),
+no contact between robots or with a wall (`RunMonitor`), MuJoCo silent.
+"""
+
+import logging
+import math
+
+import pytest
+from nav_harness import PACKAGE, WILLOW, lesson_starts
+
+from fleetsim.cli.launch import resolve_launch_file
+from fleetsim.launch.runner import LaunchSession, load_plan
+from fleetsim.msgs import collvoid_msgs, geometry_msgs
+from fleetsim.nav.map_io import load_map
+from fleetsim.runtime import Node
+
+pytestmark = pytest.mark.scenario
+
+
+def session(name: str, **args: str) -> LaunchSession:
+    return LaunchSession(load_plan(resolve_launch_file(name), args), seed=1)
+
+
+def robot_contacts(s: LaunchSession) -> set[tuple[str, str]]:
+    """Pairs of robots touching now."""
+    engine = s.monitor.sim.engine
+    robots = {m for m, e in engine.models.items() if e.kind == "robot"}
+    return {
+        tuple(sorted((c.model1, c.model2)))
+        for c in engine.contacts()
+        if c.model1 in robots and c.model2 in robots
+    }
+
+
+def assert_clean_success(s: LaunchSession, tmp_path) -> None:
+    results = s.monitor.results()
+    assert s.monitor.success(), results
+    for r in results:
+        assert r.goals_reached == 1 and r.collisions == 0, r
+    engine = s.monitor.sim.engine
+    assert {i: w.number for i, w in enumerate(engine.data.warning) if w.number} == {}
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+
+
+class Garbage(Node):
+    """Two broken robots on /position_share: a NaN pose and an empty footprint, at 10 Hz."""
+
+    def __init__(self, runtime):
+        super().__init__(runtime, "garbage", "/")
+        self.pub = self.create_publisher(collvoid_msgs.PoseTwistWithCovariance, "/position_share")
+        self.create_timer(0.1, self.tick)
+
+    def tick(self):
+        nan = collvoid_msgs.PoseTwistWithCovariance(robot_id="ghost", radius=0.3)
+        nan.header.stamp = self.now_msg()
+        nan.pose.pose.position = geometry_msgs.Point(x=math.nan, y=2.0)
+        nan.footprint.polygon.points = [geometry_msgs.Point32(x=1.0)] * 4
+        hollow = collvoid_msgs.PoseTwistWithCovariance(robot_id="hollow", radius=0.3)
+        hollow.header.stamp = self.now_msg()
+        hollow.pose.pose.position = geometry_msgs.Point(x=7.0, y=2.0)
+        self.pub.publish(nan)
+        self.pub.publish(hollow)
+
+
+def test_swap_corridor_two_robots_pass_despite_a_broken_robot_on_the_topic(
+    monkeypatch, tmp_path, caplog
+):
+    monkeypatch.chdir(tmp_path)  # where MuJoCo would write MUJOCO_LOG.TXT
+    caplog.set_level(logging.WARNING)
+    with session("swap_corridor", robots="2", gui="false") as s:
+        Garbage(s.runtime)
+        s.run(duration=60.0, until_goals=True)
+        assert_clean_success(s, tmp_path)
+        assert s.runtime.now() < 2.0 + 1.5 * 21.0  # makespan <= 1.5 x the ~21 s alone
+    for bad, why in (("ghost", "non-finite pose"), ("hollow", "empty or invalid footprint")):
+        said = [r.getMessage() for r in caplog.records if f"'{bad}'" in r.getMessage()]
+        assert said and all(why in m for m in said)
+        # once per listening node (each robot's move_base), not once per message
+        assert len(said) == 2, said
+
+
+def test_circle_of_eight_reaches_the_antipodes(monkeypatch, tmp_path):
+    monkeypatch.chdir(tmp_path)
+    with session("circle", robots="8", gui="false") as s:
+        s.run(duration=60.0, until_goals=True)
+        assert_clean_success(s, tmp_path)
+
+
+def test_plain_trajectory_planner_runs_into_the_other_robot(monkeypatch, tmp_path):
+    """The failure this issue fixes: lizis cannot see each other (their lasers sweep above the
+    other bodies), so with TrajectoryPlannerROS the corridor swap ends in a collision."""
+    monkeypatch.chdir(tmp_path)
+    with session("swap_corridor", robots="2", planner="trajectory", gui="false") as s:
+        s.runtime.run(duration=40.0, until=lambda: bool(robot_contacts(s)))
+        assert robot_contacts(s) == {("lizi1", "lizi2")}
+
+
+def test_lesson_lizis_swap_starts_in_willow(monkeypatch, tmp_path):
+    monkeypatch.chdir(tmp_path)
+    starts = lesson_starts(load_map(WILLOW))
+    args = {f"{k}{i}": str(v) for i, st in enumerate(starts, 1) for k, v in zip("xy", st[:2])}
+    launch = PACKAGE / "launch" / "collvoid_swap.launch"
+    with LaunchSession(load_plan(launch, args), seed=1) as s:
+        s.run(duration=60.0, until_goals=True)
+        assert_clean_success(s, tmp_path)
+        goals = {r.namespace: r.goal for r in s.monitor.results()}
+        assert goals["/lizi1"] == pytest.approx(starts[2][:2])
+        assert goals["/lizi2"] == pytest.approx(starts[0][:2])
+
+
+def test_the_scenarios_are_shipped_and_refuse_other_robot_counts():
+    from fleetsim.cli.launch import scenarios
+    from fleetsim.errors import LaunchError
+
+    assert {"swap_corridor", "circle"} <= set(scenarios())
+    with pytest.raises(LaunchError, match="robots_must_be_2_or_4"):
+        load_plan(resolve_launch_file("swap_corridor"), {"robots": "3"})
+    with pytest.raises(LaunchError, match="robots_must_be_8_or_16"):
+        load_plan(resolve_launch_file("circle"), {"robots": "5"})

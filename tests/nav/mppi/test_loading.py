@@ -37,14 +37,14 @@ def test_critics_load_in_order_with_their_blocks_and_prefix():
 @pytest.mark.parametrize(
     ("ns", "match"),
     [
-        ({"critics": ["CostCritic", "GoalCritc"]}, r"'critics' names 'GoalCritc'.*did you mean 'GoalCritic'"),
+        ({"critics": ["CostCritic", "GoalCritc"]}, r"'critics' names 'GoalCritc'.*'GoalCritic'"),
         ({"critics": CRITICS, "temperature": -0.1}, r"'temperature' = -0.1 is out of range"),
         ({"critics": CRITICS, "batch_size": 0}, r"'batch_size' = 0 is out of range"),
         ({"critics": CRITICS, "motion_model": "Diff"}, r"'motion_model' must be one of"),
         ({"critics": []}, r"'critics' is empty"),
         ({}, r"'critics' is empty"),
         ({"critics": CRITICS, "vx_min": 1.0}, r"'vx_min' = 1.0 exceeds vx_max"),
-        ({"critics": CRITICS, "CostCritic": {"cost_power": 0}}, r"CostCritic: parameter 'cost_power' = 0"),
+        ({"critics": CRITICS, "CostCritic": {"cost_power": 0}}, r"CostCritic: .*'cost_power' = 0"),
         ({"critics": CRITICS, "GoalCritic": 3}, r"GoalCritic: the critic's parameters must be"),
         ({"critics": CRITICS, "enforce_path_inversion": True}, r"'enforce_path_inversion'"),
     ],

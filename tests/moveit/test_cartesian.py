@@ -108,3 +108,15 @@ def test_cartesian_path_follows_a_straight_line_and_reports_the_fraction(arm):
     assert len(traj.joint_trajectory.points) >= 2
     with pytest.raises(MoveItCommanderException, match="eef_step must be > 0"):
         a.compute_cartesian_path([far], 0.0, 0.0)
+    # the service itself: bad requests come back as error codes
+    srv = "/hunter1/compute_cartesian_path"
+    for fields, code in (
+        ({"group_name": "gripper", "waypoints": [far]}, E.INVALID_GROUP_NAME),
+        ({"link_name": "nowhere", "waypoints": [far]}, E.INVALID_LINK_NAME),
+        ({"waypoints": []}, E.INVALID_GOAL_CONSTRAINTS),
+    ):
+        req = moveit_msgs.GetCartesianPathRequest(
+            **{"group_name": "arm_group", "max_step": 0.01, **fields}
+        )
+        res = h.rt.graph.call_service(srv, moveit_msgs.GetCartesianPath, req)
+        assert res.error_code.val == code, fields

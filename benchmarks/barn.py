@@ -22,6 +22,10 @@ script does (the startup of the stack is not navigation time).
     PYTHONPATH=src .venv/bin/python benchmarks/barn.py               # a handful of worlds
     PYTHONPATH=src .venv/bin/python benchmarks/barn.py --worlds 3,9,15
     PYTHONPATH=src .venv/bin/python benchmarks/barn.py --all
+    PYTHONPATH=src .venv/bin/python benchmarks/barn.py --controller mppi --worlds 3,9
+
+``--controller mppi`` loads ``params/jackal/mppi_params.yaml`` into move_base's namespace on top
+of the launch file's (base_local_planner ``nav2_mppi_controller::MPPIController``).
 """
 
 from __future__ import annotations
@@ -36,10 +40,12 @@ from pathlib import Path
 
 import numpy as np
 
+from fleetsim.launch.model import ParamOp
 from fleetsim.launch.packages import ASSETS
 from fleetsim.launch.runner import LaunchSession, load_plan
 from fleetsim.msgs import nav_msgs
 from fleetsim.runtime import Node
+from fleetsim.runtime.params import load_yaml_file
 
 #: the shared data folder beside the repository (../shared from its root)
 SHARED = Path(__file__).resolve().parents[1].parent / "shared"
@@ -53,6 +59,8 @@ TIME_LIMIT = 100.0  # s of sim time
 MOVED = 0.1  # m from the start: the clock starts
 CHECK_PERIOD = 0.1  # s of sim time between checks of the run's state
 DEFAULT_WORLDS = (3, 51, 99, 153, 201, 249)
+#: local planner -> a params file loaded into /jackal/move_base after the launch file's (or None)
+CONTROLLERS = {"dwa": None, "mppi": ASSETS / "launch" / "params" / "jackal" / "mppi_params.yaml"}
 
 
 def path_from_grid(grid_path: np.ndarray) -> np.ndarray:
@@ -107,8 +115,20 @@ class RunResult:
         return self.outcome == "success"
 
 
+def with_controller(plan, controller: str):
+    """``plan`` with the local planner ``controller`` (a `CONTROLLERS` key) for the jackal."""
+    extra = CONTROLLERS[controller]
+    if extra is not None:
+        plan.params.append(ParamOp("load", "/jackal/move_base", load_yaml_file(extra), str(extra)))
+    return plan
+
+
 def run_world(
-    world: int, barn_dir: Path = BARN_DIR, seed: int = 0, time_limit: float = TIME_LIMIT
+    world: int,
+    barn_dir: Path = BARN_DIR,
+    seed: int = 0,
+    time_limit: float = TIME_LIMIT,
+    controller: str = "dwa",
 ) -> RunResult:
     """One run of the protocol on world ``world``."""
     t_wall = time.perf_counter()
@@ -117,7 +137,8 @@ def run_world(
     # barn.launch's barn_dir default is $(env FLEETSIM_BARN_DIR), which roslaunch resolves even
     # when the arg is given: set it too
     os.environ["FLEETSIM_BARN_DIR"] = str(barn_dir)
-    session = LaunchSession(load_plan(LAUNCH, args, seed=seed), seed=seed, listen=None)
+    plan = with_controller(load_plan(LAUNCH, args, seed=seed), controller)
+    session = LaunchSession(plan, seed=seed, listen=None)
     try:
         rt, monitor = session.runtime, session.monitor
         truth = GroundTruth(rt)
@@ -181,6 +202,7 @@ def main() -> None:
     ap.add_argument("--all", action="store_true", help="every world in --barn-dir")
     ap.add_argument("--barn-dir", type=Path, default=BARN_DIR)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--controller", choices=sorted(CONTROLLERS), default="dwa")
     ap.add_argument("-v", "--verbose", action="store_true", help="show the nodes' log")
     a = ap.parse_args()
     logging.basicConfig(level=logging.INFO if a.verbose else logging.ERROR)
@@ -190,14 +212,14 @@ def main() -> None:
         worlds = [int(w) for w in a.worlds.split(",") if w.strip()]
     else:
         worlds = list(DEFAULT_WORLDS)
-    print(f"BARN: jackal + move_base (DWA), {len(worlds)} worlds from {a.barn_dir}")
+    print(f"BARN: jackal + move_base ({a.controller}), {len(worlds)} worlds from {a.barn_dir}")
     print(
         f"{'world':>5} {'outcome':>9} {'time s':>7} {'opt s':>6} {'metric':>6} {'gap m':>6} "
         f"{'wall s':>6}"
     )
     results = []
     for w in worlds:
-        r = run_world(w, a.barn_dir, seed=a.seed)
+        r = run_world(w, a.barn_dir, seed=a.seed, controller=a.controller)
         results.append(r)
         print(
             f"{r.world:>5} {r.outcome:>9} {r.time:7.1f} {r.optimal_time:6.2f} {r.metric:6.3f} "

@@ -46,6 +46,11 @@ from fleetsim.vision.image_transport import bgr_array, decompressed_array, gray_
 #: images before a missing camera_info is reported (the package's frameNum > 5)
 FRAMES_BEFORE_NO_INTRINSICS = 5
 
+#: what a frame without markers yields (empty, so sharing them between frames is safe)
+_NO_CORNERS = np.zeros((0, 4, 2), np.float32)
+_NO_IDS = np.zeros(0, np.int64)
+_NO_VECS = np.zeros((0, 3))
+
 
 class ArucoDetect(Node):
     """Detects ArUco markers and estimates their poses, one image at a time."""
@@ -162,9 +167,11 @@ class ArucoDetect(Node):
         """Markers in a grey image: (N, 4, 2) float32 corners and (N,) ids, ignored ids left out."""
         corners, ids, _ = self.detector.detectMarkers(gray)
         if ids is None or len(ids) == 0:
-            return np.zeros((0, 4, 2), np.float32), np.zeros(0, np.int64)
+            return _NO_CORNERS, _NO_IDS
         ids = ids.reshape(-1).astype(np.int64)
         corners = np.asarray(corners, dtype=np.float32).reshape(-1, 4, 2)
+        if not self.ignore_ids:
+            return corners, ids
         keep = np.array([i not in self.ignore_ids for i in ids], dtype=bool)
         return corners[keep], ids[keep]
 
@@ -216,6 +223,8 @@ class ArucoDetect(Node):
         self._publish_image(colour, corners, ids, poses, header)
 
     def _estimate(self, corners: np.ndarray, ids: np.ndarray):
+        if len(ids) == 0:  # most frames: nothing to solve, skip the array work
+            return [], _NO_VECS, _NO_VECS
         p: ArucoDetectParams = self.params
         lengths = np.array([self.len_override.get(int(i), p.fiducial_len) for i in ids])
         rvecs, tvecs, img_err = marker_poses(corners, lengths, self.camera_matrix, self.dist_coeffs)

@@ -121,6 +121,20 @@ class ResultsTable:
         """run_ids of the runs already in the table (finished without an error)."""
         return {r["run_id"] for r in self.rows}
 
+    def reindex(self, index_of: dict[str, int]) -> int:
+        """Renumber kept rows by their run's place in this sweep (``run_id -> run``), after a
+        resume with a changed spec; returns how many rows belong to no run of the sweep (they
+        are kept as they were)."""
+        outside = 0
+        for row in self.rows:
+            if row["run_id"] in index_of:
+                row["run"] = index_of[row["run_id"]]
+            else:
+                outside += 1
+        self._rewrite_csv()
+        self._write_parquet()
+        return outside
+
     def append(self, rows: list[dict[str, Any]]) -> None:
         """Add one run's rows to both files."""
         for row in rows:
@@ -180,7 +194,11 @@ def read_results(path: str | Path) -> pa.Table:
         # arguments stay text, as they were given on the command line
         with path.open(newline="") as f:
             header = next(csv.reader(f), [])
-        types = {c: pa.string() for c in header if c.startswith(ARG_PREFIX)}
-        types.update({"run_id": pa.string(), "error": pa.string(), "last_status": pa.string()})
-        return pacsv.read_csv(path, convert_options=pacsv.ConvertOptions(column_types=types))
+        known = {**RUN_COLUMNS, **ROBOT_COLUMNS, **TAIL_COLUMNS}
+        types = {c: TYPES[known[c]] for c in header if c in known}
+        types.update({c: pa.string() for c in header if c.startswith(ARG_PREFIX)})
+        options = pacsv.ConvertOptions(
+            column_types=types, true_values=["true"], false_values=["false"]
+        )
+        return pacsv.read_csv(path, convert_options=options)
     raise BatchError(f"{path}: batch results are a .parquet or .csv file, or their folder")

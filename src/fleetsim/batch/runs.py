@@ -149,6 +149,10 @@ def run_batch(
         if name is not None:
             metric_cols.update(metrics_class(name).columns)
     table = ResultsTable(outdir, columns_for(list(spec.args), metric_cols), resume=resume)
+    if resume:
+        outside = table.reindex({r.run_id: r.index for r in runs})
+        if outside:
+            _log.warning(f"{outdir}: kept {outside} rows of runs that are not in this sweep")
     done = table.finished()
     todo = [r for r in runs if r.run_id not in done]
     workers = workers or default_workers()

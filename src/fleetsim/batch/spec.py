@@ -20,6 +20,7 @@ distinct argument combination is loaded once (so a missing file shows up now, no
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import itertools
 import json
@@ -258,7 +259,10 @@ def validate(spec: BatchSpec) -> list[RunSpec]:
         for combo in itertools.product(*(spec.args[n] for n in names)):
             args = dict(zip(names, combo))
             try:
-                load_plan(path, args, seed=spec.seeds[0])
+                # relative paths in a launch file are read from the working directory, as the
+                # runs will read them
+                with contextlib.chdir(spec.workdir):
+                    load_plan(path, args, seed=spec.seeds[0])
             except FleetsimError as e:
                 raise BatchError(f"{spec.source}: scenario '{scenario}' with {args}: {e}") from e
     return spec.runs()

@@ -127,6 +127,9 @@ def report_cmd(
             *g.key, str(g.rows), str(g.errors), rate, ci, f"{g.median_time:.1f}",
             f"{g.median_path:.2f}", *(f"{g.metrics[m]:.3f}" for m in metric_names),
         )  # fmt: skip
-    Console().print(t)
+    out_console = Console()
+    if not out_console.is_terminal:  # piped or captured: no terminal width to wrap to
+        out_console = Console(width=200)
+    out_console.print(t)
     for f in files:
         console.print(f"wrote {f}")

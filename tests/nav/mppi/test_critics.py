@@ -175,3 +175,17 @@ def test_every_critic_has_nav2_defaults_declared():
     assert cp.CostCriticParams().collision_cost == 1e6
     assert cp.PathAlignCriticParams().max_path_occupancy_ratio == 0.07
     assert cp.GoalCriticParams().threshold_to_consider == 1.4
+
+
+def test_a_free_centre_with_a_corner_on_an_obstacle_collides_when_every_pose_is_checked():
+    m = Costmap2D(200, 100, 0.05, -2.5, -2.5)
+    m.costs[70:75, :] = 254  # y 1.0..1.25: lethal, no inflation around it
+    corner = np.array([[-0.3, -0.3], [-0.3, 0.3], [0.3, 0.3], [0.3, -0.3]])
+    d = data_for([straight(0.75)], m=m)  # centre 0.25 m from the row, corners 0.3 m out
+    d.outline = outline_points(corner, 0.05)
+    d.footprint_from = 0.0  # inflation short of the circumscribed radius: check every pose
+    assert score("CostCritic", d, consider_footprint=True)[0] == pytest.approx(1e6)
+    d = data_for([straight(0.75)], m=m)
+    d.outline = outline_points(corner, 0.05)
+    d.footprint_from = 1.0  # only from inflated centres: this pose's centre is free
+    assert score("CostCritic", d, consider_footprint=True)[0] == 0.0

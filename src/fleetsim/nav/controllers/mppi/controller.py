@@ -56,18 +56,23 @@ PLUGIN = "nav2_mppi_controller::MPPIController"
 
 def footprint_check_cost(costmap_ros: Any, layer_name: str = "") -> float:
     """The centre cost from which a footprint can touch an obstacle: the inflation layer's
-    cost at the circumscribed radius (Nav2's possibly_inscribed_cost); 1 (every inflated cell)
-    when the costmap has no inflation layer or does not inflate that far."""
+    cost at the circumscribed radius (Nav2's possibly_inscribed_cost). 0 (every pose checked)
+    when the costmap has no inflation layer or inflates less than the circumscribed radius: a
+    pose whose centre is on a free cell can then still have a corner on an obstacle (Nav2
+    only warns about that; a BARN jackal, 0.41 m to its padded corners with 0.30 m inflation,
+    reversed a corner into a post)."""
     layered = getattr(costmap_ros, "layered", None)
     if layered is None:
-        return 1.0
+        return 0.0
     layers = [la for la in layered.layers if isinstance(la, InflationLayer)]
     if layer_name:
         layers = [la for la in layers if la.name == layer_name]
     if not layers:
-        return 1.0
+        return 0.0
     ip = layers[-1].params
     res = layered.costmap.resolution
+    if ip.inflation_radius < layered.circumscribed_radius:
+        return 0.0
     c = costs_from_distances(
         np.array([layered.circumscribed_radius / res]), res, layered.inscribed_radius,
         ip.inflation_radius, ip.cost_scaling_factor,
@@ -93,7 +98,7 @@ class MPPIController(LocalPlanner):
         critics: list[Critic],
         rng: np.random.Generator,
         ackermann: AckermannConstraints | None = None,
-        footprint_from: float = 1.0,
+        footprint_from: float = 0.0,
     ) -> None:
         self.costmap = costmap
         self.params = p = params

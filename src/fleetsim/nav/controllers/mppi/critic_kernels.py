@@ -22,10 +22,15 @@ def _wrap(a):
 
 @njit(cache=True)
 def pose_cost(costs, ox, oy, res, outline, footprint_from, x, y, c, s):
-    """The cost of one pose (heading cos ``c``, sin ``s``): its centre cell's, or the highest
-    under its footprint outline when the centre's is at least ``footprint_from`` (< 0: never).
-    `COLLISION` for a lethal cell (or an inscribed one, by the centre alone) or off the grid;
-    NO_INFORMATION (255) is passable (Nav2 with unknown space tracked)."""
+    """The cost of one pose (heading cos ``c``, sin ``s``): its centre cell's, or `COLLISION`.
+
+    A lethal centre cell or one off the grid is a collision; so is an inscribed one unless
+    the footprint is checked (``footprint_from`` >= 0). From a centre cost of
+    ``footprint_from`` up, the footprint's outline is laid on the grid and any lethal cell (or
+    grid edge) under it is a collision. The graded cost stays the centre's: the inflation
+    layer's costs are distances from the centre (an outline cell at 253 only says an obstacle
+    is within the inscribed radius of the robot's edge, and in clutter nearly every pose's
+    outline has one). NO_INFORMATION (255) is passable (Nav2 with unknown space tracked)."""
     h, w = costs.shape
     fx = (x - ox) / res
     fy = (y - oy) / res
@@ -36,20 +41,14 @@ def pose_cost(costs, ox, oy, res, outline, footprint_from, x, y, c, s):
         return COLLISION
     if footprint_from < 0.0:
         return COLLISION if v == 253 else float(v)
-    worst = float(v)
     if v < footprint_from or v == 255:
-        return worst
+        return float(v)
     for k in range(outline.shape[0]):
         fx = (x + c * outline[k, 0] - s * outline[k, 1] - ox) / res
         fy = (y + s * outline[k, 0] + c * outline[k, 1] - oy) / res
-        if fx < 0.0 or fy < 0.0 or fx >= w or fy >= h:
+        if fx < 0.0 or fy < 0.0 or fx >= w or fy >= h or costs[int(fy), int(fx)] == 254:
             return COLLISION
-        u = costs[int(fy), int(fx)]
-        if u == 254:
-            return COLLISION
-        if u != 255 and u > worst:
-            worst = float(u)
-    return worst
+    return float(v)
 
 
 @njit(cache=True)

@@ -8,9 +8,9 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    ``max_error_holo`` at full speed);
 2. the preferred velocity points at a carrot ``carrot_distance`` m along the global plan, at
    ``max_vel_x``, slowing at a quarter of ``acc_lim_x`` (not below ``min_vel_x``) to stop at
-   the goal; while another robot is ahead, nearer than the goal, it is turned by ``left_pref``
-   rad (negative: keep right), which breaks the symmetry of head-on meetings that plain ORCA
-   cannot;
+   the goal; while another robot ahead, nearer than the goal, is closing in, it is turned by
+   ``left_pref`` rad (negative: keep right), which breaks the symmetry of head-on meetings that
+   plain ORCA cannot;
 3. the `DeadlockRule` may make the robot yield: back off to the right, away from a robot with
    priority, taking full responsibility for avoiding it;
 4. ORCA half-planes (`fleetsim.nav.multirobot.orca`): one per robot on ``/position_share``
@@ -192,6 +192,7 @@ class CollvoidLocalPlanner(LocalPlanner):
         radii = np.zeros(0)
         resp = np.zeros(0)
         ids: list[str] = []
+        controlled = np.zeros(0, dtype=bool)
         speed = float(np.hypot(*vel))
         map_xy = xy
         if tx is not None:
@@ -207,17 +208,19 @@ class CollvoidLocalPlanner(LocalPlanner):
             radii = near.radii
             still = np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED
             resp = np.where(~near.controlled | still, 1.0, 0.5)
+            controlled = near.controlled
         own_r = self.own_radius(speed, map_xy)
         dist = np.hypot(pos[:, 0] - xy[0], pos[:, 1] - xy[1])
-        self.yielding_to = self.deadlock.update(now, remaining, dict(zip(ids, dist.tolist())))
+        active = {k: d for k, d, c in zip(ids, dist.tolist(), controlled) if c}
+        self.yielding_to = self.deadlock.update(now, remaining, active)
         if self.yielding_to is not None:
             k = ids.index(self.yielding_to)
             resp[k] = 1.0
             away = xy - pos[k]
             away = away / max(float(np.hypot(*away)), 1e-9)
             pref = rotated(away, -math.pi / 3) * (0.5 * p.max_vel_x)
-        elif ids and (((pos - xy) @ pref > 0) & (dist < remaining + own_r)).any():
-            pref = rotated(pref, p.left_pref)  # a robot ahead, between us and the goal
+        elif ids and self._oncoming(pos - xy, nvel - vel, pref, dist, remaining + own_r).any():
+            pref = rotated(pref, p.left_pref)
         lines_p, lines_d = [], []
         obst = obstacle_points(
             self.costmap.costs,
@@ -260,6 +263,14 @@ class CollvoidLocalPlanner(LocalPlanner):
         )
         self.last_holo = holo
         return holo
+
+    @staticmethod
+    def _oncoming(rel, rel_vel, pref, dist, reach) -> np.ndarray:
+        """(N,) robots ahead (along ``pref``), nearer than ``reach`` m, moving and closing in:
+        the meetings keeping right resolves (a robot parked ahead is simply avoided)."""
+        moving = np.hypot(rel_vel[:, 0], rel_vel[:, 1]) >= STILL_SPEED
+        closing = np.einsum("ij,ij->i", rel, rel_vel) < 0.0
+        return (rel @ pref > 0) & (dist < reach) & moving & closing
 
     def _track(self, holo: np.ndarray, pose, velocity) -> VelocityCommand:
         p, yaw = self.params, pose[2]

@@ -8,9 +8,11 @@ measurement with RVO2: exact head-on pairs and 0.6 m corridors never finish). Ea
 1. progress is the remaining distance to the goal; when it has not shrunk by
    ``deadlock_progress`` m for ``deadlock_time`` s while another robot is within
    ``deadlock_radius`` m, the robot is *stuck*;
-2. a stuck robot looks at the robots around it: priority goes by robot id (natural order, so
-   ``lizi2`` before ``lizi10``); every robot sees the same ids, so all reach the same verdict
-   without talking. If one of them has priority over it, it *yields* to the nearest such robot
+2. a stuck robot looks at the robots around it that are navigating (``controlled`` on
+   /position_share; a robot parked at its goal will not move, waiting for it is pointless):
+   priority goes by robot id (natural order, so ``lizi2`` before ``lizi10``); every robot sees
+   the same ids, so all reach the same verdict without talking. If one of them has priority
+   over it, it *yields* to the nearest such robot
    for ``yield_time`` s: it backs away from it, off to its right, and takes full
    responsibility for avoiding it (the priority robot keeps its half and drives on);
 3. after yielding, the progress clock restarts, so a robot that is still stuck yields again.
@@ -54,7 +56,8 @@ class DeadlockRule:
     def update(self, now: float, remaining: float, nearby: dict[str, float]) -> str | None:
         """The robot to yield to this cycle, or None.
 
-        remaining : m to the goal; nearby : robot id -> distance (m) of the robots around.
+        remaining : m to the goal; nearby : robot id -> distance (m) of the navigating robots
+        around.
         """
         if remaining < self.best - self.deadlock_progress:
             self.best, self.best_time = remaining, now

@@ -29,7 +29,7 @@ def plan_carrot(
     """The plan point ``lookahead`` m along the plan past the point nearest ``xy``.
 
     plan_xy : (N, 2) plan points, m. Returns (carrot (2,), index of the nearest point,
-    path length from that point to the plan's end, m).
+    distance to that point plus the plan's length from it to its end, m).
     """
     d = np.hypot(plan_xy[:, 0] - xy[0], plan_xy[:, 1] - xy[1])
     i = int(np.argmin(d))
@@ -37,7 +37,7 @@ def plan_carrot(
     along = np.concatenate([[0.0], np.cumsum(seg)])
     j = i + int(np.searchsorted(along, lookahead, side="left"))
     j = min(j, plan_xy.shape[0] - 1)
-    return plan_xy[j], i, float(along[-1])
+    return plan_xy[j], i, float(d[i] + along[-1])
 
 
 def preferred_velocity(
@@ -114,8 +114,9 @@ def tracking_command(
 
     Heading error θ: turn at θ / time_to_holo (clamped to max_vel_theta); drive at
     ``|v_holo| θ sin θ / (2 (1 - cos θ))``, the speed whose arc over the turn ends where the
-    holonomic motion would (NH-ORCA), i.e. |v_holo| when θ = 0 and 0 from θ = π/2 on (turn in
-    place first).
+    holonomic motion would (NH-ORCA), i.e. |v_holo| when θ = 0. Where the turn would need more
+    than max_vel_theta (|θ| > max_vel_theta * time_to_holo) that speed fades linearly to a turn
+    in place at twice that error (and always from θ = π/2 on).
     """
     speed = float(np.hypot(*v_holo))
     if speed < 1e-4:
@@ -128,6 +129,12 @@ def tracking_command(
         v = speed
     else:
         v = speed * theta * math.sin(theta) / (2.0 * (1.0 - math.cos(theta)))
+    # the base turns at most max_vel_theta: a heading error it cannot close within
+    # time_to_holo slows it down, to a turn in place at twice that error (else, near a goal,
+    # it circles the goal on a turning circle wider than the distance left)
+    reach = max_vel_theta * time_to_holo
+    if abs(theta) > reach:
+        v *= max(0.0, 2.0 - abs(theta) / reach)
     return min(max(v, 0.0), max_vel_x), w
 
 

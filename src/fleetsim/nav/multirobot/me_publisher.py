@@ -11,7 +11,10 @@ and publishes a `collvoid_msgs.PoseTwistWithCovariance`:
   particles lie, capped at twice the robot radius (`uncertainty_radius`). fake_localization's
   cloud is the one true pose, so the uncertainty is zero, as it is before any cloud arrives;
 * ``pose`` (map frame, with the particle spread's x/y covariance), ``twist`` (``odom``'s
-  twist, base frame) and ``holonomic_velocity`` (that velocity turned into the map frame).
+  twist, base frame) and ``holonomic_velocity`` (that velocity turned into the map frame);
+* ``controlled``: ``~controlled``, and - once ``move_base/status`` has been heard - only while
+  move_base has a goal pending or active. A robot parked at its goal does not avoid anyone, so
+  the others take the whole avoidance on themselves and do not wait for it to yield.
 """
 
 from __future__ import annotations
@@ -23,7 +26,7 @@ from typing import Any
 import numpy as np
 
 from fleetsim.errors import TransformError
-from fleetsim.msgs import collvoid_msgs, geometry_msgs, nav_msgs
+from fleetsim.msgs import actionlib_msgs, collvoid_msgs, geometry_msgs, nav_msgs
 from fleetsim.nav.costmap.footprint import (
     footprint_from_param,
     footprint_from_radius,
@@ -81,10 +84,14 @@ class MePublisher(Node):
         self.global_frame = normalize_frame(p.global_frame)
         self._particles: np.ndarray | None = None
         self._body_vel = (0.0, 0.0, 0.0)
+        self._navigating: bool | None = None  # None until move_base/status is heard
         self._started = self.now()
         self.pub = self.create_publisher(collvoid_msgs.PoseTwistWithCovariance, TOPIC, 10)
         self.create_subscription(geometry_msgs.PoseArray, "particlecloud", self.on_cloud, 1)
         self.create_subscription(nav_msgs.Odometry, "odom", self.on_odom, 1)
+        self.create_subscription(
+            actionlib_msgs.GoalStatusArray, "move_base/status", self.on_status, 1
+        )
         _ = self.tf_buffer
         self.create_timer(1.0 / p.publish_me_frequency, self.publish_me)
 
@@ -96,6 +103,15 @@ class MePublisher(Node):
     def on_odom(self, msg: Any) -> None:
         t = msg.twist.twist
         self._body_vel = (t.linear.x, t.linear.y, t.angular.z)
+
+    def on_status(self, msg: Any) -> None:
+        busy = (actionlib_msgs.GoalStatus.PENDING, actionlib_msgs.GoalStatus.ACTIVE)
+        self._navigating = any(st.status in busy for st in msg.status_list)
+
+    @property
+    def controlled(self) -> bool:
+        """Whether the robot avoids others now (see the module doc)."""
+        return self.params.controlled and self._navigating is not False
 
     def uncertainty(self, x: float, y: float) -> float:
         """The localization uncertainty radius at estimate (x, y), m (0 without a cloud)."""
@@ -121,7 +137,7 @@ class MePublisher(Node):
             robot_id=self.robot_id,
             radius=footprint_radii(fp)[1],
             holo_robot=self.params.holo_robot,
-            controlled=self.params.controlled,
+            controlled=self.controlled,
         )
         msg.header.stamp = self.now_msg()
         msg.header.frame_id = self.global_frame

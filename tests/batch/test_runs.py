@@ -1,39 +1,14 @@
-"""Batches on an embedded Ray: the same table serially and on 2 workers, resume, faults.
-
-Each run is ``fixtures/tiny.launch`` (a lizi driven on an empty world) for 1.5 s of sim time;
-its speed is the swept argument, with a few percent drawn from the seed, so every run's path
-length differs and a mixed-up row would show.
-"""
+"""Batches on an embedded Ray: the same table serially and on 2 workers, resume, faults
+(the tiny sweep of conftest.py)."""
 
 from pathlib import Path
 
 import pytest
+from batch_sweep import FIXTURES, comparable, tiny_spec
 
-from fleetsim.batch import BatchSpec, run_batch
-from fleetsim.batch.results import WALL_CLOCK_COLUMNS
+from fleetsim.batch import run_batch
 
-FIXTURES = Path(__file__).parent / "fixtures"
 pytestmark = [pytest.mark.scenario, pytest.mark.timeout(300)]
-
-
-def tiny_spec(seeds=(0, 1), **kw) -> BatchSpec:
-    args = kw.pop("args", {"speed": ["0.2", "0.4"]})
-    return BatchSpec(
-        scenarios=["tiny.launch"], args=args, seeds=list(seeds), duration=1.5, timeout=60.0,
-        workdir=FIXTURES, **kw,
-    )  # fmt: skip
-
-
-def comparable(table) -> list[dict]:
-    """The table's rows without what depends on the machine (wall time, real-time factor)."""
-    return table.drop_columns(list(WALL_CLOCK_COLUMNS)).to_pylist()
-
-
-@pytest.fixture(scope="module")
-def serial(tmp_path_factory):
-    """The tiny sweep run on one worker."""
-    out = tmp_path_factory.mktemp("serial")
-    return run_batch(tiny_spec(), out, workers=1, progress=False).table()
 
 
 def test_serial_rows_are_real_runs(serial):

@@ -114,6 +114,8 @@ def _ray_init(workers: int, address: str | None, workdir: Path, outdir: Path) ->
             logging_level=logging.WARNING,
         )
     else:
+        # a Ray started for one batch reports no usage statistics unless the user asks it to
+        os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
         ray.init(
             num_cpus=workers,
             include_dashboard=False,

@@ -143,6 +143,9 @@ def run_batch(
     """Validate ``spec``, run every run not yet finished, and return the results table."""
     import ray
 
+    workers = default_workers() if workers is None else workers
+    if workers < 1:
+        raise BatchError(f"--workers must be >= 1, got {workers}")
     runs = validate(spec)
     outdir = Path(outdir)
     metric_cols: dict[str, str] = {}
@@ -157,9 +160,6 @@ def run_batch(
             _log.warning(f"{outdir}: kept {outside} rows of runs that are not in this sweep")
     done = table.finished()
     todo = [r for r in runs if r.run_id not in done]
-    workers = workers or default_workers()
-    if workers < 1:
-        raise BatchError(f"--workers must be >= 1, got {workers}")
     if not todo:
         return table
     started = _ray_init(workers, address, spec.workdir, outdir)

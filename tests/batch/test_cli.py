@@ -1,0 +1,44 @@
+"""`fleetsim batch`: bad input is a one-line error naming it, before any run (no Ray, no
+output folder)."""
+
+import re
+from pathlib import Path
+
+import pytest
+
+from fleetsim.cli.main import main
+
+FIXTURES = Path(__file__).parent / "fixtures"
+TINY = str(FIXTURES / "tiny.launch")
+
+
+@pytest.mark.parametrize(
+    ("argv", "message"),
+    [
+        (["no_such_scenario"], r"unknown scenario 'no_such_scenario'"),
+        ([TINY, "--arg", "sped=1,2"], r"declares no arg 'sped' \(did you mean 'speed'\?\)"),
+        ([TINY, "--arg", "speed=3..1"], r"arg 'speed': range '3..1' is empty"),
+        ([TINY, "--arg", "speed=1..z"], r"arg 'speed': malformed range '1..z'"),
+        ([TINY, "--arg", "speed"], r"--arg 'speed' is not of the form NAME=V1,V2"),
+        ([TINY, "--seeds", "4..2"], r"arg 'seeds': range '4..2' is empty"),
+        ([TINY, "--timeout", "0"], r"timeout must be > 0 s"),
+        ([TINY, "--workers", "0"], r"--workers must be >= 1"),
+        (["run", TINY, "--metrics", "nope"], r"unknown scenario metrics 'nope'"),
+    ],
+)
+def test_bad_input_is_named_before_any_run(argv, message, tmp_path: Path, capsys):
+    out = tmp_path / "out"
+    assert main(["batch", *argv, "-o", str(out)]) == 1
+    err = capsys.readouterr().err.replace("\n", " ")
+    assert re.search(message, err), err
+    assert not (out / "results.csv").exists()
+
+
+def test_a_spec_file_is_told_from_a_launch_file(tmp_path: Path, capsys):
+    spec = tmp_path / "sweep.yaml"
+    spec.write_text(f"scenarios: [{TINY}]\nargs: {{speed: [1, 2], spin: 0}}\n")
+    assert main(["batch", str(spec), "-o", str(tmp_path / "out")]) == 1
+    err = capsys.readouterr().err.replace("\n", " ")
+    assert "sweep.yaml: scenario" in err and "declares no arg 'spin'" in err
+    assert main(["batch", str(spec), "--arg", "speed=1"]) == 1
+    assert "is a batch spec: put --arg and --seeds in it" in capsys.readouterr().err

@@ -26,6 +26,14 @@ script does (the startup of the stack is not navigation time).
 
 ``--controller mppi`` loads ``params/jackal/mppi_params.yaml`` into move_base's namespace on top
 of the launch file's (base_local_planner ``nav2_mppi_controller::MPPIController``).
+
+``--batch OUTDIR`` runs BARN's own protocol, every world ``--runs`` times (seeds 0..runs-1), as a
+`fleetsim batch` on Ray: each run in its own process, ``--workers`` at once on this machine or
+on a cluster (``--address``); results in OUTDIR/results.parquet, plots with
+``fleetsim batch report OUTDIR``:
+
+    PYTHONPATH=src .venv/bin/python benchmarks/barn.py --all --batch barn_out           # 50 x 10
+    PYTHONPATH=src .venv/bin/python benchmarks/barn.py --worlds 3,9 --runs 2 --batch out --workers 2
 """
 
 from __future__ import annotations
@@ -40,11 +48,22 @@ from pathlib import Path
 
 import numpy as np
 
+# BARN's protocol (goal, radius, limits, reference path, metric, ground truth) is fleetsim's
+# own scenario metrics, so that `fleetsim batch` scores runs the same way as this script
+from fleetsim.batch.barn import (  # noqa: F401 (re-exported for the tests)
+    GOAL,
+    GOAL_RADIUS,
+    MOVED,
+    START,
+    TIME_LIMIT,
+    GroundTruth,
+    metric_of,
+    optimal_time_of,
+    path_from_grid,
+)
 from fleetsim.launch.model import ParamOp
 from fleetsim.launch.packages import ASSETS
 from fleetsim.launch.runner import LaunchSession, load_plan
-from fleetsim.msgs import nav_msgs
-from fleetsim.runtime import Node
 from fleetsim.runtime.params import load_yaml_file
 
 #: the shared data folder beside the repository (../shared from its root)
@@ -52,52 +71,10 @@ SHARED = Path(__file__).resolve().parents[1].parent / "shared"
 
 BARN_DIR = Path(SHARED, "data/barn")
 LAUNCH = ASSETS / "launch" / "barn.launch"
-START = (-2.25, 3.0)
-GOAL = (-2.25, 13.0)
-GOAL_RADIUS = 1.0  # m
-TIME_LIMIT = 100.0  # s of sim time
-MOVED = 0.1  # m from the start: the clock starts
 CHECK_PERIOD = 0.1  # s of sim time between checks of the run's state
 DEFAULT_WORLDS = (3, 51, 99, 153, 201, 249)
 #: local planner -> a params file loaded into /jackal/move_base after the launch file's (or None)
 CONTROLLERS = {"dwa": None, "mppi": ASSETS / "launch" / "params" / "jackal" / "mppi_params.yaml"}
-
-
-def path_from_grid(grid_path: np.ndarray) -> np.ndarray:
-    """(K + 2, 2) reference path in the world frame (m): start, the (K, 2) grid path
-    converted as the README gives it (x = 0.15 a - 4.575, y = 0.15 b + 5.075), goal."""
-    g = np.asarray(grid_path, dtype=float)
-    xy = np.column_stack([0.15 * g[:, 0] - 4.575, 0.15 * g[:, 1] + 5.075])
-    return np.vstack([START, xy, GOAL])
-
-
-def optimal_time_of(path: np.ndarray, speed: float = 2.0) -> float:
-    """Optimal time (s): length (m) of the (K, 2) path over ``speed`` (m/s)."""
-    return float(np.sum(np.hypot(*np.diff(path, axis=0).T))) / speed
-
-
-def metric_of(success: bool, actual_time: float, optimal_time: float) -> float:
-    """BARN's score of one run (0 on failure, at most 0.5)."""
-    clipped = float(np.clip(actual_time, 2.0 * optimal_time, 8.0 * optimal_time))
-    return float(success) * optimal_time / clipped
-
-
-class GroundTruth(Node):
-    """The jackal's latest ground-truth (x, y) from its p3d, and where it first was."""
-
-    def __init__(self, runtime) -> None:
-        super().__init__(runtime, "barn_ground_truth", "/")
-        self.xy: tuple[float, float] | None = None
-        self.first: tuple[float, float] | None = None
-        self.create_subscription(
-            nav_msgs.Odometry, "/jackal/ground_truth/state", self._on_state, queue_size=1
-        )
-
-    def _on_state(self, msg) -> None:
-        p = msg.pose.pose.position
-        self.xy = (p.x, p.y)
-        if self.first is None:
-            self.first = self.xy
 
 
 @dataclass
@@ -192,6 +169,85 @@ def summary(results: list[RunResult]) -> dict[str, float]:
     }
 
 
+#: a launch file (written into the batch's folder) with the jackal's local planner swapped:
+#: barn.launch, then the controller's params over move_base's (what `with_controller` does)
+CONTROLLER_LAUNCH = """<launch>
+  <arg name="world"/>
+  <arg name="barn_dir"/>
+  <arg name="gui" default="false"/>
+  <include file="$(find fleetsim_launch)/barn.launch">
+    <arg name="world" value="$(arg world)"/>
+    <arg name="barn_dir" value="$(arg barn_dir)"/>
+    <arg name="gui" value="$(arg gui)"/>
+  </include>
+  <rosparam file="{params}" command="load" ns="/jackal/move_base"/>
+</launch>
+"""
+
+
+def run_as_batch(worlds, barn_dir: Path, runs: int, controller: str, out: Path, **ray_kw):
+    """BARN's protocol as a batch: every world ``runs`` times; returns the results table."""
+    from fleetsim.batch import BatchSpec, run_batch
+
+    scenario, workdir = "barn", Path.cwd()
+    if CONTROLLERS[controller] is not None:
+        out.mkdir(parents=True, exist_ok=True)
+        workdir = out.resolve()
+        scenario = f"barn_{controller}.launch"
+        (out / scenario).write_text(CONTROLLER_LAUNCH.format(params=CONTROLLERS[controller]))
+    spec = BatchSpec(
+        scenarios=[scenario],
+        args={"world": [str(w) for w in worlds], "barn_dir": [str(barn_dir.resolve())]},
+        seeds=list(range(runs)),
+        duration=TIME_LIMIT + 60.0,  # the protocol ends each run; this only bounds a stuck one
+        until_goals=False,
+        timeout=900.0,
+        metrics="barn",
+        workdir=workdir,
+    )
+    os.environ["FLEETSIM_BARN_DIR"] = str(barn_dir.resolve())  # see run_world
+    return run_batch(spec, out, **ray_kw).table()
+
+
+def batch_main(a, worlds: list[int]) -> None:
+    table = run_as_batch(
+        worlds, a.barn_dir, a.runs, a.controller, a.batch,
+        workers=a.workers, address=a.address, resume=a.resume,
+    )  # fmt: skip
+    rows = table.to_pylist()
+    results = [
+        RunResult(
+            world=int(r["arg_world"]),
+            outcome=r["barn_outcome"] or "failed",  # a run that crashed or timed out (wall)
+            time=r["barn_time"] or float("nan"),
+            optimal_time=r["barn_optimal_time"] or float("nan"),
+            metric=r["barn_metric"] or 0.0,
+            final_gap=r["barn_final_gap"] or float("nan"),
+            wall=r["wall_time"] or float("nan"),
+        )
+        for r in rows
+    ]
+    errors = [r for r in rows if r["error"]]
+    print(f"{len(rows)} runs ({len(errors)} failed to run) in {a.batch}")
+    for r in errors[:5]:
+        print(f"  world {r['arg_world']} seed {r['seed']}: {r['error']}")
+    print_summary(results)
+    print(f"plots: fleetsim batch report {a.batch}")
+
+
+def print_summary(results: list[RunResult]) -> None:
+    s = summary(results)
+    print(
+        f"runs {s['runs']}: success {100 * s['success']:.1f} %, collision "
+        f"{100 * s['collision']:.1f} %, timeout {100 * s['timeout']:.1f} %, "
+        f"mean metric {s['metric']:.3f}"
+    )
+    print(
+        "reference (ROS move_base + DWA, 50 test worlds): success 85.0 %, collision 5.6 %, "
+        "timeout 9.4 %; target >= 90 % success"
+    )
+
+
 def available_worlds(barn_dir: Path) -> list[int]:
     return sorted(int(p.stem.split("_")[1]) for p in barn_dir.glob("world_*.world"))
 
@@ -204,6 +260,11 @@ def main() -> None:
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--controller", choices=sorted(CONTROLLERS), default="dwa")
     ap.add_argument("-v", "--verbose", action="store_true", help="show the nodes' log")
+    ap.add_argument("--batch", type=Path, metavar="OUTDIR", help="run as a batch on Ray")
+    ap.add_argument("--runs", type=int, default=10, help="--batch: runs per world (seeds)")
+    ap.add_argument("--workers", type=int, help="--batch: local Ray CPUs (default: cores)")
+    ap.add_argument("--address", help="--batch: an existing Ray cluster")
+    ap.add_argument("--resume", action="store_true", help="--batch: keep finished runs")
     a = ap.parse_args()
     logging.basicConfig(level=logging.INFO if a.verbose else logging.ERROR)
     if a.all:
@@ -213,6 +274,9 @@ def main() -> None:
     else:
         worlds = list(DEFAULT_WORLDS)
     print(f"BARN: jackal + move_base ({a.controller}), {len(worlds)} worlds from {a.barn_dir}")
+    if a.batch is not None:
+        batch_main(a, worlds)
+        return
     print(
         f"{'world':>5} {'outcome':>9} {'time s':>7} {'opt s':>6} {'metric':>6} {'gap m':>6} "
         f"{'wall s':>6}"
@@ -226,16 +290,7 @@ def main() -> None:
             f"{r.final_gap:6.2f} {r.wall:6.1f}",
             flush=True,
         )
-    s = summary(results)
-    print(
-        f"runs {s['runs']}: success {100 * s['success']:.1f} %, collision "
-        f"{100 * s['collision']:.1f} %, timeout {100 * s['timeout']:.1f} %, "
-        f"mean metric {s['metric']:.3f}"
-    )
-    print(
-        "reference (ROS move_base + DWA, 50 test worlds): success 85.0 %, collision 5.6 %, "
-        "timeout 9.4 %; target >= 90 % success"
-    )
+    print_summary(results)
 
 
 if __name__ == "__main__":

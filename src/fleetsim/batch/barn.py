@@ -130,6 +130,7 @@ class BarnProtocol(ScenarioMetrics):
         xy = self.truth.xy
         return {
             "success": success,
+            "time": elapsed,  # the protocol's clock, not move_base's last result
             "barn_outcome": outcome,
             "barn_time": elapsed,
             "barn_optimal_time": self.optimal,

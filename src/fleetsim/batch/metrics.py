@@ -37,7 +37,8 @@ class ScenarioMetrics:
         return False
 
     def robot_metrics(self, robot) -> dict[str, Any]:
-        """Extra columns for one robot (a `RobotResult`); ``success`` overrides the generic."""
+        """Extra columns for one robot (a `RobotResult`); ``success`` and ``time`` override
+        the generic ones (the protocol's rule and clock)."""
         return {}
 
 

@@ -185,10 +185,12 @@ def plot_against(table: pa.Table, column: str, path: Path) -> None:
         [g.ci[1] - r if g.judged else 0 for r, g in zip(rate, groups)],
     ]
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.4, 6.0), sharex=True)
-    a1.errorbar(x, rate, yerr=err, fmt="o-", capsize=4)
+    # integer values (world numbers, counts) are points, not a curve between them
+    style = "o" if numeric and all(float(v).is_integer() for v in labels) else "o-"
+    a1.errorbar(x, rate, yerr=err, fmt=style, capsize=4)
     a1.set_ylim(-0.05, 1.05)
     a1.set_ylabel(f"success rate ({CONFIDENCE:.0%} Wilson CI)")
-    a2.plot(x, [g.median_time for g in groups], "s-", color="tab:orange")
+    a2.plot(x, [g.median_time for g in groups], style.replace("o", "s"), color="tab:orange")
     a2.set_ylabel("median time to goal [s]")
     name = column.removeprefix(ARG_PREFIX)
     a2.set_xlabel(name)

@@ -67,7 +67,7 @@ def execute_run(run_json: dict, timeout: float, record: bool, workdir: str | Non
         # str hashes (set order) are then the same in every run's process
         env["PYTHONHASHSEED"] = "0"
         env.setdefault("MUJOCO_GL", "egl")
-        cmd = [sys.executable, "-m", "fleetsim.batch.worker", json.dumps(run_json), tmp]
+        cmd = [sys.executable, "-m", "fleetsim.batch", json.dumps(run_json), tmp]
         cmd.append("1" if record else "0")
         error = ""
         with (out / LOG).open("wb") as log:
@@ -163,7 +163,8 @@ def run_batch(
     if not todo:
         return table
     started = _ray_init(workers, address, spec.workdir, outdir)
-    local = started and not (address or os.environ.get("RAY_ADDRESS"))
+    # on a cluster the runs find the user's files in the shipped working dir, here in place
+    local = not (address or os.environ.get("RAY_ADDRESS"))
     try:
         task = ray.remote(num_cpus=1, max_retries=0)(execute_run)
         workdir = str(spec.workdir.resolve()) if local else None

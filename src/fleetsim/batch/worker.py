@@ -1,4 +1,4 @@
-"""One run of a batch, in a process of its own: ``python -m fleetsim.batch.worker RUN OUT``.
+"""One run of a batch, in a process of its own: ``python -m fleetsim.batch RUN OUT``.
 
 ``RUN`` is the run's JSON (`RunSpec.to_json`), ``OUT`` the folder its files go to:
 ``result.json`` (one row per robot, or the error that ended the run), ``run.mcap`` with

@@ -15,8 +15,19 @@ strategy, over the seeds (mean, and the spread across seeds):
 - ``dist mean`` / ``dist p95``: distance (m) from the follower's base to its desired pose,
   0.8 m behind the true marker in the burger's heading, over every frame;
 - ``collisions``: the follower's new contacts with anything but the floor (the run monitor's);
-- ``aruco ms``: aruco_detect's wall time per frame (JPEG decode, detection, pose estimation,
-  publishing), mean and 95th percentile; target <= 5 ms at 640x480.
+- ``aruco ms``: aruco_detect's wall time per frame (its whole image callback: JPEG decode to
+  grey, detection, pose estimation, publishing), median and 95th percentile; target <= 5 ms at
+  640x480. ``aruco cpu``: the process's CPU time over the same callback (median); above the
+  wall time when OpenCV runs the detector's 13 threshold windows on more than one thread
+  (``cv2.getNumThreads()``, printed; OpenCV's default is one per core);
+- ``others``: share of the machine's CPU that other processes used during the run (from
+  /proc/stat): this shared machine's speed swings 2x with the load, so read the timings with it.
+
+The per-frame times over all runs are printed once more for the frames in which no thread of
+ours waited for a CPU (Linux schedstat): what a quiet machine gives. After the runs, the
+recorded frames (every 5th, up to 100 a run) are timed again stage by stage (decode, detection
+with 1 thread and with OpenCV's default, the node's whole callback), each stage on each frame in
+turn, so that the stages are measured under the same load.
 
 Defaults: 10 seeds x both strategies x 180 s of sim time from the tutorial's start poses, the
 camera at 640x480 (same horizontal field of view as the real 1920x1080; software rendering
@@ -29,20 +40,26 @@ Usage: python benchmarks/visual_servoing.py [--seeds 10] [--duration 180]
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
+import os
 import time
+from dataclasses import fields
 
+import cv2
 import numpy as np
 from scipy.spatial.transform import Rotation
 
 from fleetsim.cli.launch import resolve_launch_file
 from fleetsim.launch.runner import LaunchSession, load_plan
-from fleetsim.msgs import fiducial_msgs
+from fleetsim.msgs import fiducial_msgs, sensor_msgs, std_msgs
 
 OPTICAL = "camera_rgb_optical_frame"
 FOLLOWER, TARGET, MARKER = "turtlebot3_waffle", "karl", "karl_marker"
 BEHIND = 0.8  # m, follow_marker's marker_to_target_pose x (negated)
 LOST = 4.0  # s
+#: run-queue wait (ms) from which a frame counts as slowed by other processes
+PREEMPTED_MS = 0.02
 
 
 def _pose(engine, model: str) -> tuple[np.ndarray, Rotation]:
@@ -62,7 +79,8 @@ class Probe:
         self.engine = s.nodes["/gazebo"].engine
         self.detector = s.nodes["/aruco_detect"]
         self.frames: list[tuple[float, bool, bool, float]] = []  # t, detected, in view, dist
-        self.times: list[float] = []
+        #: per image: wall s, process CPU s, s the process's threads waited for a CPU
+        self.times: list[tuple[float, float, float]] = []
         self.samples: list[bytes] = []  # every 5th JPEG, for the detector-only timing
         self._mount = None
         p = self.detector.params
@@ -74,7 +92,9 @@ class Probe:
         )
 
     def _time_detector(self) -> None:
-        """Wrap aruco_detect's image callback (decode + detect + pose + publish) in a timer."""
+        """Wrap aruco_detect's image callback (decode + detect + pose + publish) in a timer:
+        wall time, the process's CPU time (every thread, so OpenCV's workers count) and how
+        long its threads sat on a run queue, preempted by other processes."""
         for sub in self.detector._subscriptions:
             if sub.topic.name == self.detector.image_topic:
                 inner = sub.callback
@@ -82,9 +102,11 @@ class Probe:
                 def timed(msg, inner=inner):
                     if len(self.times) % 5 == 0 and len(self.samples) < 100:
                         self.samples.append(bytes(msg.data))
-                    t0 = time.perf_counter()
+                    w0 = run_queue_wait()
+                    c0, t0 = time.process_time(), time.perf_counter()
                     inner(msg)
-                    self.times.append(time.perf_counter() - t0)
+                    t1, c1 = time.perf_counter(), time.process_time()
+                    self.times.append((t1 - t0, c1 - c0, run_queue_wait() - w0))
 
                 sub.callback = timed
 
@@ -130,6 +152,50 @@ def losses(frames: list[tuple[float, bool, bool, float]], end: float) -> int:
     return int(np.sum(gaps > LOST))
 
 
+def run_queue_wait() -> float:
+    """Seconds this process's threads have spent runnable but waiting for a CPU (Linux
+    /proc/<pid>/task/*/schedstat; nan elsewhere)."""
+    total = 0
+    try:
+        tids = os.listdir("/proc/self/task")
+    except OSError:
+        return math.nan
+    for tid in tids:
+        try:
+            with open(f"/proc/self/task/{tid}/schedstat") as f:
+                total += int(f.read().split()[1])
+        except (OSError, IndexError, ValueError):
+            continue  # a thread that ended meanwhile
+    return total * 1e-9
+
+
+class MachineLoad:
+    """Share of the machine's CPU that other processes used between ``__init__`` and
+    ``others()`` (Linux /proc/stat, less this process's own CPU time; nan elsewhere)."""
+
+    def __init__(self) -> None:
+        self.start = self._sample()
+
+    @staticmethod
+    def _sample() -> tuple[float, float, float] | None:
+        try:
+            with open("/proc/stat") as f:
+                jiffies = [int(v) for v in f.readline().split()[1:9]]
+        except OSError:
+            return None
+        hz = os.sysconf("SC_CLK_TCK")
+        own = os.times()
+        idle = jiffies[3] + jiffies[4]  # idle, iowait
+        return sum(jiffies) / hz, (sum(jiffies) - idle) / hz, own.user + own.system
+
+    def others(self) -> float:
+        end = self._sample()
+        if self.start is None or end is None or end[0] <= self.start[0]:
+            return math.nan
+        total, busy, own = (b - a for a, b in zip(self.start, end))
+        return max(busy - own, 0.0) / total
+
+
 def run(strategy: str, seed: int, duration: float, width: int, height: int, rate: float) -> dict:
     args = {
         "exploration_strategy": strategy,
@@ -139,12 +205,14 @@ def run(strategy: str, seed: int, duration: float, width: int, height: int, rate
         "camera_rate": str(rate),
     }
     wall = time.perf_counter()
+    load = MachineLoad()
     with LaunchSession(load_plan(resolve_launch_file("visual_servoing"), args), seed=seed) as s:
         probe = Probe(s)
         s.runtime.run(duration=duration)
         follower = next(r for r in s.monitor.results() if r.model == FOLLOWER)
         f = np.array([row[1:] for row in probe.frames], dtype=float)
-        times = np.array(probe.times) * 1e3
+        times = np.array(probe.times, dtype=float).reshape(-1, 3) * 1e3  # wall, cpu, wait (ms)
+        det = probe.detector
         return {
             "strategy": strategy,
             "seed": seed,
@@ -155,31 +223,88 @@ def run(strategy: str, seed: int, duration: float, width: int, height: int, rate
             "dist_mean": float(f[:, 2].mean()) if len(f) else math.nan,
             "dist_p95": float(np.percentile(f[:, 2], 95)) if len(f) else math.nan,
             "collisions": follower.collisions,
-            "aruco_mean": float(times.mean()) if len(times) else math.nan,
-            "aruco_p95": float(np.percentile(times, 95)) if len(times) else math.nan,
+            "aruco_med": float(np.median(times[:, 0])) if len(times) else math.nan,
+            "aruco_p95": float(np.percentile(times[:, 0], 95)) if len(times) else math.nan,
+            "aruco_cpu": float(np.median(times[:, 1])) if len(times) else math.nan,
+            "others": load.others(),
             "wall": time.perf_counter() - wall,
+            "times": times,
             "samples": probe.samples,
+            "params": {f.name: getattr(det.params, f.name) for f in fields(det.params)},
+            "k": det.camera_matrix,
+            "d": det.dist_coeffs,
         }
 
 
-def detector_timing(jpegs: list[bytes], **overrides) -> tuple[float, float, int]:
-    """aruco_detect's detection alone on recorded frames: (mean ms, p95 ms, frames with a
-    marker), with the package's detector parameters changed by ``overrides``."""
-    import cv2
-
-    from fleetsim.vision import ArucoDetectParams, aruco_dictionary, detector_parameters
-
-    det = cv2.aruco.ArucoDetector(
-        aruco_dictionary(0), detector_parameters(ArucoDetectParams(**overrides))
+def _ms(w: np.ndarray, c: np.ndarray) -> str:
+    """Wall times ``w`` (median, p95) and CPU times ``c`` (median), all in ms."""
+    return (
+        f"{np.median(w):5.2f} ms median, {np.percentile(w, 95):5.2f} p95, "
+        f"CPU {np.median(c):5.2f} ms median"
     )
-    grays = [cv2.imdecode(np.frombuffer(b, np.uint8), cv2.IMREAD_GRAYSCALE) for b in jpegs]
-    ms, found = [], 0
-    for g in grays:
-        t0 = time.perf_counter()
-        _, ids, _ = det.detectMarkers(g)
-        ms.append((time.perf_counter() - t0) * 1e3)
-        found += ids is not None
-    return float(np.mean(ms)), float(np.percentile(ms, 95)), found
+
+
+def stage_timing(jpegs: list[bytes], params: dict, k: np.ndarray, d: np.ndarray) -> None:
+    """Time aruco_detect's stages on recorded frames, every stage on each frame in turn (so
+    that they share the machine's load): decoding to grey, detection with one thread and with
+    OpenCV's default, and the node's whole callback; then detection with OpenCV's default
+    threshold windows, for scale."""
+    from fleetsim.runtime import Runtime
+    from fleetsim.vision import ArucoDetect, aruco_dictionary, detector_parameters
+
+    threads = cv2.getNumThreads()
+    node = ArucoDetect(Runtime(), params=params)
+    if k is not None:  # the run's camera_info (none: the node times without pose estimation)
+        node.on_camera_info(
+            sensor_msgs.CameraInfo(
+                header=std_msgs.Header(frame_id=OPTICAL), k=k.reshape(-1).tolist(), d=d.tolist()
+            )
+        )
+    fewer = dataclasses.replace(
+        node.params, adaptiveThreshWinSizeMax=23, adaptiveThreshWinSizeStep=10
+    )
+    fewer_windows = cv2.aruco.ArucoDetector(
+        aruco_dictionary(node.params.dictionary), detector_parameters(fewer)
+    )
+    stages: dict[str, list[tuple[float, float, float]]] = {}
+
+    def timed(name: str, fn, *args):
+        w0 = run_queue_wait()
+        c0, t0 = time.process_time(), time.perf_counter()
+        out = fn(*args)
+        t1, c1 = time.perf_counter(), time.process_time()
+        stages.setdefault(name, []).append((t1 - t0, c1 - c0, run_queue_wait() - w0))
+        return out
+
+    found = 0
+    try:
+        for jpeg in jpegs:
+            data = np.frombuffer(jpeg, np.uint8)
+            grey = timed("JPEG decode to grey", cv2.imdecode, data, cv2.IMREAD_GRAYSCALE)
+            cv2.setNumThreads(1)
+            timed("detectMarkers, 1 thread", node.detector.detectMarkers, grey)
+            cv2.setNumThreads(threads)
+            _, ids, _ = timed(
+                f"detectMarkers, {threads} threads", node.detector.detectMarkers, grey
+            )
+            found += ids is not None
+            msg = sensor_msgs.CompressedImage(format="rgb8; jpeg compressed bgr8", data=data)
+            timed("the node's whole callback", node.on_compressed, msg)
+            node.runtime.graph.drain()
+            timed(
+                f"  (OpenCV's 3 default windows, {threads} threads)",
+                fewer_windows.detectMarkers,
+                grey,
+            )
+    finally:
+        cv2.setNumThreads(threads)
+    print(f"  marker found in {found} of {len(jpegs)} frames; each stage on all frames, then on")
+    print("  those in which no other process preempted it")
+    for name, rows in stages.items():
+        t = np.array(rows) * 1e3
+        alone = t[t[:, 2] < PREEMPTED_MS]
+        quiet = f"{len(alone)}: {_ms(alone[:, 0], alone[:, 1])}" if len(alone) else "none"
+        print(f"  {name:<42} {_ms(t[:, 0], t[:, 1])} | {quiet}")
 
 
 COLUMNS = [
@@ -189,8 +314,10 @@ COLUMNS = [
     ("dist_mean", "{:.2f}"),
     ("dist_p95", "{:.2f}"),
     ("collisions", "{:.1f}"),
-    ("aruco_mean", "{:.1f}"),
-    ("aruco_p95", "{:.1f}"),
+    ("aruco_med", "{:.2f}"),
+    ("aruco_p95", "{:.2f}"),
+    ("aruco_cpu", "{:.2f}"),
+    ("others", "{:.0%}"),
 ]
 
 
@@ -205,17 +332,18 @@ def main() -> None:
     a = ap.parse_args()
     print(
         f"visual_servoing.launch: {a.seeds} seeds x {a.duration:.0f} s, camera {a.width}x"
-        f"{a.height} at {a.rate:g} Hz"
+        f"{a.height} at {a.rate:g} Hz; OpenCV {cv2.__version__}, {cv2.getNumThreads()} threads "
+        f"on {os.cpu_count()} CPUs"
     )
-    head = "".join(f"{n:>13}" for n, _ in COLUMNS)
-    print(f"{'strategy':>15} {'seed':>4}{head}{'wall s':>9}")
+    head = "".join(f"{n:>11}" for n, _ in COLUMNS)
+    print(f"{'strategy':>15} {'seed':>4}{head}{'wall s':>8}")
     rows = []
     for strategy in a.strategies:
         for seed in range(a.seeds):
             r = run(strategy, seed, a.duration, a.width, a.height, a.rate)
             rows.append(r)
-            cells = "".join(f"{fmt.format(r[n]):>13}" for n, fmt in COLUMNS)
-            print(f"{strategy:>15} {seed:>4}{cells}{r['wall']:>9.0f}", flush=True)
+            cells = "".join(f"{fmt.format(r[n]):>11}" for n, fmt in COLUMNS)
+            print(f"{strategy:>15} {seed:>4}{cells}{r['wall']:>8.0f}", flush=True)
     print("\nper strategy: mean over seeds (min..max)")
     for strategy in a.strategies:
         rs = [r for r in rows if r["strategy"] == strategy]
@@ -226,20 +354,20 @@ def main() -> None:
                 f"{n} {fmt.format(v.mean())} ({fmt.format(v.min())}..{fmt.format(v.max())})"
             )
         print(f"{strategy}: " + ", ".join(cells))
+    times = np.concatenate([r["times"] for r in rows])
+    if len(times):
+        print(f"\naruco_detect per {a.width}x{a.height} frame (target: 5 ms):")
+        print(f"  all {len(times)} frames: {_ms(times[:, 0], times[:, 1])}")
+        alone = times[times[:, 2] < PREEMPTED_MS]
+        print(
+            f"  the {len(alone)} frames no other process preempted (run-queue wait < "
+            f"{PREEMPTED_MS} ms; what a quiet machine gives, slightly optimistic: short frames "
+            "are preempted less often): " + (_ms(alone[:, 0], alone[:, 1]) if len(alone) else "-")
+        )
     jpegs = [b for r in rows for b in r["samples"]]
     if jpegs:
-        print(
-            f"\naruco_detect's detection alone, {len(jpegs)} recorded {a.width}x{a.height} frames:"
-        )
-        for label, kw in (
-            ("the package's parameters (13 threshold windows, 3..53 px)", {}),
-            (
-                "OpenCV's default windows (adaptiveThreshWinSizeMax 23, Step 10)",
-                {"adaptiveThreshWinSizeMax": 23, "adaptiveThreshWinSizeStep": 10},
-            ),
-        ):
-            mean, p95, found = detector_timing(jpegs, **kw)
-            print(f"  {label}: {mean:.1f} ms mean, {p95:.1f} ms p95, marker in {found}")
+        print(f"\naruco_detect's stages on {len(jpegs)} recorded frames, timed now:")
+        stage_timing(jpegs, rows[0]["params"], rows[0]["k"], rows[0]["d"])
 
 
 if __name__ == "__main__":

@@ -137,21 +137,3 @@ def test_on_an_inscribed_cell_is_no_valid_trajectory_and_no_plan_is_empty():
     c.set_plan(line(1.0, 1.9, 1.0, n=10))
     with pytest.raises(NoValidTrajectory, match="every one of 50 sampled trajectories collides"):
         c.compute_velocity_commands((1.0, 1.0, 0.0), (0, 0, 0))
-
-
-def test_footprint_is_checked_everywhere_when_inflation_is_short_of_the_corners():
-    from fleetsim.nav.controllers.mppi.controller import footprint_check_cost
-    from fleetsim.nav.costmap import LayeredCostmap
-
-    square = [[-0.26, -0.22], [-0.26, 0.22], [0.26, 0.22], [0.26, -0.22]]
-    for inflation, expected in ((0.30, 0.0), (0.55, None)):
-        layered = LayeredCostmap.from_params(
-            {"footprint": square, "footprint_padding": 0.0, "inflation_radius": inflation,
-             "cost_scaling_factor": 10.0,
-             "observation_sources": ""}
-        )  # fmt: skip
-        got = footprint_check_cost(type("CostmapROS", (), {"layered": layered}))
-        if expected is not None:
-            assert got == expected
-        else:  # the inflation cost 0.34 m (the corners) from an obstacle
-            assert got == int(252 * math.exp(-10.0 * (math.hypot(0.26, 0.22) - 0.22)))

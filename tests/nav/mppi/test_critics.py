@@ -5,11 +5,13 @@ import math
 import numpy as np
 import pytest
 
+from fleetsim.nav.controllers.mppi import critic_kernels as k
 from fleetsim.nav.controllers.mppi import critic_params as cp
 from fleetsim.nav.controllers.mppi.critics import CRITICS, CriticData
 from fleetsim.nav.controllers.mppi.kernels import DIFF_DRIVE
 from fleetsim.nav.costmap import Costmap2D
 from fleetsim.nav.costmap.footprint import footprint_from_radius, outline_points
+from fleetsim.nav.costmap.inflation_layer import squared_distances_to
 
 DT = 0.05
 
@@ -45,7 +47,9 @@ def data_for(trajs, vels=None, robot=(0.0, 0.0, 0.0), goal=(5.0, 0.0, 0.0), path
         min_turning_r=0.2,
         costmap=m,
         outline=outline_points(footprint_from_radius(0.2), 0.05),
-        footprint_from=1.0,
+        clearance2=squared_distances_to(m.costs == 254),
+        inside2=(0.2 / 0.05 - math.sqrt(2)) ** 2,
+        outside2=(0.2 / 0.05 + math.sqrt(2)) ** 2,
         inscribed_radius=0.2,
         costs=np.zeros(b),
     )
@@ -78,9 +82,9 @@ def test_cost_critic_prefers_free_space_and_charges_collisions():
     d = data_for([straight(1.1)] * 2, m=m)
     score("CostCritic", d)
     assert d.fail  # every sample collides
-    # with the footprint: a centre in free space whose outline touches the lethal row
-    d = data_for([straight(0.85)], m=m)
+    # with the footprint: a centre in inflated space whose outline touches the lethal row
     m.costs[66:70, :] = 50
+    d = data_for([straight(0.85)], m=m)
     assert score("CostCritic", d, consider_footprint=True)[0] == pytest.approx(1e6)
     d = data_for([straight(0.85)], m=m)
     assert score("CostCritic", d, consider_footprint=False)[0] < 1.0
@@ -177,15 +181,46 @@ def test_every_critic_has_nav2_defaults_declared():
     assert cp.GoalCriticParams().threshold_to_consider == 1.4
 
 
-def test_a_free_centre_with_a_corner_on_an_obstacle_collides_when_every_pose_is_checked():
+def test_a_free_centre_with_a_corner_on_an_obstacle_collides():
     m = Costmap2D(200, 100, 0.05, -2.5, -2.5)
     m.costs[70:75, :] = 254  # y 1.0..1.25: lethal, no inflation around it
     corner = np.array([[-0.3, -0.3], [-0.3, 0.3], [0.3, 0.3], [0.3, -0.3]])
-    d = data_for([straight(0.75)], m=m)  # centre 0.25 m from the row, corners 0.3 m out
-    d.outline = outline_points(corner, 0.05)
-    d.footprint_from = 0.0  # inflation short of the circumscribed radius: check every pose
+
+    def square_robot(d):
+        d.outline = outline_points(corner, 0.05)
+        d.inside2 = (0.3 / 0.05 - math.sqrt(2)) ** 2
+        d.outside2 = (math.hypot(0.3, 0.3) / 0.05 + math.sqrt(2)) ** 2
+        return d
+
+    d = square_robot(data_for([straight(0.75, 0.5)], m=m))  # turned: a corner reaches y 1.0
     assert score("CostCritic", d, consider_footprint=True)[0] == pytest.approx(1e6)
-    d = data_for([straight(0.75)], m=m)
-    d.outline = outline_points(corner, 0.05)
-    d.footprint_from = 1.0  # only from inflated centres: this pose's centre is free
-    assert score("CostCritic", d, consider_footprint=True)[0] == 0.0
+    d = square_robot(data_for([straight(0.75, 0.5)], m=m))
+    assert score("CostCritic", d, consider_footprint=False)[0] == 0.0  # its centre is free
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_footprint_collisions_match_the_outline_or_an_obstacle_inside(seed):
+    rng = np.random.default_rng(seed)
+    m = Costmap2D(60, 60, 0.05)
+    m.costs[rng.random((60, 60)) < 0.01] = 254
+    rect = np.array([[-0.31, -0.27], [-0.31, 0.27], [0.31, 0.27], [0.31, -0.27]])
+    outline = outline_points(rect, 0.05)
+    clear2 = squared_distances_to(m.costs == 254)
+    inside2 = (0.27 / 0.05 - math.sqrt(2)) ** 2
+    outside2 = (math.hypot(0.31, 0.27) / 0.05 + math.sqrt(2)) ** 2
+    lethal = np.argwhere(m.costs == 254)[:, ::-1] * 0.05 + 0.025  # cell centres (x, y)
+    for x, y, yaw in rng.uniform((0.5, 0.5, -math.pi), (2.5, 2.5, math.pi), (300, 3)):
+        c, s = math.cos(yaw), math.sin(yaw)
+        got = k.pose_cost(m.costs, clear2, 0.0, 0.0, 0.05, outline, True, inside2, outside2,
+                          x, y, c, s)  # fmt: skip
+        pts = np.column_stack([x + c * outline[:, 0] - s * outline[:, 1],
+                               y + s * outline[:, 0] + c * outline[:, 1]])  # fmt: skip
+        cells = np.floor(pts / 0.05).astype(int)
+        on_outline = (m.costs[cells[:, 1], cells[:, 0]] == 254).any()
+        centre_lethal = m.costs[int(y / 0.05), int(x / 0.05)] == 254
+        local = (lethal - (x, y)) @ np.array([[c, -s], [s, c]])  # into the robot frame
+        inside = ((np.abs(local[:, 0]) < 0.31) & (np.abs(local[:, 1]) < 0.27)).any()
+        if on_outline or centre_lethal:
+            assert got == k.COLLISION
+        elif got == k.COLLISION:
+            assert inside  # only an obstacle within the footprint, not under its outline

@@ -47,37 +47,11 @@ from fleetsim.nav.controllers.mppi.kernels import (
 from fleetsim.nav.controllers.mppi.loading import load_mppi
 from fleetsim.nav.controllers.mppi.params import AckermannConstraints, MPPIParams
 from fleetsim.nav.controllers.mppi.path import blocked_points, furthest_reached, pruned_path
-from fleetsim.nav.costmap.costmap_2d import Costmap2D
+from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE, Costmap2D
 from fleetsim.nav.costmap.footprint import footprint_radii, outline_points
-from fleetsim.nav.costmap.inflation_layer import InflationLayer, costs_from_distances
+from fleetsim.nav.costmap.inflation_layer import squared_distances_to
 
 PLUGIN = "nav2_mppi_controller::MPPIController"
-
-
-def footprint_check_cost(costmap_ros: Any, layer_name: str = "") -> float:
-    """The centre cost from which a footprint can touch an obstacle: the inflation layer's
-    cost at the circumscribed radius (Nav2's possibly_inscribed_cost). 0 (every pose checked)
-    when the costmap has no inflation layer or inflates less than the circumscribed radius: a
-    pose whose centre is on a free cell can then still have a corner on an obstacle (Nav2
-    only warns about that; a BARN jackal, 0.41 m to its padded corners with 0.30 m inflation,
-    reversed a corner into a post)."""
-    layered = getattr(costmap_ros, "layered", None)
-    if layered is None:
-        return 0.0
-    layers = [la for la in layered.layers if isinstance(la, InflationLayer)]
-    if layer_name:
-        layers = [la for la in layers if la.name == layer_name]
-    if not layers:
-        return 0.0
-    ip = layers[-1].params
-    res = layered.costmap.resolution
-    if ip.inflation_radius < layered.circumscribed_radius:
-        return 0.0
-    c = costs_from_distances(
-        np.array([layered.circumscribed_radius / res]), res, layered.inscribed_radius,
-        ip.inflation_radius, ip.cost_scaling_factor,
-    )[0]  # fmt: skip
-    return float(max(int(c), 1))
 
 
 class MPPIController(LocalPlanner):
@@ -85,7 +59,6 @@ class MPPIController(LocalPlanner):
 
     costmap : the local costmap's master grid. footprint : (K, 2) robot polygon, m.
     critics : the scoring critics, in order. rng : the generator all noise is drawn from.
-    footprint_from : centre cost from which CostCritic/ObstaclesCritic lay the footprint.
     """
 
     Params = MPPIParams
@@ -98,7 +71,6 @@ class MPPIController(LocalPlanner):
         critics: list[Critic],
         rng: np.random.Generator,
         ackermann: AckermannConstraints | None = None,
-        footprint_from: float = 0.0,
     ) -> None:
         self.costmap = costmap
         self.params = p = params
@@ -107,8 +79,14 @@ class MPPIController(LocalPlanner):
         self.ackermann = ackermann or AckermannConstraints()
         self.footprint = np.asarray(footprint, dtype=np.float64)
         self.outline = outline_points(self.footprint, costmap.resolution)
-        self.inscribed_radius = footprint_radii(self.footprint)[0]
-        self.footprint_from = footprint_from
+        self.inscribed_radius, circumscribed = footprint_radii(self.footprint)
+        # clearance (cells^2) beyond which no outline point reaches a lethal cell and below
+        # which one is inside the footprint; a cell's diagonal of slack either way
+        slack = math.sqrt(2.0)
+        res = costmap.resolution
+        self.outside2 = (circumscribed / res + slack) ** 2
+        self.inside2 = max(self.inscribed_radius / res - slack, 0.0) ** 2
+        self.uses_footprint = any(getattr(c.params, "consider_footprint", False) for c in critics)
         self.model = MODEL_CODES[p.motion_model]
         self.std = np.array([p.vx_std, p.vy_std if self.model == OMNI else 0.0, p.wz_std])
         self.limits = np.array(
@@ -125,6 +103,8 @@ class MPPIController(LocalPlanner):
         self.reached_goal = False
         self.xy_tolerance_latch = False
         self._plan_start = 0
+        self._no_clearance = np.full((1, 1), -1, dtype=np.int64)
+        self.clearance2 = self._no_clearance
         self.reset()
 
     @classmethod
@@ -132,12 +112,8 @@ class MPPIController(LocalPlanner):
         cls, node: Any, costmap_ros: Any, ns: dict | None, where: str = "MPPIController"
     ) -> MPPIController:
         params, ackermann, critics = load_mppi(ns, where)
-        names = [getattr(c.params, "inflation_layer_name", "") for c in critics]
         rng = node.runtime.rng(where)
-        return cls(
-            costmap_ros.costmap, costmap_ros.footprint, params, critics, rng, ackermann,
-            footprint_check_cost(costmap_ros, next((n for n in names if n), "")),
-        )  # fmt: skip
+        return cls(costmap_ros.costmap, costmap_ros.footprint, params, critics, rng, ackermann)
 
     def reset(self) -> None:
         """Zero control sequence, fresh noise (Nav2's optimizer reset)."""
@@ -197,6 +173,9 @@ class MPPIController(LocalPlanner):
             self.plan, robot[0], robot[1], self._plan_start, search, p.prune_distance
         )
         blocked = blocked_points(m.costs, m.origin_x, m.origin_y, m.resolution, path)
+        self.clearance2 = self._no_clearance
+        if self.uses_footprint:
+            self.clearance2 = squared_distances_to(m.costs == LETHAL_OBSTACLE)
         vel = np.array([float(v) for v in velocity])
         for _attempt in range(p.retry_attempt_limit + 1):
             data = self._optimize(robot, vel, path, blocked)
@@ -243,7 +222,8 @@ class MPPIController(LocalPlanner):
             blocked=blocked, furthest=int(furthest_reached(self.poses, path)), dt=p.model_dt,
             limits=(p.vx_min, p.vx_max, p.vy_max, p.wz_max), model=self.model,
             min_turning_r=self.ackermann.min_turning_r, costmap=self.costmap,
-            outline=self.outline, footprint_from=self.footprint_from,
+            outline=self.outline, clearance2=self.clearance2, inside2=self.inside2,
+            outside2=self.outside2,
             inscribed_radius=self.inscribed_radius, costs=np.zeros(p.batch_size),
         )  # fmt: skip
         for critic in self.critics:

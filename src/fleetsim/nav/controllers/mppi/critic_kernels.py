@@ -21,28 +21,34 @@ def _wrap(a):
 
 
 @njit(cache=True)
-def pose_cost(costs, ox, oy, res, outline, footprint_from, x, y, c, s):
+def pose_cost(costs, clear2, ox, oy, res, outline, use_footprint, inside2, outside2, x, y, c, s):
     """The cost of one pose (heading cos ``c``, sin ``s``): its centre cell's, or `COLLISION`.
 
-    A lethal centre cell or one off the grid is a collision; so is an inscribed one unless
-    the footprint is checked (``footprint_from`` >= 0). From a centre cost of
-    ``footprint_from`` up, the footprint's outline is laid on the grid and any lethal cell (or
-    grid edge) under it is a collision. The graded cost stays the centre's: the inflation
-    layer's costs are distances from the centre (an outline cell at 253 only says an obstacle
-    is within the inscribed radius of the robot's edge, and in clutter nearly every pose's
-    outline has one). NO_INFORMATION (255) is passable (Nav2 with unknown space tracked)."""
+    A lethal centre cell or one off the grid is a collision. Without ``use_footprint`` so is an
+    inscribed (253) one. With it, ``clear2`` (H, W) gives each cell's squared distance (cells)
+    to the nearest lethal cell (-1: none): beyond ``outside2`` no footprint can touch one, below
+    ``inside2`` one lies inside the footprint, in between the footprint's outline is laid on
+    the grid and a lethal cell (or the grid's edge) under it is a collision. The graded cost
+    stays the centre's: the inflation layer's costs are distances from the centre (an outline
+    cell at 253 only says an obstacle is within the inscribed radius of the robot's edge, and
+    in clutter nearly every pose's outline has one). NO_INFORMATION (255) is passable (Nav2
+    with unknown space tracked)."""
     h, w = costs.shape
     fx = (x - ox) / res
     fy = (y - oy) / res
     if fx < 0.0 or fy < 0.0 or fx >= w or fy >= h:
         return COLLISION
-    v = costs[int(fy), int(fx)]
+    iy, ix = int(fy), int(fx)
+    v = costs[iy, ix]
     if v == 254:
         return COLLISION
-    if footprint_from < 0.0:
+    if not use_footprint:
         return COLLISION if v == 253 else float(v)
-    if v < footprint_from or v == 255:
+    d2 = clear2[iy, ix]
+    if d2 < 0 or d2 > outside2:
         return float(v)
+    if d2 < inside2:
+        return COLLISION
     for k in range(outline.shape[0]):
         fx = (x + c * outline[k, 0] - s * outline[k, 1] - ox) / res
         fy = (y + s * outline[k, 0] + c * outline[k, 1] - oy) / res
@@ -56,11 +62,14 @@ def cost_terms(
     poses,
     headings,
     costs,
+    clear2,
     ox,
     oy,
     res,
     outline,
-    footprint_from,
+    use_footprint,
+    inside2,
+    outside2,
     step,
     near_collision,
     critical,
@@ -78,11 +87,14 @@ def cost_terms(
         for t in range(0, nt, step):
             c = pose_cost(
                 costs,
+                clear2,
                 ox,
                 oy,
                 res,
                 outline,
-                footprint_from,
+                use_footprint,
+                inside2,
+                outside2,
                 poses[b, t, 0],
                 poses[b, t, 1],
                 headings[b, t, 0],
@@ -104,11 +116,14 @@ def obstacle_terms(
     poses,
     headings,
     costs,
+    clear2,
     ox,
     oy,
     res,
     outline,
-    footprint_from,
+    use_footprint,
+    inside2,
+    outside2,
     inscribed,
     scaling,
     margin,
@@ -128,11 +143,14 @@ def obstacle_terms(
         for t in range(nt):
             c = pose_cost(
                 costs,
+                clear2,
                 ox,
                 oy,
                 res,
                 outline,
-                footprint_from,
+                use_footprint,
+                inside2,
+                outside2,
                 poses[b, t, 0],
                 poses[b, t, 1],
                 headings[b, t, 0],

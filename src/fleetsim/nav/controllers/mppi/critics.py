@@ -36,7 +36,9 @@ class CriticData:
     min_turning_r: float
     costmap: object  # Costmap2D
     outline: np.ndarray  # (M, 2) footprint outline points
-    footprint_from: float  # centre cost from which the footprint is checked (-1: never)
+    clearance2: np.ndarray  # (H, W) squared cells to the nearest lethal cell (-1: none)
+    inside2: float  # clearance2 below which a lethal cell is inside the footprint
+    outside2: float  # clearance2 above which no footprint reaches a lethal cell
     inscribed_radius: float
     fail: bool = False
     costs: np.ndarray = field(default_factory=lambda: np.zeros(0))
@@ -79,9 +81,13 @@ def _collided(data: CriticData, hit: np.ndarray, collision_cost: float) -> None:
         data.fail = True
 
 
-def _grid(data: CriticData):
+def _grid(data: CriticData, consider_footprint: bool):
+    """The costmap arguments of `k.pose_cost` after the poses."""
     m = data.costmap
-    return m.costs, m.origin_x, m.origin_y, m.resolution
+    return (
+        m.costs, data.clearance2, m.origin_x, m.origin_y, m.resolution, data.outline,
+        consider_footprint, data.inside2, data.outside2,
+    )  # fmt: skip
 
 
 class CostCritic(Critic):
@@ -90,9 +96,8 @@ class CostCritic(Critic):
     def score(self, data):
         p = self.params
         near_goal = data.goal_distance < p.near_goal_distance
-        fp_from = data.footprint_from if p.consider_footprint else -1.0
         term, hit = k.cost_terms(
-            data.poses, data.headings, *_grid(data), data.outline, fp_from, p.trajectory_point_step,
+            data.poses, data.headings, *_grid(data, p.consider_footprint), p.trajectory_point_step,
             float(p.near_collision_cost), p.critical_cost, near_goal,
         )  # fmt: skip
         # Nav2 normalises costs (0..254) by 254
@@ -107,9 +112,8 @@ class ObstaclesCritic(Critic):
     def score(self, data):
         p = self.params
         near_goal = data.goal_distance < p.near_goal_distance
-        fp_from = data.footprint_from if p.consider_footprint else -1.0
         critical, repulsive, hit = k.obstacle_terms(
-            data.poses, data.headings, *_grid(data), data.outline, fp_from, data.inscribed_radius,
+            data.poses, data.headings, *_grid(data, p.consider_footprint), data.inscribed_radius,
             p.cost_scaling_factor, p.collision_margin_distance, p.inflation_radius, near_goal,
         )  # fmt: skip
         ok = ~hit

@@ -119,13 +119,26 @@ def test_corridor_swap_keeps_off_the_walls():
     assert np.all(np.abs(f.state[:, 1]) < 1.0 - BODY)
 
 
-def test_without_side_preference_the_exact_swap_needs_the_deadlock_rule():
-    f = Fleet(
-        [(-3, 0, 0), (3, 0, math.pi)], [(3, 0, 0), (-3, 0, math.pi)], left_pref=0.0,
-        deadlock_time=3.0,
-    )  # fmt: skip
-    assert f.run(60.0)
-    assert f.min_gap > 0.0
+def test_in_a_corridor_too_narrow_to_pass_the_lower_priority_robot_backs_off():
+    """0.9 m between the walls: the lizis cannot pass, ORCA stalls them nose to nose. Without
+    the rule they stay put; with it robot2 (lower priority) backs away and robot1 advances.
+    (Backing off for ``yield_time`` does not clear a 12 m corridor: such a swap still needs a
+    longer retreat or a reservation, which the rule does not do.)"""
+    walls = [(-8, 0.45, 8, 0.65), (-8, -0.65, 8, -0.45)]
+    swap = ([(-3, 0, 0), (3, 0, math.pi)], [(3, 0, 0), (-3, 0, math.pi)])
+
+    def standoff(deadlock_time):
+        f = Fleet(*swap, walls=walls, deadlock_time=deadlock_time, yield_time=4.0)
+        f.run(16.0)  # nose to nose by ~10 s; no progress for 8 s
+        before = f.state[:, 0].copy()
+        f.run(6.0)
+        assert f.min_gap > 0.0
+        return f, f.state[:, 0] - before
+
+    stalled, moved = standoff(1000.0)
+    assert np.all(np.abs(moved) < 0.1)
+    f, moved = standoff(8.0)
+    assert moved[1] > 0.5 and moved[0] > 0.3  # robot2 retreats east, robot1 follows
     assert f.planners[1].deadlock.yields >= 1 and f.planners[0].deadlock.yields == 0
 
 

@@ -48,7 +48,7 @@ class CollvoidParams:
         3.0, unit="m", range=(0.0, None), help="robots farther than this are ignored"
     )
     time_horizon: float = param(
-        2.0, unit="s", range=(1e-3, None), help="robots: collisions later than this are ignored"
+        3.0, unit="s", range=(1e-3, None), help="robots: collisions later than this are ignored"
     )
     time_horizon_obst: float = param(
         1.0, unit="s", range=(1e-3, None), help="static obstacles: the same horizon"
@@ -60,7 +60,7 @@ class CollvoidParams:
         0, choices=(0, 1, 2), help="HRVO 0, RVO 1, VO 2: collvoid's sampling only, not ORCA"
     )
     left_pref: float = param(
-        -0.3,
+        -0.6,
         unit="rad",
         help="turn of the preferred velocity while a robot is ahead (negative: keep right)",
     )
@@ -88,7 +88,7 @@ class CollvoidParams:
         0.8, unit="m", range=(1e-3, None), help="look-ahead along the plan for the heading"
     )
     deadlock_time: float = param(
-        5.0, unit="s", range=(0.0, None), help="no progress this long near a robot: stuck"
+        10.0, unit="s", range=(0.0, None), help="no progress this long near a robot: stuck"
     )
     deadlock_progress: float = param(
         0.2, unit="m", range=(0.0, None), help="progress that resets the deadlock clock"

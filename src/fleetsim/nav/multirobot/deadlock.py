@@ -37,7 +37,7 @@ class DeadlockRule:
     """One robot's deadlock state (see the module doc)."""
 
     robot_id: str
-    deadlock_time: float = 5.0
+    deadlock_time: float = 10.0
     deadlock_progress: float = 0.2
     deadlock_radius: float = 2.0
     yield_time: float = 4.0

@@ -154,3 +154,24 @@ def test_me_publisher_rejects_a_bad_footprint_parameter():
     rt = Runtime()
     with pytest.raises(Exception, match="me_publisher/footprint"):
         MePublisher(rt, "me_publisher", "/lizi1", params={"footprint": [[0, 0]]})
+
+
+def test_me_publisher_is_controlled_only_while_move_base_has_a_goal():
+    from fleetsim.msgs import actionlib_msgs
+
+    rt = Runtime()
+    robot = Robot(rt, 0.0, 0.0, 0.0)
+    MePublisher(rt, "me_publisher", "/lizi1", params={"footprint": SQUARE})
+    status = robot.create_publisher(actionlib_msgs.GoalStatusArray, "move_base/status")
+    rt.run(duration=0.3)
+    assert robot.got[-1].controlled  # no move_base heard: the parameter (true)
+
+    def say(code):
+        status.publish(
+            actionlib_msgs.GoalStatusArray(status_list=[actionlib_msgs.GoalStatus(status=code)])
+        )
+        rt.run(duration=0.3)
+        return robot.got[-1].controlled
+
+    assert say(actionlib_msgs.GoalStatus.ACTIVE)
+    assert not say(actionlib_msgs.GoalStatus.SUCCEEDED)  # parked at its goal

@@ -1,1 +1,41 @@
-"""Multi-robot navigation: position sharing, ORCA, collision avoidance (collvoid)."""
+"""Multi-robot navigation: robots that know about each other (collvoid's design).
+
+- `position_share`: the ``/position_share`` topic's table of neighbours (`NeighbourTable`,
+  `PositionShare`);
+- `me_publisher`: the node that shares a robot's pose, velocity and uncertainty-inflated
+  footprint (`MePublisher`, ``collvoid/me_publisher`` in launch files);
+- `orca`: ORCA half-planes and linear programs (`orca_halfplanes`, `orca_velocity`);
+- `holonomic`: preferred velocity, static obstacle points, differential-drive tracking;
+- `deadlock`: the priority rule above ORCA (`DeadlockRule`);
+- `uncertainty`: amcl's particle spread as a radius (`uncertainty_radius`).
+
+The local planner plugin is `fleetsim.nav.controllers.collvoid_planner.CollvoidLocalPlanner`,
+the costmap layer `fleetsim.nav.costmap.robots_layer.RobotsLayer`.
+"""
+
+from fleetsim.nav.multirobot.deadlock import DeadlockRule, priority_key
+from fleetsim.nav.multirobot.me_publisher import MePublisher, MePublisherParams
+from fleetsim.nav.multirobot.orca import orca_halfplanes, orca_velocity
+from fleetsim.nav.multirobot.position_share import (
+    TOPIC,
+    Neighbour,
+    NeighbourTable,
+    PositionShare,
+    neighbour_from_msg,
+)
+from fleetsim.nav.multirobot.uncertainty import uncertainty_radius
+
+__all__ = [
+    "TOPIC",
+    "DeadlockRule",
+    "MePublisher",
+    "MePublisherParams",
+    "Neighbour",
+    "NeighbourTable",
+    "PositionShare",
+    "neighbour_from_msg",
+    "orca_halfplanes",
+    "orca_velocity",
+    "priority_key",
+    "uncertainty_radius",
+]

@@ -54,7 +54,8 @@ def scan_from(pose, n=180):
 
 
 def reference_score(maps, p, pose, ranges, angles, kernel=1, sigma=0.05, lsigma=0.075):
-    """gmapping's ``score`` and ``likelihoodAndScore``, beam by beam, cell by cell."""
+    """gmapping's ``score`` and ``likelihoodAndScore``, beam by beam, cell by cell, as it runs:
+    the nearest cell with a hit in the kernel (see fleetsim.slam.scan_match on the free cell)."""
     ox, oy, delta = maps.geom
     dense = np.zeros((*maps.shape_cells, 3))
     for ty in range(maps.table.shape[1]):
@@ -69,16 +70,13 @@ def reference_score(maps, p, pose, ranges, angles, kernel=1, sigma=0.05, lsigma=
     for r, ang in zip(ranges, angles):
         a = pose[2] + LASER[2] + ang
         hx, hy = lx + r * math.cos(a), ly + r * math.sin(a)
-        fx = hx - delta * math.sqrt(2) * math.cos(a)
-        fy = hy - delta * math.sqrt(2) * math.sin(a)
         ih = (math.floor((hx - ox) / delta), math.floor((hy - oy) / delta))
-        df = (math.floor((fx - ox) / delta) - ih[0], math.floor((fy - oy) / delta) - ih[1])
         best = None
         for xx in range(-kernel, kernel + 1):
             for yy in range(-kernel, kernel + 1):
                 cx, cy = ih[0] + xx, ih[1] + yy
                 n, sx, sy = dense[cy, cx]
-                if n <= 0 or dense[cy + df[1], cx + df[0], 0] > 0:
+                if n <= 0:  # gmapping's free cell lies half a map away: never hit
                     continue
                 mu = (hx - (ox + cx * delta + sx / n), hy - (oy + cy * delta + sy / n))
                 d2 = mu[0] ** 2 + mu[1] ** 2

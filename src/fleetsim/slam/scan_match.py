@@ -6,10 +6,17 @@ count and the sums of the hit positions (x, y in m), or -1 for a tile never hit.
 gmapping with ``setgenerateMap(false)``, what slam_gmapping runs: the matching maps store
 endpoints only.
 
-A cell is "full" when it holds a hit and the cell one step back along the beam holds none
-(gmapping's ``cell > fullnessThreshold && fcell < fullnessThreshold`` with endpoint-only
-cells). gmapping computes that free cell from ``world2map(pfree - phit)``, which offsets by the
-map centre; we take the cell one ``sqrt(2) * delta`` back along the beam, as the code intends.
+A cell is "full" when it holds a hit. gmapping also asks that a "free" cell be empty
+(``cell > fullnessThreshold && fcell < fullnessThreshold``), but it finds that cell at
+``world2map(pfree - phit)``: a vector of a few millimetres taken through ``world2map``, which
+adds the map's half size, so the free cell lies half a map away from the hit, in space the
+robot has not seen, and the test never rejects. What gmapping runs is therefore "any cell with a
+hit", and so is this. Taking the free cell one step back along the beam, as the code seems to
+intend, biases every match: only the front-most hit cell of a wall counts, and its mean lies
+in front of the wall, so each match pulls the robot away from what it sees by a few
+millimetres. A 360-degree laser sees walls on all sides and the pulls cancel; a forward-facing
+180-degree laser (the hunter's) drifts backwards, by 1 m over the office (tests/slam/
+test_filter.py, a robot circling with a 180-degree laser).
 
 Geometry arguments shared by the kernels:
 ``geom = (origin_x, origin_y, delta)`` (m, m, m/cell) of cell (0, 0)'s corner;
@@ -53,7 +60,6 @@ def _match(pool, table, p, pose, laser, ranges, cos_a, sin_a, geom, kernel, sigm
     lx = pose[0] + c * laser[0] - s * laser[1]
     ly = pose[1] + s * laser[0] + c * laser[1]
     cl, sl = math.cos(pose[2] + laser[2]), math.sin(pose[2] + laser[2])
-    free_back = delta * math.sqrt(2.0)
     no_hit = NULL_LIKELIHOOD / lsigma
     score = 0.0
     like = 0.0
@@ -64,8 +70,6 @@ def _match(pool, table, p, pose, laser, ranges, cos_a, sin_a, geom, kernel, sigm
         hx, hy = lx + r * ca, ly + r * sa
         ihx = math.floor((hx - ox) * inv)
         ihy = math.floor((hy - oy) * inv)
-        dfx = math.floor((hx - free_back * ca - ox) * inv) - ihx
-        dfy = math.floor((hy - free_back * sa - oy) * inv) - ihy
         found = False
         best = 0.0
         tx0, tx1 = (ihx - kernel) >> _SHIFT, (ihx + kernel) >> _SHIFT
@@ -86,10 +90,6 @@ def _match(pool, table, p, pose, laser, ranges, cos_a, sin_a, geom, kernel, sigm
                         continue
                     n = pool[t, cy & _MASK, cx & _MASK, 0]
                     if n <= 0.0:
-                        continue
-                    fx, fy = cx + dfx, cy + dfy
-                    ft = _hits_at(pool, table, p, fx, fy)
-                    if ft >= 0 and pool[ft, fy & _MASK, fx & _MASK, 0] > 0.0:
                         continue
                     # sums are offsets from the cell's own corner (float32 exact to ~1e-8 m)
                     mx = hx - (ox + cx * delta + pool[t, cy & _MASK, cx & _MASK, 1] / n)

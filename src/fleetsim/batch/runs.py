@@ -17,6 +17,7 @@ only ``pip install fleetsim``. A run's files come back to the driver as bytes, s
 
 from __future__ import annotations
 
+import ctypes
 import json
 import logging
 import os
@@ -53,6 +54,20 @@ ERROR_TAIL = 300
 OBJECT_STORE_MB = 150
 
 
+#: prctl(2), looked up here in the parent: between fork and exec the child must not load
+#: libraries (a lock another of the Ray worker's threads held at the fork would never be freed)
+_PRCTL = ctypes.CDLL(None, use_errno=True).prctl if sys.platform.startswith("linux") else None
+PR_SET_PDEATHSIG = 1
+
+
+def _die_with_parent() -> None:
+    """In the child before exec: be killed when the Ray worker that started it dies (Linux's
+    PR_SET_PDEATHSIG; the standard library has no call for it), so that a crashed worker or
+    a batch stopped with Ctrl-C leaves no run behind."""
+    if _PRCTL is not None:
+        _PRCTL(PR_SET_PDEATHSIG, signal.SIGKILL)
+
+
 def execute_run(run_json: dict, timeout: float, record: bool, workdir: str | None) -> dict:
     """Body of a Ray task: ``run_json`` run in a child process; its rows or error and files.
 
@@ -74,6 +89,7 @@ def execute_run(run_json: dict, timeout: float, record: bool, workdir: str | Non
             proc = subprocess.Popen(
                 cmd, cwd=cwd, env=env, stdout=log, stderr=subprocess.STDOUT,
                 start_new_session=True,  # its own process group, killed whole on a timeout
+                preexec_fn=_die_with_parent,
             )  # fmt: skip
             try:
                 code = proc.wait(timeout=timeout)
@@ -209,7 +225,7 @@ def _collect(pending, table, outdir, slots, already, total, progress, console) -
                 rows = _rows_of(run, result, outdir)
                 failed += bool(result["error"])
                 table.append(rows)
-                bar.update(task, advance=1, failed=failed)
+                bar.update(task, advance=1, failed=failed, running=min(slots, len(pending)))
 
 
 def _rows_of(run: RunSpec, result: dict[str, Any], outdir: Path) -> list[dict[str, Any]]:

@@ -153,3 +153,10 @@ def test_spec_file(tmp_path: Path):
         load_spec(f)
     with pytest.raises(BatchError, match="does not exist"):
         load_spec(tmp_path / "nope.yaml")
+
+
+def test_scenario_metrics_check_every_combination():
+    barn_dir = str(Path(__file__).resolve().parents[2].parent / "shared" / "data" / "barn")
+    spec = BatchSpec(scenarios=["barn"], args={"world": ["3", "4"], "barn_dir": [barn_dir]})
+    with pytest.raises(BatchError, match=r"BARN world 4: .*world_4.world does not exist"):
+        validate(spec)

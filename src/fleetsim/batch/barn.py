@@ -53,6 +53,13 @@ def metric_of(success: bool, actual_time: float, optimal_time: float) -> float:
     return float(success) * optimal_time / clipped
 
 
+def _worlds_in(barn_dir: Path) -> str:
+    numbers = sorted(int(p.stem.split("_")[1]) for p in barn_dir.glob("world_*.world"))
+    if not numbers:
+        return "none"
+    return ", ".join(map(str, numbers[:8])) + (", ..." if len(numbers) > 8 else "")
+
+
 class GroundTruth(Node):
     """The jackal's latest ground-truth (x, y) from its p3d, and where it first was."""
 
@@ -83,13 +90,22 @@ class BarnProtocol(ScenarioMetrics):
     }
     robot = "/jackal"
 
+    @classmethod
+    def check(cls, args: dict[str, str]) -> None:
+        barn_dir = Path(args.get("barn_dir") or os.environ.get("FLEETSIM_BARN_DIR", ""))
+        world = args.get("world", "3")
+        for name in (f"world_{world}.world", f"path_{world}.npy"):
+            if not (barn_dir / name).is_file():
+                raise BatchError(
+                    f"BARN world {world}: {barn_dir / name} does not exist (args world, "
+                    f"barn_dir); worlds there: {_worlds_in(barn_dir)}"
+                )
+
     def __init__(self, session, args: dict[str, str], time_limit: float = TIME_LIMIT) -> None:
         super().__init__(session, args)
+        self.check(args)
         barn_dir = args.get("barn_dir") or os.environ.get("FLEETSIM_BARN_DIR", "")
-        world = args.get("world", "3")
-        path = Path(barn_dir, f"path_{world}.npy")
-        if not path.is_file():
-            raise BatchError(f"BARN metrics: reference path {path} does not exist (arg barn_dir)")
+        path = Path(barn_dir, f"path_{args.get('world', '3')}.npy")
         self.optimal = optimal_time_of(path_from_grid(np.load(path)))
         self.time_limit = time_limit
         self.truth = GroundTruth(session.runtime)

@@ -32,6 +32,11 @@ class ScenarioMetrics:
         self.session = session
         self.args = args
 
+    @classmethod
+    def check(cls, args: dict[str, str]) -> None:
+        """Raise a `BatchError` if a run with these launch arguments cannot be scored (a
+        missing reference file, ...): called for every combination before any run."""
+
     def done(self) -> bool:
         """True once the protocol's run is over (checked every few tenths of a sim second)."""
         return False

@@ -241,13 +241,13 @@ def validate(spec: BatchSpec) -> list[RunSpec]:
         raise BatchError(f"{spec.source}: duration must be > 0 s, got {spec.duration}")
     if spec.timeout <= 0:
         raise BatchError(f"{spec.source}: timeout must be > 0 s, got {spec.timeout}")
-    if spec.metrics is not None:
-        from fleetsim.batch.metrics import metrics_class
+    from fleetsim.batch.metrics import metrics_class, metrics_name_for
 
-        metrics_class(spec.metrics)
     names = sorted(spec.args)
     for scenario in spec.scenarios:
         path = resolve_scenario(scenario, spec.workdir)
+        metrics_name = metrics_name_for(scenario, spec.metrics)
+        metrics = metrics_class(metrics_name) if metrics_name is not None else None
         declared = declared_args(path)
         for name in names:
             if name not in declared:
@@ -263,6 +263,8 @@ def validate(spec: BatchSpec) -> list[RunSpec]:
                 # runs will read them
                 with contextlib.chdir(spec.workdir):
                     load_plan(path, args, seed=spec.seeds[0])
+                    if metrics is not None:
+                        metrics.check(args)
             except FleetsimError as e:
                 raise BatchError(f"{spec.source}: scenario '{scenario}' with {args}: {e}") from e
     return spec.runs()

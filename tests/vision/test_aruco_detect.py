@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+import cv2
 import numpy as np
 import pytest
 from marker_images import camera_info_msg, camera_matrix, image_msg, marker_image
@@ -136,6 +137,30 @@ def test_compressed_transport_through_the_tutorials_remap():
     assert pose_errors(ft, facing(25), t)[0] < 0.05
     (img,) = hn.images
     assert (img.width, img.height, img.encoding) == (W, H, "bgr8")
+
+
+def test_outputs_on_every_core_equal_one_threads():
+    """OpenCV runs the package's 13 threshold windows as a parallel_for (its default thread
+    count, one per core); markers, corners, poses and errors are a single thread's, exactly."""
+    rng = np.random.default_rng(3)
+    shots = [(-30.0, -0.2, 1.0), (10.0, 0.1, 1.6), (35.0, 0.3, 2.2)]
+    images = [
+        marker_image(facing(yaw).as_rotvec(), np.array([x, 0.05, z]), K, W, H, noise=2.0, rng=rng)
+        for yaw, x, z in shots
+    ]
+    default = cv2.getNumThreads()
+    outputs = {}
+    try:
+        for threads in (1, max(default, 2)):
+            cv2.setNumThreads(threads)
+            hn = Harness({"fiducial_len": 0.15})
+            for img in images:
+                hn.send(img)
+            assert [len(m.transforms) for m in hn.transforms] == [1, 1, 1]
+            outputs[threads] = [repr(m) for m in hn.vertices + hn.transforms + hn.tf]
+    finally:
+        cv2.setNumThreads(default)
+    assert outputs[1] == outputs[max(default, 2)]
 
 
 def test_ignore_len_override_and_no_pose_estimation():

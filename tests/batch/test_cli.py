@@ -42,3 +42,10 @@ def test_a_spec_file_is_told_from_a_launch_file(tmp_path: Path, capsys):
     assert "sweep.yaml: scenario" in err and "declares no arg 'spin'" in err
     assert main(["batch", str(spec), "--arg", "speed=1"]) == 1
     assert "is a batch spec: put --arg and --seeds in it" in capsys.readouterr().err
+
+
+def test_a_yaml_launch_file_is_not_taken_for_a_spec(tmp_path: Path, capsys):
+    f = tmp_path / "one.yaml"
+    f.write_text("launch:\n- arg: {name: speed, default: '0.2'}\n")
+    assert main(["batch", str(f), "--arg", "sped=1", "-o", str(tmp_path / "out")]) == 1
+    assert "declares no arg 'sped' (did you mean 'speed'?)" in capsys.readouterr().err

@@ -160,3 +160,12 @@ def test_scenario_metrics_check_every_combination():
     spec = BatchSpec(scenarios=["barn"], args={"world": ["3", "4"], "barn_dir": [barn_dir]})
     with pytest.raises(BatchError, match=r"BARN world 4: .*world_4.world does not exist"):
         validate(spec)
+
+
+def test_declared_args_of_a_yaml_launch_file(tmp_path: Path):
+    f = tmp_path / "two.launch.yaml"
+    f.write_text(
+        "launch:\n- arg: {name: speed, default: '0.2'}\n- arg: {name: world}\n"
+        "- let: {name: fixed, value: '1'}\n"
+    )
+    assert declared_args(f) == {"speed", "world"}

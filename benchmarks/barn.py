@@ -40,7 +40,6 @@ from __future__ import annotations
 
 import argparse
 import logging
-import math
 import os
 import time
 from dataclasses import dataclass
@@ -56,12 +55,14 @@ from fleetsim.batch.barn import (  # noqa: F401 (re-exported for the tests)
     MOVED,
     START,
     TIME_LIMIT,
+    BarnProtocol,
     GroundTruth,
     metric_of,
     optimal_time_of,
     path_from_grid,
 )
 from fleetsim.launch.model import ParamOp
+from fleetsim.launch.monitor import RobotResult
 from fleetsim.launch.packages import ASSETS
 from fleetsim.launch.runner import LaunchSession, load_plan
 from fleetsim.runtime.params import load_yaml_file
@@ -109,7 +110,6 @@ def run_world(
 ) -> RunResult:
     """One run of the protocol on world ``world``."""
     t_wall = time.perf_counter()
-    optimal = optimal_time_of(path_from_grid(np.load(barn_dir / f"path_{world}.npy")))
     args = {"world": str(world), "barn_dir": str(barn_dir), "gui": "false"}
     # barn.launch's barn_dir default is $(env FLEETSIM_BARN_DIR), which roslaunch resolves even
     # when the arg is given: set it too
@@ -117,38 +117,19 @@ def run_world(
     plan = with_controller(load_plan(LAUNCH, args, seed=seed), controller)
     session = LaunchSession(plan, seed=seed, listen=None)
     try:
-        rt, monitor = session.runtime, session.monitor
-        truth = GroundTruth(rt)
-        started: float | None = None
-        outcome = "timeout"
-        while True:
-            rt.run(duration=CHECK_PERIOD)
-            now = rt.now()
-            robot = monitor.results()[0] if monitor.results() else None
-            if truth.xy is None:
-                continue
-            if started is None and math.dist(truth.xy, truth.first) >= MOVED:
-                started = now
-            if robot is not None and robot.collisions > 0:
-                outcome = "collision"
-                break
-            if math.dist(truth.xy, GOAL) <= GOAL_RADIUS:
-                outcome = "success"
-                break
-            if robot is not None and robot.goals_failed > 0:
-                outcome = "aborted"
-                break
-            if now - (started if started is not None else 0.0) >= time_limit:
-                break
-        elapsed = now - (started if started is not None else 0.0)
-        success = outcome == "success"
+        # the protocol's end conditions and scores: the same code scores `--batch` runs
+        protocol = BarnProtocol(session, args, time_limit=time_limit)
+        while not protocol.done():
+            session.runtime.run(duration=CHECK_PERIOD)
+        robot = session.monitor.robots.get(protocol.robot) or RobotResult(protocol.robot)
+        m = protocol.robot_metrics(robot)
         return RunResult(
             world=world,
-            outcome=outcome,
-            time=elapsed,
-            optimal_time=optimal,
-            metric=metric_of(success, elapsed, optimal),
-            final_gap=math.dist(truth.xy, GOAL) if truth.xy is not None else float("nan"),
+            outcome=m["barn_outcome"],
+            time=m["barn_time"],
+            optimal_time=m["barn_optimal_time"],
+            metric=m["barn_metric"],
+            final_gap=m["barn_final_gap"],
             wall=time.perf_counter() - t_wall,
         )
     finally:

@@ -9,6 +9,8 @@ from fleetsim.slam.filter import Beams, GmappingFilter, systematic_resample
 from fleetsim.slam.motion import poses_after_motion
 from fleetsim.slam.params import GmappingParams
 from fleetsim.slam.quality import ate
+from fleetsim.slam.render import cast_counts, occupancy_from_counts
+from fleetsim.slam.tiles import COUNT_CELL, TILE, CowTiles
 
 ANGLES = -np.pi + 2 * np.pi / 360 * np.arange(360)
 FORWARD = np.linspace(-np.pi / 2, np.pi / 2, 361)  # the hunter's laser: 180 degrees, 10 m
@@ -39,43 +41,47 @@ def test_systematic_resampling_keeps_heavy_particles():
     assert len(idx) == 5 and 4 not in idx and (idx == 0).sum() in (3, 4)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="unbiased matches keep the weights even: lineages no longer coalesce, so the base "
-    "never advances (the published map is being reworked into per-particle count tiles)",
-)
-def test_rendering_replays_only_the_scans_since_the_particles_agreed(monkeypatch):
+def test_the_published_map_is_the_best_particles_whole_history_read_out(monkeypatch):
     rng = np.random.default_rng(2)
-    # resampling often (the lineages coalesce): a high threshold, as matches agree closely
+    # resampling often (so that lineages branch and tiles are shared): a high threshold
     params = GmappingParams(
         particles=10, xmin=-4, ymin=-4, xmax=14, ymax=10, linearUpdate=0.3, angularUpdate=0.3,
         resampleThreshold=0.99,
     )  # fmt: skip
     f = GmappingFilter(params, rng, LASER, 11.99, 11.99)
-    casts = []
-    real = GmappingFilter._cast
-    monkeypatch.setattr(
-        GmappingFilter, "_cast", lambda self, g, n: (casts.append(n), real(self, g, n))
-    )
-    replayed = []
+    # each particle's history of (pose, scan), followed through resampling
+    history = [[] for _ in range(params.particles)]
+    real = GmappingFilter._resample
+
+    def resample(self, idx):
+        history[:] = [list(history[i]) for i in idx]
+        real(self, idx)
+
+    monkeypatch.setattr(GmappingFilter, "_resample", resample)
     resampled = 0
-    depths = []
     for i, (true, odom) in enumerate(drive(ROUTE, np.random.default_rng(3))):
-        result = f.process(odom, 0.1 * i, beams_at(true, rng))
+        beams = beams_at(true, rng)
+        result = f.process(odom, 0.1 * i, beams)
         resampled += result.resampled
-        if result.updated and f.updates % 5 == 0:
-            casts.clear()
-            f.occupancy()
-            replayed.append(len(casts))
-            depths.append(f.nodes[0].depth - f.base_node.depth)
+        if result.updated:
+            for p in range(params.particles):
+                history[p].append((f.poses[p].copy(), beams))
     assert f.updates > 60 and resampled > 5
-    # each map costs the scans since the particles' common ancestor plus those newly agreed
-    # on, not the whole run: it falls back whenever the lineages coalesce
-    assert max(replayed) < f.updates / 2
-    half = len(replayed) // 2
-    assert min(replayed[half:]) < max(replayed[:half])
-    assert f.base_node is not None and f.base_node.parent is None  # older history freed
-    assert 0 < f.maps.tiles_in_use < 3 * 10 * 200  # tiles shared, not 10 full copies
+    # reading the map out casts nothing: its cost does not grow with the run
+    monkeypatch.setattr(slam_filter, "cast_counts", None)
+    data, geom = f.occupancy()
+    # ... and it is what replaying the best particle's whole history gives (gmapping's map)
+    best = f.best_index
+    replay = CowTiles(1, *f.counts.bounds[:2], *f.counts.bounds[2:], 0.05, COUNT_CELL)
+    for pose, beams in history[best]:
+        replay.write(cast_counts, pose[None], LASER, beams.ranges, beams.angles, 11.99, replay.geom)
+    counts = replay.dense(0)
+    assert np.array_equal(f.counts.dense(best), counts)
+    assert np.array_equal(data, occupancy_from_counts(counts[..., 0], counts[..., 1], 0.25))
+    assert np.array_equal(geom, replay.geom) and (data == 100).sum() > 500
+    # tiles shared, not ten full copies of every grid
+    h, w = f.counts.shape_cells
+    assert f.counts.tiles_in_use < 0.5 * params.particles * h * w / TILE**2
 
 
 def test_map_grows_when_the_robot_leaves_it():
@@ -87,7 +93,7 @@ def test_map_grows_when_the_robot_leaves_it():
     x0, y0, x1, y1 = f.maps.bounds
     assert x0 <= -12 - slam_filter.ENLARGE_STEP + 1 and x1 >= 12 + slam_filter.ENLARGE_STEP - 1
     data, geom = f.occupancy()
-    assert data.shape == f.base.visits.shape and tuple(geom[:2]) == (x0, y0)
+    assert data.shape == f.counts.shape_cells and tuple(geom[:2]) == (x0, y0)
 
 
 def test_a_forward_laser_does_not_drift_while_the_robot_turns():

@@ -5,8 +5,9 @@ travelled ``linearUpdate`` / turned ``angularUpdate`` / waited ``temporalUpdate`
 first scan) each particle's pose is refined by hill-climbing scan matching against its own map,
 weighted by the scan's likelihood, the particles are resampled when the effective sample size
 falls below ``resampleThreshold * particles``, and the scan is added to every particle's map.
-The maps are `TiledHitMaps` (shared tiles), the history a `TreeNode` tree, and the published
-map a `CountGrid` base plus the scans since the particles' common ancestor (see `render`).
+Each particle holds two copy-on-write tile grids (`CowTiles`, tiles shared across resampled
+particles): the matcher's hit map and the visit/hit counts the published map is read from (see
+`render`).
 """
 
 from __future__ import annotations
@@ -18,10 +19,9 @@ import numpy as np
 
 from .motion import poses_after_motion, relative_pose
 from .params import GmappingParams
-from .render import CountGrid, occupancy_from_counts
-from .scan_match import endpoint_cells, matched_poses
-from .tiles import TiledHitMaps
-from .tree import ScanRecord, TreeNode, common_ancestor, path_from
+from .render import cast_counts, occupancy_from_counts
+from .scan_match import add_hits, endpoint_cells, matched_poses
+from .tiles import COUNT_CELL, HIT_CELL, CowTiles
 
 ENLARGE_STEP = 10.0  # m beyond a scan that leaves the map (gmapping's enlargeStep)
 
@@ -68,14 +68,12 @@ class GmappingFilter:
         self.max_range = float(max_range)
         self.usable_range = float(usable_range)
         n = p.particles
-        self.maps = TiledHitMaps(n, p.xmin, p.ymin, p.xmax, p.ymax, p.delta)
-        h, w = self.maps.shape_cells
-        self.base = CountGrid(h, w, self.maps.geom)
-        self.base_node: TreeNode | None = None
+        extent = (p.xmin, p.ymin, p.xmax, p.ymax, p.delta)
+        self.maps = CowTiles(n, *extent, HIT_CELL)  # what the matcher matches against
+        self.counts = CowTiles(n, *extent, COUNT_CELL)  # what the published map shows
         self.poses = np.zeros((n, 3))
         self.weights = np.zeros(n)  # log, since the last resampling
         self.weight_sums = np.zeros(n)  # log, over the whole run (best particle)
-        self.nodes: list[TreeNode] = []
         self.last_odom: np.ndarray | None = None
         self.linear = 0.0
         self.angular = 0.0
@@ -123,17 +121,19 @@ class GmappingFilter:
                 idx = systematic_resample(norm, self.rng)
                 self._resample(idx)
                 result.resampled = True
-        record = ScanRecord(
-            np.asarray(beams.ranges, dtype=np.float64),
-            np.asarray(beams.angles, dtype=np.float64),
-            self.laser,
-        )
-        if first:  # one root shared by all particles (they all start at the first odometry)
-            self.nodes = [TreeNode(None, self.poses[0], record)] * p.particles
-        else:
-            self.nodes = [TreeNode(par, pose, record) for par, pose in zip(self.nodes, self.poses)]
-        cells, hits = endpoint_cells(self.poses, self.laser, ranges, angles, self.maps.geom)
-        self.maps.add_scan(cells, hits)
+        # the first scan: every particle is at the same pose, register it once and share it
+        poses = self.poses[:1] if first else self.poses
+        cells, hits = endpoint_cells(poses, self.laser, ranges, angles, self.maps.geom)
+        self.maps.write(add_hits, cells, hits)
+        self.counts.write(
+            cast_counts, poses, self.laser,
+            np.ascontiguousarray(beams.ranges, dtype=np.float64),
+            np.ascontiguousarray(beams.angles, dtype=np.float64),
+            self.usable_range, self.counts.geom,
+        )  # fmt: skip
+        if first:
+            self.maps.resample(np.zeros(p.particles, dtype=int))
+            self.counts.resample(np.zeros(p.particles, dtype=int))
         self.linear = self.angular = 0.0
         self.last_update_time = stamp
         self.updates += 1
@@ -149,8 +149,8 @@ class GmappingFilter:
         self.poses = self.poses[idx]
         self.weight_sums = self.weight_sums[idx]
         self.weights = np.zeros(len(idx))
-        self.nodes = [self.nodes[i] for i in idx]
         self.maps.resample(idx)
+        self.counts.resample(idx)
 
     def _grow_for(self, ranges: np.ndarray, angles: np.ndarray) -> None:
         """Enlarge every map when this scan (from any particle) reaches beyond it."""
@@ -160,10 +160,8 @@ class GmappingFilter:
             x.min() - reach, y.min() - reach, x.max() + reach, y.max() + reach, ENLARGE_STEP
         )
         if any(pads):
-            from .scan_match import TILE
-
             self.maps.grow(*pads)
-            self.base.grow(*(t * TILE for t in pads))
+            self.counts.grow(*pads)
 
     # ----- outputs -----
     @property
@@ -183,23 +181,8 @@ class GmappingFilter:
     def occupancy(self) -> tuple[np.ndarray, np.ndarray]:
         """The best particle's map: ``(data (H, W) int8, geom (origin x, origin y, delta))``.
 
-        Scans every particle agrees on are folded into the base once; only the scans since the
-        particles' common ancestor are replayed onto a copy of it.
+        Read out of its counts: the cost is the map's size, not the length of the run.
         """
-        if not self.nodes:
-            h, w = self.base.visits.shape
-            return np.full((h, w), -1, dtype=np.int8), self.base.geom.copy()
-        ancestor = common_ancestor(self.nodes)
-        if ancestor is not None and ancestor is not self.base_node:
-            for node in path_from(self.base_node, ancestor):
-                self._cast(self.base, node)
-            self.base_node = ancestor
-            ancestor.parent = None  # history before it lives in the base now; free it
-        grid = self.base.copy()
-        for node in path_from(self.base_node, self.nodes[self.best_index]):
-            self._cast(grid, node)
-        return occupancy_from_counts(grid.visits, grid.hits, self.p.occ_thresh), grid.geom
-
-    def _cast(self, grid: CountGrid, node: TreeNode) -> None:
-        s = node.scan
-        grid.add(node.pose, s.laser, s.ranges, s.angles, self.usable_range)
+        counts = self.counts.dense(self.best_index)
+        data = occupancy_from_counts(counts[..., 0], counts[..., 1], self.p.occ_thresh)
+        return data, self.counts.geom.copy()

@@ -1,12 +1,14 @@
-"""The published map: scans ray-cast into hit and visit counts (gmapping's ``updateMap``).
+"""The published map: every processed scan ray-cast into each particle's own visit and hit
+counts (gmapping's ``updateMap``, kept up to date instead of rebuilt).
 
 gmapping rebuilds the published map from scratch every ``map_update_interval`` by replaying
-every scan of the best particle's trajectory, a cost that grows with the length of the run.
-fleetsim keeps a *base* grid holding every scan up to the particles' most recent common
-ancestor in the trajectory tree (the history all particles agree on, which never changes
-again), adds each scan to it once, and renders a map as a copy of the base plus the few scans
-from that ancestor to the best particle. The cost of a map is the grid's size plus the scans
-since the particles last coalesced, whatever the length of the run.
+every scan along the best particle's trajectory, a cost that grows with the length of the run.
+fleetsim casts each processed scan once into every particle's count grid, a `CowTiles` grid
+whose tiles resampled particles share, so a published map is the best particle's counts read
+out: its cost is the map's size, whatever the length of the run. The counts are those
+gmapping's replay makes: the cells a beam crosses are visited (its start cell included, its
+end cell not), a beam shorter than ``maxUrange`` adds a visit and a hit at its end cell, and a
+longer one is cut at ``maxUrange`` and marks free space only.
 """
 
 from __future__ import annotations
@@ -16,53 +18,86 @@ import math
 import numba
 import numpy as np
 
+from .tiles import MASK, SHIFT, writable_tile
+
+_SATURATED = 65535  # uint16 counts stop here (a cell visited that often is settled)
+
+
+@numba.njit(cache=True, inline="always")
+def _bump(pool, t, x, y, channel):
+    v = pool[t, y & MASK, x & MASK, channel]
+    if v < _SATURATED:
+        pool[t, y & MASK, x & MASK, channel] = v + 1
+
 
 @numba.njit(cache=True)
-def cast_scan(visits, hits, pose, laser, ranges, angles, usable, geom):
-    """Ray-cast one scan into ``visits`` / ``hits`` (H, W) int32 counts, in place.
+def cast_counts(
+    pool, table, refs, free, top, blank, start, poses, laser, ranges, angles, usable, geom
+):
+    """Ray-cast one scan into each particle's counts (from ``start`` on); a `CowTiles` kernel.
 
-    Each beam marks the cells from the laser to its endpoint visited (Bresenham); an endpoint
-    within ``usable`` m is a hit, a longer beam is cut at ``usable`` m and marks only free
-    space. ``pose`` is the base pose (m, m, rad) in the map frame, ``laser`` the laser in the
-    base frame, ``ranges``/``angles`` (B,) m/rad, ``geom`` ``(origin x, origin y, delta)``.
+    ``pool`` (T, TILE, TILE, 2) uint16 holds visits and hits per cell; ``poses`` (P, 3) are the
+    base poses (m, m, rad) in the map frame, ``laser`` the laser in the base frame,
+    ``ranges``/``angles`` (B,) m/rad, all beams up to maxRange; ``geom`` ``(origin x, origin
+    y, delta)``; every cell a beam reaches lies inside the grid (grow it first). Returns
+    ``(next particle, free-stack top, tiles needed)``: early when the free tiles might not
+    cover the next particle's scan.
     """
     ox, oy, delta = geom[0], geom[1], geom[2]
-    h, w = visits.shape
-    c, s = math.cos(pose[2]), math.sin(pose[2])
-    lx = pose[0] + c * laser[0] - s * laser[1]
-    ly = pose[1] + s * laser[0] + c * laser[1]
-    lt = pose[2] + laser[2]
-    x0 = math.floor((lx - ox) / delta)
-    y0 = math.floor((ly - oy) / delta)
-    for b in range(ranges.shape[0]):
-        r = ranges[b]
-        hit = r < usable
-        if not hit:
-            r = usable
-        a = lt + angles[b]
-        x1 = math.floor((lx + r * math.cos(a) - ox) / delta)
-        y1 = math.floor((ly + r * math.sin(a) - oy) / delta)
-        dx, dy = abs(x1 - x0), -abs(y1 - y0)
-        sx = 1 if x0 < x1 else -1
-        sy = 1 if y0 < y1 else -1
-        err = dx + dy
-        x, y = x0, y0
-        while True:
-            if x == x1 and y == y1:
-                break
-            if 0 <= x < w and 0 <= y < h:
-                visits[y, x] += 1
-            e2 = 2 * err
-            if e2 >= dy:
-                err += dy
-                x += sx
-            if e2 <= dx:
-                err += dx
-                y += sy
-        if 0 <= x1 < w and 0 <= y1 < h:
-            visits[y1, x1] += 1
-            if hit:
-                hits[y1, x1] += 1
+    nb = ranges.shape[0]
+    x1s = np.empty(nb, dtype=np.int64)
+    y1s = np.empty(nb, dtype=np.int64)
+    for p in range(start, poses.shape[0]):
+        c, s = math.cos(poses[p, 2]), math.sin(poses[p, 2])
+        lx = poses[p, 0] + c * laser[0] - s * laser[1]
+        ly = poses[p, 1] + s * laser[0] + c * laser[1]
+        lt = poses[p, 2] + laser[2]
+        x0 = math.floor((lx - ox) / delta)
+        y0 = math.floor((ly - oy) / delta)
+        bx0, bx1, by0, by1 = x0, x0, y0, y0
+        for b in range(nb):
+            r = min(ranges[b], usable)
+            x1s[b] = math.floor((lx + r * math.cos(lt + angles[b]) - ox) / delta)
+            y1s[b] = math.floor((ly + r * math.sin(lt + angles[b]) - oy) / delta)
+            bx0, bx1 = min(bx0, x1s[b]), max(bx1, x1s[b])
+            by0, by1 = min(by0, y1s[b]), max(by1, y1s[b])
+        need = ((bx1 >> SHIFT) - (bx0 >> SHIFT) + 1) * ((by1 >> SHIFT) - (by0 >> SHIFT) + 1)
+        if top < need:
+            return p, top, need
+        key = -1
+        t = -1
+        for b in range(nb):
+            x1, y1 = x1s[b], y1s[b]
+            dx, dy = abs(x1 - x0), -abs(y1 - y0)
+            sx = 1 if x0 < x1 else -1
+            sy = 1 if y0 < y1 else -1
+            err = dx + dy
+            x, y = x0, y0
+            while x != x1 or y != y1:  # Bresenham, the end cell excluded
+                k = (y >> SHIFT) * table.shape[2] + (x >> SHIFT)
+                if k != key:
+                    t, top = writable_tile(
+                        pool, table, refs, free, top, blank, p, y >> SHIFT, x >> SHIFT
+                    )
+                    key = k
+                _bump(pool, t, x, y, 0)
+                e2 = 2 * err
+                if e2 >= dy:
+                    err += dy
+                    x += sx
+                if e2 <= dx:
+                    err += dx
+                    y += sy
+            if ranges[b] < usable:
+                k = (y1 >> SHIFT) * table.shape[2] + (x1 >> SHIFT)
+                if k != key:
+                    t, top = writable_tile(
+                        pool, table, refs, free, top, blank, p, y1 >> SHIFT, x1 >> SHIFT
+                    )
+                    key = k
+                _bump(pool, t, x1, y1, 0)
+                _bump(pool, t, x1, y1, 1)
+    return poses.shape[0], top, 0
 
 
 def occupancy_from_counts(visits: np.ndarray, hits: np.ndarray, occ_thresh: float) -> np.ndarray:
@@ -73,28 +108,3 @@ def occupancy_from_counts(visits: np.ndarray, hits: np.ndarray, occ_thresh: floa
     np.divide(hits, visits, out=ratio, where=seen)
     out[seen] = np.where(ratio[seen] > occ_thresh, 100, 0)
     return out
-
-
-class CountGrid:
-    """Hit and visit counts over a growing extent (cell (0, 0)'s corner at ``geom[:2]``)."""
-
-    def __init__(self, height: int, width: int, geom: np.ndarray) -> None:
-        self.visits = np.zeros((height, width), dtype=np.int32)
-        self.hits = np.zeros((height, width), dtype=np.int32)
-        self.geom = np.array(geom, dtype=float)
-
-    def grow(self, left: int, bottom: int, right: int, top: int) -> None:
-        """Add cells on each side (unseen)."""
-        pad = ((bottom, top), (left, right))
-        self.visits = np.pad(self.visits, pad)
-        self.hits = np.pad(self.hits, pad)
-        self.geom[0] -= left * self.geom[2]
-        self.geom[1] -= bottom * self.geom[2]
-
-    def copy(self) -> CountGrid:
-        out = CountGrid.__new__(CountGrid)
-        out.visits, out.hits, out.geom = self.visits.copy(), self.hits.copy(), self.geom.copy()
-        return out
-
-    def add(self, pose, laser, ranges, angles, usable) -> None:
-        cast_scan(self.visits, self.hits, pose, laser, ranges, angles, usable, self.geom)

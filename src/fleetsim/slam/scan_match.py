@@ -2,9 +2,11 @@
 
 Each particle's map is a tiled hit map (see `fleetsim.slam.tiles`): ``table[p, ty, tx]`` is the
 index of a tile in a shared ``pool`` of shape ``(T, TILE, TILE, 3)`` holding per cell the hit
-count and the sums of the hit positions (x, y in m), or -1 for a tile never hit. This is
-gmapping with ``setgenerateMap(false)``, what slam_gmapping runs: the matching maps store
-endpoints only.
+count and the mean hit position (x, y in m, map frame; `FAR` where never hit), or -1 for a
+tile never hit. This is gmapping with ``setgenerateMap(false)``, what slam_gmapping runs: the
+matching maps store endpoints only. (gmapping keeps sums and divides at every look-up; the
+mean, with FAR for an empty cell, leaves the matcher's inner loop without a division or a
+branch.)
 
 A cell is "full" when it holds a hit. gmapping also asks that a "free" cell be empty
 (``cell > fullnessThreshold && fcell < fullnessThreshold``), but it finds that cell at
@@ -31,10 +33,12 @@ import math
 import numba
 import numpy as np
 
-TILE = 16  # cells per tile side (0.8 m at 5 cm)
-_SHIFT = 4
-_MASK = TILE - 1
+from .tiles import FAR, writable_tile
+from .tiles import MASK as _MASK
+from .tiles import SHIFT as _SHIFT
+
 NULL_LIKELIHOOD = -0.5  # gmapping's nullLikelihood
+NO_HIT = 1e30  # squared distances (m^2) from here on mean "no hit in the window"
 
 
 @numba.njit(cache=True, inline="always")
@@ -47,7 +51,7 @@ def _hits_at(pool, table, p, ix, iy):
     return table[p, ty, tx]
 
 
-@numba.njit(cache=True, fastmath=True)
+@numba.njit(cache=True, fastmath=True, error_model="numpy")
 def _match(pool, table, p, pose, laser, ranges, cos_a, sin_a, geom, kernel, sigma, lsigma, skip,
            want_l):  # fmt: skip
     """gmapping's score (and, when want_l, likelihood) of ``pose`` for particle p.
@@ -81,6 +85,9 @@ def _match(pool, table, p, pose, laser, ranges, cos_a, sin_a, geom, kernel, sigm
         if one_tile and table[p, ty0, tx0] < 0:
             pass  # the whole window lies in a tile this particle never hit: no match
         else:
+            # branch-free: an empty cell's mean lies FAR away (whether a cell is empty is a
+            # coin toss along a wall, and a branch on it mispredicts)
+            best = FAR * FAR
             for xx in range(-kernel, kernel + 1):
                 cx = ihx + xx
                 for yy in range(-kernel, kernel + 1):
@@ -88,16 +95,10 @@ def _match(pool, table, p, pose, laser, ranges, cos_a, sin_a, geom, kernel, sigm
                     t = table[p, ty0, tx0] if one_tile else _hits_at(pool, table, p, cx, cy)
                     if t < 0:
                         continue
-                    n = pool[t, cy & _MASK, cx & _MASK, 0]
-                    if n <= 0.0:
-                        continue
-                    # sums are offsets from the cell's own corner (float32 exact to ~1e-8 m)
-                    mx = hx - (ox + cx * delta + pool[t, cy & _MASK, cx & _MASK, 1] / n)
-                    my = hy - (oy + cy * delta + pool[t, cy & _MASK, cx & _MASK, 2] / n)
-                    d2 = mx * mx + my * my
-                    if not found or d2 < best:
-                        best = d2
-                        found = True
+                    mx = hx - pool[t, cy & _MASK, cx & _MASK, 1]
+                    my = hy - pool[t, cy & _MASK, cx & _MASK, 2]
+                    best = min(best, mx * mx + my * my)
+            found = best < NO_HIT
         if found:
             score += math.exp(-best / sigma)
         if want_l:
@@ -225,17 +226,32 @@ def endpoint_cells(poses, laser, ranges, angles, geom):
 
 
 @numba.njit(cache=True)
-def add_hits(pool, table, cells, hits, geom):
-    """Add each particle's endpoints to its own tiles (which the caller made writable).
+def add_hits(pool, table, refs, free, top, blank, start, cells, hits):
+    """Add each particle's endpoints (from ``start`` on) to its own tiles; a `CowTiles` kernel.
 
-    A cell holds its hit count and the sums of the hits' offsets from the cell's corner (m).
+    ``cells`` (P, B, 2) int cells and ``hits`` (P, B, 2) m, all inside the map. A cell holds
+    its hit count and the mean hit position. Returns ``(next particle, free-stack top, tiles
+    needed)``: early when fewer than B tiles are free.
     """
-    ox, oy, delta = geom[0], geom[1], geom[2]
-    for p in range(cells.shape[0]):
-        for i in range(cells.shape[1]):
+    nb = cells.shape[1]
+    for p in range(start, cells.shape[0]):
+        if top < nb:  # at most one new tile per endpoint
+            return p, top, nb
+        key = -1
+        t = -1
+        for i in range(nb):
             ix, iy = cells[p, i, 0], cells[p, i, 1]
-            t = table[p, iy >> _SHIFT, ix >> _SHIFT]
+            k = (iy >> _SHIFT) * table.shape[2] + (ix >> _SHIFT)
+            if k != key:
+                t, top = writable_tile(
+                    pool, table, refs, free, top, blank, p, iy >> _SHIFT, ix >> _SHIFT
+                )
+                key = k
             c = pool[t, iy & _MASK, ix & _MASK]
             c[0] += 1.0
-            c[1] += hits[p, i, 0] - (ox + ix * delta)
-            c[2] += hits[p, i, 1] - (oy + iy * delta)
+            if c[0] == 1.0:
+                c[1], c[2] = hits[p, i, 0], hits[p, i, 1]
+            else:
+                c[1] += (hits[p, i, 0] - c[1]) / c[0]
+                c[2] += (hits[p, i, 1] - c[2]) / c[0]
+    return cells.shape[0], top, 0

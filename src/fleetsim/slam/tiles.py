@@ -1,35 +1,81 @@
-"""Per-particle hit maps that share memory: copy-on-write tiles, as gmapping's
+"""Per-particle grids that share memory: copy-on-write tiles, as gmapping's
 ``HierarchicalArray2D`` of reference-counted patches.
 
-Every particle has a table of tile indices (``table[p, ty, tx]``, -1 where it never saw a hit)
-into one pool of ``TILE x TILE`` tiles. Resampling copies tables, not tiles: the copies share
-their tiles (the reference count goes up). Registering a scan copies only the tiles it writes
-to that another particle also holds. The map grows by whole tiles, so a cell's own corner (from
-which its hit offsets are measured) never moves.
+Every particle has a table of tile indices (``table[p, ty, tx]``, -1 where it never wrote) into
+one pool of ``TILE x TILE`` tiles of cells (``pool[t, iy, ix, ...]``). Resampling copies
+tables, not tiles: the copies share their tiles (the reference count goes up). A kernel that
+writes a cell first asks `writable_tile` for the tile, which copies it when another particle
+holds it too (or takes a fresh one where the particle has none). The grid grows by whole
+tiles, so a cell's corner never moves.
+
+slam_gmapping keeps two such grids per particle: the matcher's hit map (`HIT_CELL`, gmapping's
+endpoint-only map) and the counts the published map is made of (`COUNT_CELL`).
 """
 
 from __future__ import annotations
 
 import math
 
+import numba
 import numpy as np
 
-from .scan_match import TILE, add_hits
+TILE = 16  # cells per tile side (0.8 m at 5 cm)
+SHIFT = 4
+MASK = TILE - 1
+#: hit map cell, float32: hit count, mean hit position (x, y in m in the map frame; `FAR` in a
+#: cell never hit, so that a distance to it is huge without a test)
+HIT_CELL = ((3,), np.float32, (0.0, 1e18, 1e18))
+FAR = 1e18
+#: count cell, uint16: visits, hits (saturating at 65535)
+COUNT_CELL = ((2,), np.uint16, (0, 0))
 
 
-class TiledHitMaps:
-    """Endpoint (hit) maps of ``particles`` particles over the extent ``[x0, x1] x [y0, y1]``."""
+@numba.njit(cache=True)
+def writable_tile(pool, table, refs, free, top, blank, p, ty, tx):
+    """Index of particle p's tile (ty, tx), made private to p; and the new free-stack top.
+
+    A tile another particle holds is copied; an unset one is taken from ``free[:top]`` (the
+    caller reserved enough) and set to ``blank`` (TILE, TILE, ...).
+    """
+    t = table[p, ty, tx]
+    if t >= 0 and refs[t] == 1:
+        return t, top
+    top -= 1
+    new = free[top]
+    if t >= 0:
+        pool[new] = pool[t]
+        refs[t] -= 1
+    else:
+        pool[new] = blank
+    refs[new] = 1
+    table[p, ty, tx] = new
+    return new, top
+
+
+class CowTiles:
+    """One copy-on-write grid per particle over the extent ``[x0, x1] x [y0, y1]``."""
 
     def __init__(
-        self, particles: int, x0: float, y0: float, x1: float, y1: float, delta: float
+        self,
+        particles: int,
+        x0: float,
+        y0: float,
+        x1: float,
+        y1: float,
+        delta: float,
+        cell: tuple[tuple[int, ...], type] = HIT_CELL,
     ) -> None:
         self.delta = float(delta)
         tx = max(1, math.ceil((x1 - x0) / (delta * TILE)))
         ty = max(1, math.ceil((y1 - y0) / (delta * TILE)))
         self.geom = np.array([float(x0), float(y0), self.delta])
         self.table = np.full((particles, ty, tx), -1, dtype=np.int32)
-        self.pool = np.zeros((64, TILE, TILE, 3), dtype=np.float32)
-        self.refs = np.zeros(64, dtype=np.int64)
+        shape, dtype, blank = cell
+        self.blank = np.asarray(blank, dtype=dtype)  # a cell never written
+        self.blank_tile = np.broadcast_to(self.blank, (TILE, TILE, *shape)).copy()
+        self.pool = np.empty((0, TILE, TILE, *shape), dtype=dtype)
+        self.refs = np.zeros(0, dtype=np.int64)
+        self.free_stack(64)
 
     # ----- geometry -----
     @property
@@ -70,44 +116,45 @@ class TiledHitMaps:
         used = self.table[self.table >= 0]
         self.refs = np.bincount(used, minlength=len(self.pool)).astype(np.int64)
 
-    def _allocate(self, count: int) -> np.ndarray:
+    def free_stack(self, count: int) -> np.ndarray:
+        """Indices of free tiles, at least ``count`` of them (the pool grows as needed); a
+        kernel pops them from the end through `writable_tile`."""
         free = np.flatnonzero(self.refs == 0)
         if len(free) < count:
             old = len(self.pool)
             new = max(2 * old, old + count - len(free))
-            self.pool = np.concatenate(
-                [self.pool, np.zeros((new - old, TILE, TILE, 3), dtype=np.float32)]
-            )
+            pool = np.empty((new, *self.pool.shape[1:]), dtype=self.pool.dtype)
+            pool[:old] = self.pool
+            self.pool = pool
             self.refs = np.concatenate([self.refs, np.zeros(new - old, dtype=np.int64)])
             free = np.flatnonzero(self.refs == 0)
-        return free[:count]
+        return free
 
-    def add_scan(self, cells: np.ndarray, hits: np.ndarray) -> None:
-        """Register endpoints: ``cells`` (P, B, 2) int cells and ``hits`` (P, B, 2) m, all
-        inside the map (grow it first)."""
-        if cells.shape[1] == 0:
-            return
-        n, ty, tx = self.table.shape
-        p = np.repeat(np.arange(n), cells.shape[1])
-        keys = np.unique(
-            (p * ty + (cells[..., 1].ravel() // TILE)) * tx + (cells[..., 0].ravel() // TILE)
-        )
-        flat = self.table.reshape(-1)
-        tiles = flat[keys]
-        shared = np.zeros(len(keys), dtype=bool)
-        held = tiles >= 0
-        shared[held] = self.refs[tiles[held]] > 1
-        need = ~held | shared
-        new = self._allocate(int(need.sum()))
-        src = tiles[need]
-        copy = src >= 0
-        self.pool[new] = 0.0
-        self.pool[new[copy]] = self.pool[src[copy]]
-        np.subtract.at(self.refs, src[copy], 1)
-        self.refs[new] = 1
-        flat[keys[need]] = new
-        add_hits(self.pool, self.table, cells, hits, self.geom)
+    def write(self, kernel, *args) -> None:
+        """Run ``kernel(pool, table, refs, free, top, blank, start, *args) -> (next, top,
+        need)``
+        over its particles from ``start``: it returns early, at particle ``next``, when fewer
+        than ``need`` free tiles are left (and is called again with a larger pool), with
+        ``need`` 0 when done."""
+        start, need = 0, 0
+        while True:
+            free = self.free_stack(need)
+            start, _, need = kernel(
+                self.pool, self.table, self.refs, free, len(free), self.blank_tile, start, *args
+            )
+            if need == 0:
+                return
 
     @property
     def tiles_in_use(self) -> int:
         return int(np.count_nonzero(self.refs))
+
+    def dense(self, p: int) -> np.ndarray:
+        """(H, W, ...) particle p's cells, blank where it never wrote."""
+        ty, tx = self.table.shape[1:]
+        out = np.empty((ty, tx, *self.pool.shape[1:]), dtype=self.pool.dtype)
+        out[...] = self.blank
+        held = self.table[p] >= 0
+        out[held] = self.pool[self.table[p][held]]
+        out = np.swapaxes(out, 1, 2)  # (ty, iy, tx, ix, ...)
+        return out.reshape(ty * TILE, tx * TILE, *self.pool.shape[3:])

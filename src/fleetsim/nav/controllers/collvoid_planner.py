@@ -280,7 +280,7 @@ class CollvoidLocalPlanner(LocalPlanner):
         else:
             v, w = tracking_command(holo, yaw, p.time_to_holo, p.max_vel_x, p.max_vel_theta)
             v = speed_along_heading(*self.lines, yaw, v, p.max_vel_x)
-            cmd = (v, 0.0, w)
+            cmd = (v, 0.0, _clamp(w, p.min_vel_theta, p.max_vel_theta))
         v0, vy0, w0 = (float(c) for c in velocity)
         dv, dw = p.acc_lim_x * self.dt, p.acc_lim_theta * self.dt
         dvy = p.acc_lim_y * self.dt

@@ -8,10 +8,11 @@ extrudes its walls from), and the trajectory with the simulator's ground truth:
   +-0.2 m, +-2 deg): a SLAM cell is right when a true occupied cell lies within 0.1 m, a true
   cell is found when a SLAM occupied cell lies within 0.1 m (true cells counted only where the
   SLAM map has seen space, i.e. next to a known cell);
-- ATE (RMS of position error after a rigid Umeyama alignment, written out here in NumPy in a
-  few lines rather than adding ``evo`` for one function) of map -> base_link sampled every 1 s;
-- the time to explore (sim s) and the wall time per filter update (median and p90), plus one
-  update with 30 particles and 360 beams timed on the synthetic room of tests/slam.
+- ATE (`fleetsim.slam.quality.ate`: RMS of position error after a rigid Umeyama alignment) of
+  map -> base_link sampled every 1 s;
+- the time to explore (sim s) and the CPU time of the thread per filter update (median and
+  p90; CPU time, as this shared machine's wall time swings with the other jobs on it), plus
+  one update with 30 particles and 360 beams timed on the synthetic room of tests/slam.
 
 Not done yet: the Willow loop and two robots (issue 17 asks for both).
 
@@ -31,16 +32,6 @@ from scipy import ndimage
 
 ROOT = Path(__file__).resolve().parent.parent
 sys.path.insert(0, str(ROOT / "tests" / "slam"))
-
-
-def umeyama_ate(est: np.ndarray, truth: np.ndarray) -> float:
-    """RMS position error (m) of (N, 2) ``est`` after the rigid alignment onto ``truth``."""
-    me, mt = est.mean(0), truth.mean(0)
-    u, _, vt = np.linalg.svd((truth - mt).T @ (est - me))
-    d = np.diag([1.0, np.sign(np.linalg.det(u @ vt))])
-    rot = u @ d @ vt
-    aligned = (est - me) @ rot.T + mt
-    return float(np.sqrt(np.mean(np.sum((aligned - truth) ** 2, axis=1))))
 
 
 def precision_recall(slam, truth) -> tuple[float, float, tuple[float, float, float]]:
@@ -89,15 +80,16 @@ def office(max_time: float, seed: int) -> None:
     from fleetsim.launch.runner import LaunchSession, load_plan
     from fleetsim.nav.map_io import load_map
     from fleetsim.slam.filter import GmappingFilter
+    from fleetsim.slam.quality import ate
 
     update_times: list[float] = []
     real = GmappingFilter.process
 
     def timed(self, *a, **k):
-        t = time.perf_counter()
+        t = time.thread_time()
         out = real(self, *a, **k)
         if out.updated:
-            update_times.append(time.perf_counter() - t)
+            update_times.append(time.thread_time() - t)
         return out
 
     GmappingFilter.process = timed
@@ -116,12 +108,12 @@ def office(max_time: float, seed: int) -> None:
         blacklisted = len(ex.blacklist)
     wall = time.perf_counter() - t0
     p, r, shift = precision_recall(slam, truth)
-    ate = umeyama_ate(np.array(est), np.array(true))
+    ate_m = ate(np.array(est), np.array(true))
     ut = np.array(update_times) * 1e3
     print(f"office (hunter, seed {seed}): finished={ex.finished} blacklisted={blacklisted}")
     print(f"  time to explore      {explored_at:8.1f} sim s ({wall:.0f} s wall)")
     print(f"  occupied precision   {p:8.3f}   recall {r:.3f}   (alignment {shift})")
-    print(f"  ATE RMS              {ate:8.3f} m over {len(est)} poses")
+    print(f"  ATE RMS              {ate_m:8.3f} m over {len(est)} poses")
     print(f"  filter update        {np.median(ut):8.1f} ms median, p90 {np.percentile(ut, 90):.1f}"
           f" ms ({len(ut)} updates, 20 particles)")  # fmt: skip
 
@@ -142,10 +134,10 @@ def update_30x360() -> None:
         sensor = true + np.array([c * LASER[0], s * LASER[0], 0.0])
         r = exact_ranges(sensor, angles, 12.0) + 0.01 * rng.standard_normal(360)
         r = np.where(np.isfinite(r), r, 12.0)
-        t = time.perf_counter()
+        t = time.thread_time()
         res = f.process(odom, 0.1 * i, Beams(r, angles))
         if res.updated and f.updates > 2:  # past numba's compilation
-            times.append(time.perf_counter() - t)
+            times.append(time.thread_time() - t)
     ms = np.array(times) * 1e3
     print(
         f"one update, 30 particles x 360 beams (gmapping defaults): median {np.median(ms):.1f} "

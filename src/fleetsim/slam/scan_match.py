@@ -151,6 +151,7 @@ def matched_poses(
         best_score = -1.0
         ld, ad = lstep, astep
         refinement = 0
+        back = -1  # the move leading back to the last round's pose (no better: not scored)
         while True:
             if best_score >= cur_score:
                 refinement += 1
@@ -158,7 +159,10 @@ def matched_poses(
                 ad *= 0.5
             best_score = cur_score
             best_local = cur.copy()
+            taken = -1
             for move in range(6):
+                if move == back:
+                    continue
                 cand[0], cand[1], cand[2] = cur[0], cur[1], cur[2]
                 if move == 0:
                     cand[0] += ld
@@ -179,7 +183,9 @@ def matched_poses(
                 if sc > cur_score:
                     cur_score = sc
                     best_local[:] = cand
+                    taken = move
             cur[:] = best_local
+            back = taken ^ 1 if taken >= 0 else -1  # moves come in opposite pairs
             if not (cur_score > best_score or refinement < iterations):
                 break
         if best_score > minimum_score:

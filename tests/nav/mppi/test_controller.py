@@ -128,12 +128,27 @@ def test_omni_strafes_to_a_goal_beside_it():
     assert np.abs(poses[:, 2]).max() < 0.5  # rather than turning towards it
 
 
-def test_on_an_inscribed_cell_is_no_valid_trajectory_and_no_plan_is_empty():
+def test_on_a_lethal_cell_is_no_valid_trajectory_and_no_plan_is_empty():
     m = Costmap2D(40, 40, 0.05)
-    m.costs[:] = 253  # the robot's centre is within its inscribed radius of an obstacle
+    m.costs[:] = 254  # every pose, the robot's own too, is on an obstacle
     c = make(m, batch_size=50)
     with pytest.raises(EmptyPlan):
         c.compute_velocity_commands((1.0, 1.0, 0.0), (0, 0, 0))
     c.set_plan(line(1.0, 1.9, 1.0, n=10))
     with pytest.raises(NoValidTrajectory, match="every one of 50 sampled trajectories collides"):
         c.compute_velocity_commands((1.0, 1.0, 0.0), (0, 0, 0))
+
+
+def test_a_robot_whose_footprint_touches_a_post_backs_away_instead_of_failing():
+    m = Costmap2D(80, 80, 0.05)
+    m.costs[40, 45] = 254  # a post 0.25 m ahead of the robot at (2.0, 2.0)
+    c = make(m, CostCritic={"consider_footprint": True})
+    c.set_plan(line(2.0, 3.5, 2.0, n=30))  # through the post (the costmap changed under it)
+    pose = (2.0, 2.0, 0.0)  # facing the post, its 0.2 m radius outline 5 cm from it
+    assert c._escape_clearance(np.array(pose)) == -1.0  # not yet touching
+    pose = (2.06, 2.025, 0.0)  # now the outline is on the post
+    poses, cmds = drive(c, pose, 30)
+    post = np.array([45.5, 40.5]) * 0.05
+    gaps = np.hypot(*(poses[:, :2] - post).T)
+    start = math.hypot(2.06 - post[0], 2.025 - post[1])
+    assert gaps[-1] > start + 0.03 and gaps.min() > start - 1e-3  # out, never nearer

@@ -211,7 +211,7 @@ def test_footprint_collisions_match_the_outline_or_an_obstacle_inside(seed):
     lethal = np.argwhere(m.costs == 254)[:, ::-1] * 0.05 + 0.025  # cell centres (x, y)
     for x, y, yaw in rng.uniform((0.5, 0.5, -math.pi), (2.5, 2.5, math.pi), (300, 3)):
         c, s = math.cos(yaw), math.sin(yaw)
-        got = k.pose_cost(m.costs, clear2, 0.0, 0.0, 0.05, outline, True, inside2, outside2,
+        got = k.strict_pose_cost(m.costs, clear2, 0.0, 0.0, 0.05, outline, True, inside2, outside2,
                           x, y, c, s)  # fmt: skip
         pts = np.column_stack([x + c * outline[:, 0] - s * outline[:, 1],
                                y + s * outline[:, 0] + c * outline[:, 1]])  # fmt: skip

@@ -35,6 +35,7 @@ from fleetsim.nav.controllers.base import (
     NoValidTrajectory,
     VelocityCommand,
 )
+from fleetsim.nav.controllers.mppi.critic_kernels import COLLISION, strict_pose_cost
 from fleetsim.nav.controllers.mppi.critics import Critic, CriticData
 from fleetsim.nav.controllers.mppi.kernels import (
     MODEL_CODES,
@@ -103,8 +104,8 @@ class MPPIController(LocalPlanner):
         self.reached_goal = False
         self.xy_tolerance_latch = False
         self._plan_start = 0
-        self._no_clearance = np.full((1, 1), -1, dtype=np.int64)
-        self.clearance2 = self._no_clearance
+        self.clearance2 = np.full((1, 1), -1, dtype=np.int64)
+        self.escape2 = -1.0
         self.reset()
 
     @classmethod
@@ -173,9 +174,8 @@ class MPPIController(LocalPlanner):
             self.plan, robot[0], robot[1], self._plan_start, search, p.prune_distance
         )
         blocked = blocked_points(m.costs, m.origin_x, m.origin_y, m.resolution, path)
-        self.clearance2 = self._no_clearance
-        if self.uses_footprint:
-            self.clearance2 = squared_distances_to(m.costs == LETHAL_OBSTACLE)
+        self.clearance2 = squared_distances_to(m.costs == LETHAL_OBSTACLE)
+        self.escape2 = self._escape_clearance(robot)
         vel = np.array([float(v) for v in velocity])
         for _attempt in range(p.retry_attempt_limit + 1):
             data = self._optimize(robot, vel, path, blocked)
@@ -195,6 +195,20 @@ class MPPIController(LocalPlanner):
         return VelocityCommand(float(cmd[0]), float(cmd[1]), float(cmd[2]))
 
     # -- optimisation ---------------------------------------------------------------------------
+    def _escape_clearance(self, robot: np.ndarray) -> float:
+        """The robot's clearance2 when its own pose counts as a collision by the footprint or
+        inscribed rule (then samples may leave it without getting nearer to an obstacle; see
+        `critic_kernels.pose_cost`), else -1."""
+        m = self.costmap
+        use_fp = self.uses_footprint
+        c, s = math.cos(robot[2]), math.sin(robot[2])
+        args = (m.costs, self.clearance2, m.origin_x, m.origin_y, m.resolution, self.outline)
+        here = strict_pose_cost(*args, use_fp, self.inside2, self.outside2, *robot[:2], c, s)
+        cell = m.world_to_map(robot[0], robot[1])
+        if here != COLLISION or cell is None:
+            return -1.0
+        return float(max(self.clearance2[cell[1], cell[0]], 0))
+
     def _optimize(self, robot, vel, path, blocked) -> CriticData:
         p = self.params
         for _ in range(p.iteration_count):
@@ -223,7 +237,7 @@ class MPPIController(LocalPlanner):
             limits=(p.vx_min, p.vx_max, p.vy_max, p.wz_max), model=self.model,
             min_turning_r=self.ackermann.min_turning_r, costmap=self.costmap,
             outline=self.outline, clearance2=self.clearance2, inside2=self.inside2,
-            outside2=self.outside2,
+            outside2=self.outside2, escape2=self.escape2,
             inscribed_radius=self.inscribed_radius, costs=np.zeros(p.batch_size),
         )  # fmt: skip
         for critic in self.critics:

@@ -21,7 +21,35 @@ def _wrap(a):
 
 
 @njit(cache=True)
-def pose_cost(costs, clear2, ox, oy, res, outline, use_footprint, inside2, outside2, x, y, c, s):
+def pose_cost(
+    costs, clear2, ox, oy, res, outline, use_footprint, inside2, outside2, escape2, x, y, c, s
+):
+    """`strict_pose_cost`, escaping: with ``escape2`` >= 0 (the robot's own pose already counts
+    as a collision, ``escape2`` its clearance2), a pose that would collide only by the
+    footprint or inscribed rule, no nearer to a lethal cell than the robot is now, costs 253
+    (critical) instead, so the robot can back or turn out of the spot it is in rather than
+    fail every sample (a padded footprint touching a post the robot itself has not hit)."""
+    r = strict_pose_cost(
+        costs, clear2, ox, oy, res, outline, use_footprint, inside2, outside2, x, y, c, s
+    )
+    if r != COLLISION or escape2 < 0.0:
+        return r
+    h, w = costs.shape
+    fx = (x - ox) / res
+    fy = (y - oy) / res
+    if fx < 0.0 or fy < 0.0 or fx >= w or fy >= h:
+        return r
+    iy, ix = int(fy), int(fx)
+    d2 = clear2[iy, ix]
+    if costs[iy, ix] == 254 or (d2 >= 0 and d2 < escape2):  # d2 -1: no lethal cell at all
+        return r
+    return 253.0
+
+
+@njit(cache=True)
+def strict_pose_cost(
+    costs, clear2, ox, oy, res, outline, use_footprint, inside2, outside2, x, y, c, s
+):
     """The cost of one pose (heading cos ``c``, sin ``s``): its centre cell's, or `COLLISION`.
 
     A lethal centre cell or one off the grid is a collision. Without ``use_footprint`` so is an
@@ -70,6 +98,7 @@ def cost_terms(
     use_footprint,
     inside2,
     outside2,
+    escape2,
     step,
     near_collision,
     critical,
@@ -95,6 +124,7 @@ def cost_terms(
                 use_footprint,
                 inside2,
                 outside2,
+                escape2,
                 poses[b, t, 0],
                 poses[b, t, 1],
                 headings[b, t, 0],
@@ -124,6 +154,7 @@ def obstacle_terms(
     use_footprint,
     inside2,
     outside2,
+    escape2,
     inscribed,
     scaling,
     margin,
@@ -151,6 +182,7 @@ def obstacle_terms(
                 use_footprint,
                 inside2,
                 outside2,
+                escape2,
                 poses[b, t, 0],
                 poses[b, t, 1],
                 headings[b, t, 0],

@@ -41,6 +41,7 @@ class CriticData:
     outside2: float  # clearance2 above which no footprint reaches a lethal cell
     inscribed_radius: float
     fail: bool = False
+    escape2: float = -1.0  # the robot's clearance2 when its own pose collides (else -1)
     costs: np.ndarray = field(default_factory=lambda: np.zeros(0))
 
     @property
@@ -86,7 +87,7 @@ def _grid(data: CriticData, consider_footprint: bool):
     m = data.costmap
     return (
         m.costs, data.clearance2, m.origin_x, m.origin_y, m.resolution, data.outline,
-        consider_footprint, data.inside2, data.outside2,
+        consider_footprint, data.inside2, data.outside2, data.escape2,
     )  # fmt: skip
 
 

@@ -359,11 +359,15 @@ def main() -> None:
         print(f"\naruco_detect per {a.width}x{a.height} frame (target: 5 ms):")
         print(f"  all {len(times)} frames: {_ms(times[:, 0], times[:, 1])}")
         alone = times[times[:, 2] < PREEMPTED_MS]
-        print(
-            f"  the {len(alone)} frames no other process preempted (run-queue wait < "
-            f"{PREEMPTED_MS} ms; what a quiet machine gives, slightly optimistic: short frames "
-            "are preempted less often): " + (_ms(alone[:, 0], alone[:, 1]) if len(alone) else "-")
-        )
+        if np.isnan(times[:, 2]).all():
+            print("  (no schedstat here: frames preempted by other processes cannot be told)")
+        else:
+            print(
+                f"  the {len(alone)} frames no other process preempted (run-queue wait < "
+                f"{PREEMPTED_MS} ms; what a quiet machine gives, slightly optimistic: short "
+                "frames are preempted less often): "
+                + (_ms(alone[:, 0], alone[:, 1]) if len(alone) else "-")
+            )
     jpegs = [b for r in rows for b in r["samples"]]
     if jpegs:
         print(f"\naruco_detect's stages on {len(jpegs)} recorded frames, timed now:")

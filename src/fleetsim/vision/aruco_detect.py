@@ -18,13 +18,13 @@ naming the topic, not a warning repeated for every frame; malformed id lists and
 ids the dictionary does not hold, are errors naming the parameter.
 
 Cost (figures: ``benchmarks/visual_servoing.py``, README): about 94 % of a frame's CPU is
-OpenCV's detection, which with the package's 13 adaptive-threshold windows (3..53 px) thresholds the
-image and traces its contours 13 times. OpenCV runs the windows as a parallel_for on every core
-(its default thread count, which the node leaves alone): on 2 idle cores that halves the wall
-time for a few % more CPU. A compressed image is decoded straight to grey (libjpeg's luma, which
-can differ from cv_bridge's BGR-to-grey by a few levels at colour edges; corners moved by at
-most 0.02 px on 1,200 rendered frames), and to colour only while ``/fiducial_images`` has a
-subscriber; a frame without markers skips the pose arrays.
+OpenCV's detection, which with the package's 13 adaptive-threshold windows (3..53 px) thresholds
+the image and traces its contours 13 times. OpenCV runs the windows as a parallel_for on every
+core (its default thread count, which the node leaves alone): on 2 idle cores that divides the
+wall time by 1.85 for 7 % more CPU. A compressed image is decoded straight to grey (libjpeg's
+luma, which can differ from cv_bridge's BGR-to-grey by a few levels at colour edges; corners
+moved by at most 0.02 px on 1,200 rendered frames), and to colour only while
+``/fiducial_images`` has a subscriber; a frame without markers skips the pose arrays.
 """
 
 from __future__ import annotations

@@ -22,7 +22,7 @@ OpenCV's detection, which with the package's 13 adaptive-threshold windows (3..5
 the image and traces its contours 13 times. OpenCV runs the windows as a parallel_for on every
 core (its default thread count, which the node leaves alone): on 2 idle cores that divides the
 wall time by 1.85 for 7 % more CPU. A compressed image is decoded straight to grey (libjpeg's
-luma, which can differ from cv_bridge's BGR-to-grey by a few levels at colour edges; corners
+luma, which can differ from cv_bridge's BGR-to-grey by up to 14 levels at colour edges; corners
 moved by at most 0.02 px on 1,200 rendered frames), and to colour only while
 ``/fiducial_images`` has a subscriber; a frame without markers skips the pose arrays.
 """

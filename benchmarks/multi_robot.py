@@ -42,6 +42,7 @@ os.environ.setdefault("NUMBA_NUM_THREADS", "1")
 import numpy as np
 
 from fleetsim.cli.launch import resolve_launch_file
+from fleetsim.errors import PhysicsInstability
 from fleetsim.launch.runner import LaunchSession, load_plan
 
 START_DELAY = 2.0  # s, the scenarios' default
@@ -64,6 +65,7 @@ class Run:
     paths: dict[str, float] = field(default_factory=dict)
     arrival: dict[str, float] = field(default_factory=dict)
     wall: float = 0.0
+    crashed: str = ""  # the simulator's error, when the run ended in one
 
 
 def jittered_plan(path: Path, args: dict[str, str], seed: int, jitter: float):
@@ -139,7 +141,10 @@ def run_once(name: str, robots: int, planner: str, seed: int, limit: float, jitt
                 return False
             return all(r.all_done or r.model in stuck for r in rs)
 
-        rt.run(duration=limit, until=finished)
+        try:
+            rt.run(duration=limit, until=finished)
+        except PhysicsInstability as err:  # a pile-up flung a robot: the run ends there
+            out.crashed = str(err).split(";")[0]
         for r in mon.results():
             if r.goals_reached and r.time_of_last_result is not None:
                 out.reached += 1
@@ -243,6 +248,9 @@ def main() -> None:
             )
             print(f"    alone: slowest {alone_time:.1f} s; per seed makespan "
                   + " ".join("-" if math.isnan(s) else f"{s:.1f}" for s in spans))  # fmt: skip
+            for r in runs:
+                if r.crashed:
+                    print(f"    seed {r.seed}: the simulation failed: {r.crashed}")
 
 
 if __name__ == "__main__":

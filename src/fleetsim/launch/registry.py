@@ -38,6 +38,8 @@ NODES: dict[tuple[str, str], str] = {
     ("aruco_detect", "aruco_detect"): "fleetsim.vision.aruco_detect:ArucoDetect",
     ("grobot_utilities", "spawn_marker_on_robot"): "fleetsim.apps.spawn_marker_on_robot:SpawnMarkerOnRobot",
     ("grobot_navigation", "follow_marker"): "fleetsim.apps.follow_marker:FollowMarker",
+    ("fleetsim", "patrol_route"): "fleetsim.apps.patrol_route:PatrolRoute",
+    ("fleetsim", "predictive_follower"): "fleetsim.apps.predictive_follower:PredictiveFollower",
     ("controller_manager", "spawner"): "fleetsim.control.spawner:Spawner",
     ("moveit_ros_move_group", "move_group"): "fleetsim.moveit.move_group:MoveGroup",
 }  # fmt: skip

@@ -25,6 +25,7 @@ limits):
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass
 from typing import Any
 
@@ -36,6 +37,7 @@ from fleetsim.apps.follower_mpc import rollout_costs, velocity_samples
 from fleetsim.apps.target_tracker import TargetTracker, TrackerParams
 from fleetsim.errors import TransformError
 from fleetsim.msgs import fiducial_msgs, geometry_msgs, nav_msgs, std_msgs
+from fleetsim.nav.costmap.costmap_2d import FREE_SPACE, LETHAL_OBSTACLE
 from fleetsim.nav.costmap.costmap_ros import Costmap2DROS
 from fleetsim.nav.costmap.footprint import outline_points
 from fleetsim.runtime import Node, param
@@ -112,6 +114,15 @@ class PredictiveFollowerParams:
         help="the tutorial's exploration, the last fallback (strategy, robot_frame, target_pose)",
     )
     local_costmap: dict = param({}, help="the follower's rolling costmap (costmap_2d params)")
+    target_radius: float = param(
+        0.2,
+        unit="m",
+        range=(0.0, None),
+        help="lethal marks this near the target's track are its own",
+    )
+    trail_time: float = param(
+        30.0, unit="s", range=(0.0, None), help="how long the target's track is remembered"
+    )
 
 
 class PredictiveFollower(Node):
@@ -168,6 +179,7 @@ class PredictiveFollower(Node):
         self.mode = TRACK
         self.started = self.now()
         self.sightings = 0
+        self.trail: deque[tuple[float, float, float]] = deque()  # stamp, x, y in map
         self.infeasible_cycles = 0
         self._warned_at: dict[str, float] = {}
         self._patience = TransformPatience()
@@ -216,6 +228,11 @@ class PredictiveFollower(Node):
         stamp = msg.header.stamp.to_sec()
         if self.tracker.update(stamp, fix, distance=float(np.linalg.norm(tvec))):
             self.sightings += 1
+            x, y = self.tracker.x[:2]
+            if not self.trail or math.hypot(x - self.trail[-1][1], y - self.trail[-1][2]) > 0.05:
+                self.trail.append((stamp, float(x), float(y)))
+            while self.trail and self.trail[0][0] < stamp - self.params.trail_time:
+                self.trail.popleft()
             if self.exploration.is_exploring():
                 self.exploration.cancel()
 
@@ -261,6 +278,32 @@ class PredictiveFollower(Node):
                 return None
             self.camera_x = float(t[0])
         return self.camera_x
+
+    def _costs_without_target(self, cm, ox: float, oy: float, oth: float) -> np.ndarray:
+        """The local costmap with the lethal marks the target left along its track (and at its
+        estimate) cleared: they are the target itself, which the MPC keeps ``min_gap`` from,
+        and a laser that sees nothing behind them (beyond its range) never clears them."""
+        pts = [(x, y) for _, x, y in self.trail]
+        pts.append(tuple(self.tracker.x[:2]))
+        xy = np.asarray(pts, float)
+        c, s = math.cos(oth), math.sin(oth)
+        gx = ox + c * xy[:, 0] - s * xy[:, 1]
+        gy = oy + s * xy[:, 0] + c * xy[:, 1]
+        res = cm.resolution
+        k = math.ceil(self.params.target_radius / res)
+        d = np.arange(-k, k + 1)
+        di, dj = np.meshgrid(d, d)
+        keep = np.hypot(di, dj) * res <= self.params.target_radius
+        di, dj = di[keep], dj[keep]
+        cols = (np.floor((gx - cm.origin_x) / res).astype(int)[:, None] + di[None, :]).ravel()
+        rows = (np.floor((gy - cm.origin_y) / res).astype(int)[:, None] + dj[None, :]).ravel()
+        h, w = cm.costs.shape
+        ok = (cols >= 0) & (rows >= 0) & (cols < w) & (rows < h)
+        rows, cols = rows[ok], cols[ok]
+        costs = cm.costs.copy()
+        lethal = costs[rows, cols] == LETHAL_OBSTACLE
+        costs[rows[lethal], cols[lethal]] = FREE_SPACE
+        return costs
 
     def publish_command(self, v: float, w: float) -> None:
         self.command = np.array([v, w])
@@ -308,7 +351,7 @@ class PredictiveFollower(Node):
         cm = self.costmap.costmap
         p = self.params
         costs, poses = rollout_costs(
-            cm.costs,
+            self._costs_without_target(cm, ox, oy, oth),
             cm.origin_x,
             cm.origin_y,
             cm.resolution,

@@ -1,8 +1,12 @@
-"""The tutorial's visual servoing, measured (issue 15): baseline figures for the next issue.
+"""The tutorial's visual servoing, measured (issue 15), and fleetsim's predictive follower
+against it (issue 19), side by side on the same seeds and scenarios.
 
 Runs ``visual_servoing.launch`` (karl patrols with a marker, the waffle follows it with
-aruco_detect and follow_marker, as grobot does) for each strategy and seed, and prints per
-strategy, over the seeds (mean, and the spread across seeds):
+aruco_detect) for each patrol (``circle``: the tutorial's; ``building``: move_base goals through
+the building's gaps and corners, with stops), follower (``follow_marker``: the tutorial's
+move_base goals; ``predictive``: the tracker + MPC of `fleetsim.apps.predictive_follower`),
+exploration strategy and seed, and prints per run, then side by side per patrol and strategy
+(mean over the seeds, min..max; and follow_marker's losses over the predictive follower's):
 
 - ``detected``: share of camera frames in which aruco_detect found the marker;
 - ``in view``: share of those frames in which the true marker was inside the camera's field of
@@ -33,14 +37,19 @@ Defaults: 10 seeds x both strategies x 180 s of sim time from the tutorial's sta
 camera at 640x480 (same horizontal field of view as the real 1920x1080; software rendering
 cannot render that at 30 Hz). Shorter: ``--seeds 2 --duration 60``.
 
+``--picture run.png`` draws the first seed's run of each patrol and follower (the report module
+``visual_servoing_report.py``); ``--no-stages`` skips the detector's stage timing.
+
 Usage: python benchmarks/visual_servoing.py [--seeds 10] [--duration 180]
-       [--strategies rotate move_to_target] [--width 640 --height 480 --rate 10]
+       [--strategies rotate move_to_target] [--followers follow_marker predictive]
+       [--patrols circle building] [--width 640 --height 480 --rate 10] [--picture PNG]
 """
 
 from __future__ import annotations
 
 import argparse
 import dataclasses
+import itertools
 import math
 import os
 import time
@@ -53,6 +62,7 @@ from scipy.spatial.transform import Rotation
 from fleetsim.cli.launch import resolve_launch_file
 from fleetsim.launch.runner import LaunchSession, load_plan
 from fleetsim.msgs import fiducial_msgs, sensor_msgs, std_msgs
+from visual_servoing_report import picture, summary
 
 OPTICAL = "camera_rgb_optical_frame"
 FOLLOWER, TARGET, MARKER = "turtlebot3_waffle", "karl", "karl_marker"
@@ -79,6 +89,7 @@ class Probe:
         self.engine = s.nodes["/gazebo"].engine
         self.detector = s.nodes["/aruco_detect"]
         self.frames: list[tuple[float, bool, bool, float]] = []  # t, detected, in view, dist
+        self.paths: list[tuple[float, float, float, float, bool]] = []  # follower xy, target xy
         #: per image: wall s, process CPU s, s the process's threads waited for a CPU
         self.times: list[tuple[float, float, float]] = []
         self.samples: list[bytes] = []  # every 5th JPEG, for the detector-only timing
@@ -121,6 +132,7 @@ class Probe:
         self.frames.append(
             (msg.header.stamp.to_sec(), detected, self._in_view(t_wb, r_wb, t_wm, r_wm), dist)
         )
+        self.paths.append((t_wb[0], t_wb[1], t_wm[0], t_wm[1], detected))
 
     def _in_view(self, t_wb, r_wb, t_wm, r_wm) -> bool:
         k = self.detector.camera_matrix
@@ -196,9 +208,20 @@ class MachineLoad:
         return max(busy - own, 0.0) / total
 
 
-def run(strategy: str, seed: int, duration: float, width: int, height: int, rate: float) -> dict:
+def run(
+    strategy: str,
+    seed: int,
+    duration: float,
+    width: int,
+    height: int,
+    rate: float,
+    follower: str = "follow_marker",
+    patrol: str = "circle",
+) -> dict:
     args = {
         "exploration_strategy": strategy,
+        "follower": follower,
+        "patrol": patrol,
         "gui": "false",
         "camera_width": str(width),
         "camera_height": str(height),
@@ -215,6 +238,9 @@ def run(strategy: str, seed: int, duration: float, width: int, height: int, rate
         det = probe.detector
         return {
             "strategy": strategy,
+            "follower": follower,
+            "patrol": patrol,
+            "paths": np.array(probe.paths, dtype=float).reshape(-1, 5),
             "seed": seed,
             "frames": len(f),
             "detected": float(f[:, 0].mean()) if len(f) else 0.0,
@@ -326,9 +352,13 @@ def main() -> None:
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--duration", type=float, default=180.0, help="sim seconds per run")
     ap.add_argument("--strategies", nargs="+", default=["rotate", "move_to_target"])
+    ap.add_argument("--followers", nargs="+", default=["follow_marker", "predictive"])
+    ap.add_argument("--patrols", nargs="+", default=["circle", "building"])
     ap.add_argument("--width", type=int, default=640)
     ap.add_argument("--height", type=int, default=480)
     ap.add_argument("--rate", type=float, default=10.0, help="camera Hz")
+    ap.add_argument("--picture", help="write a PNG of the first seed's paths here")
+    ap.add_argument("--no-stages", action="store_true", help="skip aruco_detect's stage timing")
     a = ap.parse_args()
     print(
         f"visual_servoing.launch: {a.seeds} seeds x {a.duration:.0f} s, camera {a.width}x"
@@ -336,24 +366,21 @@ def main() -> None:
         f"on {os.cpu_count()} CPUs"
     )
     head = "".join(f"{n:>11}" for n, _ in COLUMNS)
-    print(f"{'strategy':>15} {'seed':>4}{head}{'wall s':>8}")
+    print(f"{'patrol':>9} {'follower':>14} {'strategy':>15} {'seed':>4}{head}{'wall s':>8}")
     rows = []
-    for strategy in a.strategies:
-        for seed in range(a.seeds):
-            r = run(strategy, seed, a.duration, a.width, a.height, a.rate)
-            rows.append(r)
-            cells = "".join(f"{fmt.format(r[n]):>11}" for n, fmt in COLUMNS)
-            print(f"{strategy:>15} {seed:>4}{cells}{r['wall']:>8.0f}", flush=True)
-    print("\nper strategy: mean over seeds (min..max)")
-    for strategy in a.strategies:
-        rs = [r for r in rows if r["strategy"] == strategy]
-        cells = []
-        for n, fmt in COLUMNS:
-            v = np.array([r[n] for r in rs], float)
-            cells.append(
-                f"{n} {fmt.format(v.mean())} ({fmt.format(v.min())}..{fmt.format(v.max())})"
-            )
-        print(f"{strategy}: " + ", ".join(cells))
+    for patrol, follower, strategy, seed in itertools.product(
+        a.patrols, a.followers, a.strategies, range(a.seeds)
+    ):
+        r = run(strategy, seed, a.duration, a.width, a.height, a.rate, follower, patrol)
+        rows.append(r)
+        cells = "".join(f"{fmt.format(r[n]):>11}" for n, fmt in COLUMNS)
+        print(
+            f"{patrol:>9} {follower:>14} {strategy:>15} {seed:>4}{cells}{r['wall']:>8.0f}",
+            flush=True,
+        )
+    summary(rows, COLUMNS)
+    if a.picture:
+        picture(rows, a.picture)
     times = np.concatenate([r["times"] for r in rows])
     if len(times):
         print(f"\naruco_detect per {a.width}x{a.height} frame (target: 5 ms):")
@@ -369,7 +396,7 @@ def main() -> None:
                 + (_ms(alone[:, 0], alone[:, 1]) if len(alone) else "-")
             )
     jpegs = [b for r in rows for b in r["samples"]]
-    if jpegs:
+    if jpegs and not a.no_stages:
         print(f"\naruco_detect's stages on {len(jpegs)} recorded frames, timed now:")
         stage_timing(jpegs, rows[0]["params"], rows[0]["k"], rows[0]["d"])
 

@@ -72,6 +72,23 @@ def test_drives_down_a_corridor_and_stops_within_the_goal_tolerances():
     assert c.local_plan.shape == (0, 3)
 
 
+def test_a_plan_handed_over_again_every_cycle_is_followed_to_its_end():
+    # move_base re-expresses the plan in odom and hands it over each cycle; the nearest-point
+    # search must go on from where it was, not from the plan's first point (it would search
+    # only max_robot_pose_search_dist = 1.5 m of plan and the robot would stop near 3.2 m)
+    c = make(corridor(), max_robot_pose_search_dist=1.5)
+    plan = line(0.3, 5.7, 1.0, n=300)
+    x, y, th, v = 0.3, 1.0, 0.0, (0.0, 0.0, 0.0)
+    for k in range(500):
+        c.set_plan(plan + np.array([0.001 * (k % 3), 0.0, 0.0]))  # odom drifts by 1 mm
+        v = c.compute_velocity_commands((x, y, th), v)
+        x, y, th = x + v.vx * math.cos(th) * DT, y + v.vx * math.sin(th) * DT, th + v.vtheta * DT
+        if c.is_goal_reached():
+            break
+    assert c.is_goal_reached(), (x, y)
+    assert math.hypot(x - 5.7, y - 1.0) <= 0.25
+
+
 def detour():
     """A plan around the box as navfn draws it: along y 2, over the box at y 2.8, back."""
     pts = np.array([[0.5, 2.0], [1.8, 2.0], [2.4, 2.8], [3.0, 2.8], [3.6, 2.0], [5.0, 2.0]])

@@ -53,6 +53,9 @@ from fleetsim.nav.costmap.footprint import footprint_radii, outline_points
 from fleetsim.nav.costmap.inflation_layer import squared_distances_to
 
 PLUGIN = "nav2_mppi_controller::MPPIController"
+#: m: a plan whose every point moved less than this is the last one re-expressed (a map->odom
+#: correction), not a new plan
+SAME_PLAN_SHIFT = 0.5
 
 
 class MPPIController(LocalPlanner):
@@ -137,11 +140,20 @@ class MPPIController(LocalPlanner):
             raise EmptyPlan(f"set_plan: a plan must be (N, 3) x, y, yaw poses, got {poses.shape}")
         if poses.shape[1] == 2:
             poses = np.concatenate([poses, np.zeros((poses.shape[0], 1))], axis=1)
-        same_goal = self.plan.shape[0] > 0 and np.allclose(
-            self.plan[-1], poses[-1], rtol=0.0, atol=1e-6
+        # move_base hands the same plan over again each cycle when the local costmap's frame
+        # is not the global one (re-expressed in odom): Nav2 keeps its plan pruned up to the
+        # robot, so the nearest-point search starts where it ended; starting it over at the
+        # plan's first point would only search max_robot_pose_search_dist m of a long plan and
+        # pin the robot there. A plan from the planner (another shape, or moved) starts at 0.
+        again = poses.shape == self.plan.shape and bool(
+            np.max(np.abs(poses[:, :2] - self.plan[:, :2]), initial=0.0) <= SAME_PLAN_SHIFT
+        )
+        same_goal = again or (
+            self.plan.shape[0] > 0 and np.allclose(self.plan[-1], poses[-1], rtol=0.0, atol=1e-6)
         )
         self.plan = np.ascontiguousarray(poses)
-        self._plan_start = 0
+        if not again:
+            self._plan_start = 0
         if not same_goal:
             self.reached_goal = False
             self.xy_tolerance_latch = False

@@ -14,14 +14,17 @@ extrudes its walls from), and the trajectory with the simulator's ground truth:
   p90; CPU time, as this shared machine's wall time swings with the other jobs on it), plus
   one update with 30 particles and 360 beams timed on the synthetic room of tests/slam.
 
-Not done yet: the Willow loop and two robots (issue 17 asks for both).
+Willow: the hunter driven by move_base goals out along Willow's west and north corridors and
+back (about 90 m), mapping with the manual's gmapping parameters; the same figures. Not done
+yet: two robots (issue 17 asks for it).
 
-Usage: python benchmarks/slam_quality.py [--max-time 900] [--seed 1]
+Usage: python benchmarks/slam_quality.py [--max-time 900] [--seed 1] [--only willow]
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
 import math
 import sys
 import time
@@ -74,48 +77,125 @@ def precision_recall(slam, truth) -> tuple[float, float, tuple[float, float, flo
     return best
 
 
-def office(max_time: float, seed: int) -> None:
-    import fleetsim
-    from fleetsim.cli.launch import resolve_launch_file
-    from fleetsim.launch.runner import LaunchSession, load_plan
-    from fleetsim.nav.map_io import load_map
+@contextlib.contextmanager
+def update_timer():
+    """Thread CPU seconds of every filter update run inside the block (appended to a list)."""
     from fleetsim.slam.filter import GmappingFilter
-    from fleetsim.slam.quality import ate
 
-    update_times: list[float] = []
+    times: list[float] = []
     real = GmappingFilter.process
 
     def timed(self, *a, **k):
         t = time.thread_time()
         out = real(self, *a, **k)
         if out.updated:
-            update_times.append(time.thread_time() - t)
+            times.append(time.thread_time() - t)
         return out
 
     GmappingFilter.process = timed
+    try:
+        yield times
+    finally:
+        GmappingFilter.process = real
+
+
+def report(name, slam, truth, est, true, times, wall, sim_s) -> None:
+    from fleetsim.slam.quality import ate
+
+    p, r, shift = precision_recall(slam, truth)
+    ut = np.array(times) * 1e3
+    print(f"  sim time             {sim_s:8.1f} sim s ({wall:.0f} s wall)")
+    print(f"  occupied precision   {p:8.3f}   recall {r:.3f}   (alignment {shift})")
+    print(
+        f"  ATE RMS              {ate(np.array(est), np.array(true)):8.3f} m over {len(est)} poses"
+    )
+    print(f"  filter update        {np.median(ut):8.1f} ms median, p90 {np.percentile(ut, 90):.1f}"
+          f" ms ({len(ut)} updates, 20 particles, 720 beams; CPU time)")  # fmt: skip
+
+
+def sample(s, est, true) -> None:
+    pos, _ = s.monitor.sim.engine.model_pose("robocluedo_robot")
+    est.append(s.runtime.tf_buffer.lookup_pose2d("map", "base_link", 0.0)[:2])
+    true.append((float(pos[0]), float(pos[1])))
+
+
+def office(max_time: float, seed: int) -> None:
+    import fleetsim
+    from fleetsim.cli.launch import resolve_launch_file
+    from fleetsim.launch.runner import LaunchSession, load_plan
+    from fleetsim.nav.map_io import load_map
+
     truth = load_map(Path(fleetsim.__file__).parent / "assets" / "maps" / "office.yaml")
     t0 = time.perf_counter()
-    with LaunchSession(load_plan(resolve_launch_file("slam_explore"), {}), seed=seed) as s:
+    plan = load_plan(resolve_launch_file("slam_explore"), {})
+    with update_timer() as times, LaunchSession(plan, seed=seed) as s:
         ex = s.nodes["/explore"]
         est, true = [], []
         while not ex.finished and s.runtime.now() < max_time:
             s.runtime.run(duration=1.0)
-            pos, _ = s.monitor.sim.engine.model_pose("robocluedo_robot")
-            est.append(s.runtime.tf_buffer.lookup_pose2d("map", "base_link", 0.0)[:2])
-            true.append((float(pos[0]), float(pos[1])))
+            sample(s, est, true)
         explored_at = s.runtime.now()
         slam = s.nodes["/slam_gmapping"].grid_msg
         blacklisted = len(ex.blacklist)
-    wall = time.perf_counter() - t0
-    p, r, shift = precision_recall(slam, truth)
-    ate_m = ate(np.array(est), np.array(true))
-    ut = np.array(update_times) * 1e3
-    print(f"office (hunter, seed {seed}): finished={ex.finished} blacklisted={blacklisted}")
-    print(f"  time to explore      {explored_at:8.1f} sim s ({wall:.0f} s wall)")
-    print(f"  occupied precision   {p:8.3f}   recall {r:.3f}   (alignment {shift})")
-    print(f"  ATE RMS              {ate_m:8.3f} m over {len(est)} poses")
-    print(f"  filter update        {np.median(ut):8.1f} ms median, p90 {np.percentile(ut, 90):.1f}"
-          f" ms ({len(ut)} updates, 20 particles)")  # fmt: skip
+    print(
+        f"office (hunter explores, seed {seed}): finished={ex.finished} blacklisted={blacklisted}"
+    )
+    report("office", slam, truth, est, true, times, time.perf_counter() - t0, explored_at)
+
+
+#: Willow: the hunter out along the west corridor and the north one, and back (map frame m)
+WILLOW_START = (7.3, 14.0)
+WILLOW_ROUTE = [(7.5, 29.0), (7.2, 43.4), (13.0, 46.8), (21.0, 48.2), (31.0, 48.2), (21.0, 48.2),
+                (13.0, 46.8), (7.2, 43.4), (7.5, 29.0), (7.3, 14.0)]  # fmt: skip
+
+
+def willow(seed: int, goals: int = len(WILLOW_ROUTE)) -> None:
+    """The hunter (the manual's nav_stack: gmapping + move_base) driven along WILLOW_ROUTE in
+    the Willow map world, as benchmarks/fleet_rtf.py builds it."""
+    import tempfile
+
+    from fleetsim.launch.runner import LaunchSession, load_plan
+    from fleetsim.nav.map_io import load_map
+    from fleetsim.nav.navigator import Navigator
+
+    world = ROOT.parent / "shared" / "data" / "maps" / "willow-full.yaml"
+    x, y = WILLOW_START
+    xml = f"""<launch>
+  <include file="$(find robocluedo_robot_hunter)/launch/gazebo.launch">
+    <arg name="gazebo_gui" value="false"/><arg name="world_file_path" value="{world}"/>
+    <arg name="x" value="{x}"/><arg name="y" value="{y}"/>
+    <arg name="model_name" value="robocluedo_robot"/>
+  </include>
+  <node name="robot_state_publisher" pkg="robot_state_publisher" type="robot_state_publisher"/>
+  <include file="$(find fleetsim_launch)/nav_stack.launch"/>
+</launch>
+"""
+    truth = load_map(world)
+    t0 = time.perf_counter()
+    with tempfile.TemporaryDirectory() as tmp:
+        path = Path(tmp) / "willow_slam.launch"
+        path.write_text(xml)
+        plan = load_plan(path, {})
+    reached = 0
+    with update_timer() as times, LaunchSession(plan, seed=seed) as s:
+        nav = Navigator(s.runtime, "/")
+        est, true = [], []
+        s.runtime.run(duration=1.0)
+        prev = WILLOW_START
+        for gx, gy in WILLOW_ROUTE[:goals]:
+            nav.go_to_pose(gx, gy, math.atan2(gy - prev[1], gx - prev[0]))
+            deadline = s.runtime.now() + 150.0
+            while not nav.is_task_complete() and s.runtime.now() < deadline:
+                s.runtime.run(duration=1.0)
+                sample(s, est, true)
+            reached += nav.get_result().name == "SUCCEEDED"
+            prev = (gx, gy)
+            print(f"  goal ({gx}, {gy}): {nav.get_result().name} at {s.runtime.now():.0f} sim s,"
+                  f" {time.perf_counter() - t0:.0f} s wall", flush=True)  # fmt: skip
+        slam = s.nodes["/slam_gmapping"].grid_msg
+        sim_s = s.runtime.now()
+    print(f"willow (hunter, scripted route, seed {seed}): {reached}/{goals} goals")
+    report("willow", slam, truth, est, true, times, time.perf_counter() - t0, sim_s)
 
 
 def update_30x360() -> None:
@@ -149,9 +229,15 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--max-time", type=float, default=900.0)
     ap.add_argument("--seed", type=int, default=1)
+    ap.add_argument("--only", choices=["update", "office", "willow"], default=None)
+    ap.add_argument("--willow-goals", type=int, default=len(WILLOW_ROUTE))
     a = ap.parse_args()
-    update_30x360()
-    office(a.max_time, a.seed)
+    if a.only in (None, "update"):
+        update_30x360()
+    if a.only in (None, "office"):
+        office(a.max_time, a.seed)
+    if a.only in (None, "willow"):
+        willow(a.seed, a.willow_goals)
 
 
 if __name__ == "__main__":

@@ -233,10 +233,30 @@ def available_worlds(barn_dir: Path) -> list[int]:
     return sorted(int(p.stem.split("_")[1]) for p in barn_dir.glob("world_*.world"))
 
 
+#: the held-out discipline: parameters and planner changes are tuned on the first half of the
+#: shared worlds by number (3-147), the second half (153-297) only measured
+HALVES = ("tuning", "held-out")
+
+
+def half_worlds(barn_dir: Path, half: str) -> list[int]:
+    """The worlds of one half of the split (``tuning``: the first half by number)."""
+    worlds = available_worlds(barn_dir)
+    k = len(worlds) // 2
+    return worlds[:k] if half == "tuning" else worlds[k:]
+
+
+def split_name(barn_dir: Path, half: str) -> str:
+    worlds = half_worlds(barn_dir, half)
+    return f"{half} half of the split, worlds {worlds[0]}-{worlds[-1]} ({len(worlds)})"
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--worlds", help="comma-separated world numbers, e.g. 3,9,15")
     ap.add_argument("--all", action="store_true", help="every world in --barn-dir")
+    ap.add_argument(
+        "--half", choices=HALVES, help="one half of the tuning split (tuning: first by number)"
+    )
     ap.add_argument("--barn-dir", type=Path, default=BARN_DIR)
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--controller", choices=sorted(CONTROLLERS), default="dwa")
@@ -248,13 +268,19 @@ def main() -> None:
     ap.add_argument("--resume", action="store_true", help="--batch: keep finished runs")
     a = ap.parse_args()
     logging.basicConfig(level=logging.INFO if a.verbose else logging.ERROR)
-    if a.all:
+    if a.half:
+        worlds = half_worlds(a.barn_dir, a.half)
+    elif a.all:
         worlds = available_worlds(a.barn_dir)
     elif a.worlds:
         worlds = [int(w) for w in a.worlds.split(",") if w.strip()]
     else:
         worlds = list(DEFAULT_WORLDS)
     print(f"BARN: jackal + move_base ({a.controller}), {len(worlds)} worlds from {a.barn_dir}")
+    tuned = half_worlds(a.barn_dir, "tuning")
+    print(f"split: tuned on worlds {tuned[0]}-{tuned[-1]}; held out: the rest")
+    if a.half:
+        print(f"measuring the {split_name(a.barn_dir, a.half)}")
     if a.batch is not None:
         batch_main(a, worlds)
         return

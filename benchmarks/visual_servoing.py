@@ -244,7 +244,7 @@ def run(
     with LaunchSession(load_plan(resolve_launch_file("visual_servoing"), args), seed=seed) as s:
         probe = Probe(s)
         s.runtime.run(duration=duration)
-        follower = next(r for r in s.monitor.results() if r.model == FOLLOWER)
+        robot = next(r for r in s.monitor.results() if r.model == FOLLOWER)
         f = np.array([row[1:] for row in probe.frames], dtype=float)
         times = np.array(probe.times, dtype=float).reshape(-1, 3) * 1e3  # wall, cpu, wait (ms)
         det = probe.detector
@@ -260,7 +260,7 @@ def run(
             "losses": losses(probe.frames, s.runtime.now()),
             "dist_mean": float(f[:, 2].mean()) if len(f) else math.nan,
             "dist_p95": float(np.percentile(f[:, 2], 95)) if len(f) else math.nan,
-            "collisions": follower.collisions,
+            "collisions": robot.collisions,
             "aruco_med": float(np.median(times[:, 0])) if len(times) else math.nan,
             "aruco_p95": float(np.percentile(times[:, 0], 95)) if len(times) else math.nan,
             "aruco_cpu": float(np.median(times[:, 1])) if len(times) else math.nan,

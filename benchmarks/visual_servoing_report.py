@@ -93,5 +93,6 @@ def summary(rows: list[dict], columns: list[tuple[str, str]]) -> None:
             means[follower] = np.mean([r["losses"] for r in rs])
             print(f"| {patrol} | {strategy} | {follower} | {len(rs)} | " + " | ".join(cells) + " |")
         if "follow_marker" in means and "predictive" in means:
-            ratio = means["follow_marker"] / max(means["predictive"], 1e-9)
-            print(f"|  |  | losses follow_marker / predictive: {ratio:.1f}x |")
+            fm, pr = means["follow_marker"], means["predictive"]
+            ratio = f"{fm / pr:.1f}x fewer" if pr > 0 else f"none against {fm:.1f}"
+            print(f"|  |  | predictive's losses: {ratio} |")

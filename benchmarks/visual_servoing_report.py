@@ -29,8 +29,8 @@ def picture(rows: list[dict], path: str) -> None:
     runs = {}
     for r in rows:
         runs.setdefault((r["patrol"], r["follower"]), r)
-    patrols = sorted({k[0] for k in runs})
-    followers = sorted({k[1] for k in runs})
+    patrols = list(dict.fromkeys(k[0] for k in runs))  # in the order they ran
+    followers = list(dict.fromkeys(k[1] for k in runs))
     fig, axes = plt.subplots(
         len(patrols),
         len(followers),

@@ -198,6 +198,22 @@ def test_a_free_centre_with_a_corner_on_an_obstacle_collides():
     assert score("CostCritic", d, consider_footprint=False)[0] == 0.0  # its centre is free
 
 
+def test_with_the_footprint_an_inscribed_centre_is_graded_not_critical():
+    # the footprint decides collisions; an INSCRIBED centre it finds clear is a tight fit, not
+    # a near collision worth critical_cost per pose (which kept MPPI out of gaps navfn takes)
+    m = Costmap2D(200, 100, 0.05, -2.5, -2.5)
+    m.costs[70:75, :] = 254  # y 1.0..1.25
+    m.costs[60:70, :] = 253  # an inscribed band below it, out of the round robot's reach
+    traj = [straight(0.55)]  # cell row 61: 253, the outline (r 0.2) reaches y 0.75 < 1.0
+    graded = score("CostCritic", data_for(traj, m=m), consider_footprint=True)[0]
+    assert graded == pytest.approx(3.81 / 254 * 252)
+    strict = score("CostCritic", data_for(traj, m=m), consider_footprint=False)[0]
+    assert strict == pytest.approx(1e6)  # the centre rule: inscribed is a collision
+    near = score("CostCritic", data_for(traj, m=m), consider_footprint=True,
+                 near_collision_cost=200)[0]  # fmt: skip
+    assert near == pytest.approx(3.81 / 254 * 300)  # a lower threshold still applies
+
+
 @pytest.mark.parametrize("seed", range(3))
 def test_footprint_collisions_match_the_outline_or_an_obstacle_inside(seed):
     rng = np.random.default_rng(seed)

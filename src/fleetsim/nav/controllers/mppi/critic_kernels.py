@@ -56,11 +56,12 @@ def strict_pose_cost(
     inscribed (253) one. With it, ``clear2`` (H, W) gives each cell's squared distance (cells)
     to the nearest lethal cell (-1: none): beyond ``outside2`` no footprint can touch one, below
     ``inside2`` one lies inside the footprint, in between the footprint's outline is laid on
-    the grid and a lethal cell (or the grid's edge) under it is a collision. The graded cost
-    stays the centre's: the inflation layer's costs are distances from the centre (an outline
-    cell at 253 only says an obstacle is within the inscribed radius of the robot's edge, and
-    in clutter nearly every pose's outline has one). NO_INFORMATION (255) is passable (Nav2
-    with unknown space tracked)."""
+    the grid and a lethal cell (or the grid's edge) under it is a collision; a pose the
+    footprint passes costs at most 252 (below INSCRIBED, so not critical_cost by itself). The
+    graded cost stays the centre's: the inflation layer's costs are distances from the centre
+    (an outline cell at 253 only says an obstacle is within the inscribed radius of the
+    robot's edge, and in clutter nearly every pose's outline has one). NO_INFORMATION (255) is
+    passable (Nav2 with unknown space tracked)."""
     h, w = costs.shape
     fx = (x - ox) / res
     fy = (y - oy) / res
@@ -74,7 +75,7 @@ def strict_pose_cost(
         return COLLISION if v == 253 else float(v)
     d2 = clear2[iy, ix]
     if d2 < 0 or d2 > outside2:
-        return float(v)
+        return float(min(v, 252))
     if d2 < inside2:
         return COLLISION
     for k in range(outline.shape[0]):
@@ -82,7 +83,11 @@ def strict_pose_cost(
         fy = (y + s * outline[k, 0] + c * outline[k, 1] - oy) / res
         if fx < 0.0 or fy < 0.0 or fx >= w or fy >= h or costs[int(fy), int(fx)] == 254:
             return COLLISION
-    return float(v)
+    # the footprint found no contact: an INSCRIBED centre (an obstacle within the inscribed
+    # radius of the centre cell, a cell's rounding from the outline) is not "near collision"
+    # by itself; it scores as the highest graded cost, so a gap the footprint fits through
+    # costs what its tightness costs rather than critical_cost per pose
+    return float(min(v, 252))
 
 
 @njit(cache=True)

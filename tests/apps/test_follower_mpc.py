@@ -7,7 +7,7 @@ import math
 import numpy as np
 import pytest
 
-from fleetsim.apps.follower_mpc import rollout_costs, velocity_samples
+from fleetsim.apps.follower_mpc import costs_without_target, rollout_costs, velocity_samples
 from fleetsim.apps.target_tracker import ctrv_step
 from fleetsim.nav.costmap.footprint import outline_points
 
@@ -102,3 +102,26 @@ def test_velocity_samples_hold_zero_and_the_limits():
     assert {0.0, -0.1, 0.26} <= set(s[:, 0]) and {0.0, -1.82, 1.82} <= set(s[:, 1])
     assert s.flags.c_contiguous and s.dtype == np.float64
     assert len(s) == pytest.approx(len(np.unique(s, axis=0)))
+
+
+def test_the_targets_own_marks_are_freed_and_walls_kept():
+    grid = free_map()
+    grid[50, 40:44] = 254  # the target's mark at (-0.5..-0.3, 0.0)
+    grid[50, 80] = 254  # a wall cell 1.5 m away
+    grid[51, 40] = 253  # inflation stays
+    out = costs_without_target(grid, *ORIGIN, RES, np.array([[-0.4, 0.0]]), 0.2)
+    assert (out[50, 40:44] == 0).all() and out[50, 80] == 254 and out[51, 40] == 253
+    assert grid[50, 40] == 254  # a copy
+
+
+def test_node_parameters_are_checked_and_named():
+    from fleetsim.apps.predictive_follower import PredictiveFollower
+    from fleetsim.errors import ParameterError
+    from fleetsim.runtime import Runtime
+
+    with pytest.raises(ParameterError, match=r"/predictive_follower: parameter 'horizon'"):
+        PredictiveFollower(Runtime(seed=0), params={"horizon": 0.0})
+    with pytest.raises(ParameterError, match=r"/predictive_follower/tracker: .*'accel_noise'"):
+        PredictiveFollower(Runtime(seed=0), params={"tracker": {"accel_noise": -1.0}})
+    with pytest.raises(ParameterError, match=r"exploration: parameter 'strategy'.*'spin'"):
+        PredictiveFollower(Runtime(seed=0), params={"exploration": {"strategy": "spin"}})

@@ -29,6 +29,7 @@ import math
 import numpy as np
 from numba import njit
 
+from fleetsim.nav.costmap.costmap_2d import FREE_SPACE, LETHAL_OBSTACLE
 from fleetsim.nav.costmap.footprint import footprint_cost_at
 
 #: weights vector layout of `rollout_costs`
@@ -153,3 +154,36 @@ def velocity_samples(
     if extra is not None:
         grid = np.concatenate([grid, np.atleast_2d(extra)])
     return np.ascontiguousarray(grid, dtype=np.float64)
+
+
+def costs_without_target(
+    costs: np.ndarray,
+    origin_x: float,
+    origin_y: float,
+    resolution: float,
+    track: np.ndarray,
+    radius: float,
+) -> np.ndarray:
+    """A copy of ``costs`` with the LETHAL cells within ``radius`` of the target's track freed.
+
+    Those marks are the target itself, which the MPC keeps ``min_gap`` from by its prediction;
+    a laser that sees nothing behind them (beyond its range) never clears them, and they would
+    wall the follower in behind the target. Inflation around them stays (a cost, not a wall).
+
+    costs : (H, W) uint8; track : (N, 2) target positions in the costmap frame (m).
+    """
+    k = math.ceil(radius / resolution)
+    d = np.arange(-k, k + 1)
+    di, dj = np.meshgrid(d, d)
+    keep = np.hypot(di, dj) * resolution <= radius
+    di, dj = di[keep], dj[keep]
+    track = np.asarray(track, float).reshape(-1, 2)
+    cols = (np.floor((track[:, 0] - origin_x) / resolution).astype(int)[:, None] + di).ravel()
+    rows = (np.floor((track[:, 1] - origin_y) / resolution).astype(int)[:, None] + dj).ravel()
+    h, w = costs.shape
+    ok = (cols >= 0) & (rows >= 0) & (cols < w) & (rows < h)
+    rows, cols = rows[ok], cols[ok]
+    out = costs.copy()
+    lethal = out[rows, cols] == LETHAL_OBSTACLE
+    out[rows[lethal], cols[lethal]] = FREE_SPACE
+    return out

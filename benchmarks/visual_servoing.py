@@ -362,6 +362,7 @@ COLUMNS = [
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--seeds", type=int, default=10)
+    ap.add_argument("--first-seed", type=int, default=0, help="seeds first..first+seeds-1")
     ap.add_argument("--duration", type=float, default=180.0, help="sim seconds per run")
     ap.add_argument("--strategies", nargs="+", default=["rotate", "move_to_target"])
     ap.add_argument("--followers", nargs="+", default=["follow_marker", "predictive"])
@@ -383,7 +384,7 @@ def main() -> None:
     print(f"{'patrol':>9} {'follower':>14} {'strategy':>15} {'seed':>4}{head}{'wall s':>8}")
     rows = []
     for patrol, follower, strategy, seed in itertools.product(
-        a.patrols, a.followers, a.strategies, range(a.seeds)
+        a.patrols, a.followers, a.strategies, range(a.first_seed, a.first_seed + a.seeds)
     ):
         r = run(strategy, seed, a.duration, a.width, a.height, a.rate, follower, patrol, a.start)
         rows.append(r)

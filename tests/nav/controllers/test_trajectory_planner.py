@@ -176,3 +176,22 @@ def test_the_default_limits_are_not_warned_about(caplog):
     with caplog.at_level(logging.WARNING, logger="fleetsim.nav"):
         TrajectoryPlanner.from_namespace(corridor(), footprint_from_radius(0.2), {})
     assert caplog.text == ""
+
+
+def test_an_escape_that_cannot_turn_yet_backs_on_past_escape_reset_dist():
+    from fleetsim.nav.controllers.selection import ESCAPE_ROOM, _end_escape_when_clear
+
+    tp = make(corridor())
+    reset = tp.params.escape_reset_dist
+    for dist, can_turn, still in (
+        (0.5 * reset, True, True),  # not far enough yet
+        (2.0 * reset, True, False),  # far enough and it can turn: base_local_planner's rule
+        (2.0 * reset, False, True),  # far enough but wedged in a gap: back on
+        ((ESCAPE_ROOM + 0.5) * reset, False, False),  # but not for ever
+    ):
+        tp.escaping, tp.escape_pose = True, (1.0, 1.0, 0.0)
+        _end_escape_when_clear(tp, 1.0 - dist, 1.0, 0.0, can_turn)
+        assert tp.escaping is still, (dist, can_turn)
+    tp.escaping = True
+    _end_escape_when_clear(tp, 1.0, 1.0, tp.params.escape_reset_theta + 0.1, False)
+    assert not tp.escaping  # turned far enough

@@ -77,13 +77,29 @@ def _ahead_goal_dist(tp: TrajectoryPlanner, index: int) -> float | None:
     return None if cell is None else float(tp.goal_dist[cell[1], cell[0]])
 
 
-def _end_escape_when_clear(tp: TrajectoryPlanner, x: float, y: float, th: float) -> None:
+#: how many escape_reset_dist a robot that cannot turn in place backs up at most
+ESCAPE_ROOM = 5.0
+
+
+def _end_escape_when_clear(
+    tp: TrajectoryPlanner, x: float, y: float, th: float, can_turn: bool = True
+) -> None:
     """Stop escaping once the robot is escape_reset_dist or escape_reset_theta away from
-    where the escape began."""
+    where the escape began.
+
+    Departure from base_local_planner: the distance ends an escape only where an in-place
+    rotation is legal (or after ``ESCAPE_ROOM`` times escape_reset_dist). In a gap barely
+    wider than the robot, ROS backs up 0.1 m, drives the same 0.1 m forward into the spot where
+    nothing is legal, and backs up again, for ever (the BARN timeouts); backing on, while the
+    backward rollout is legal, until the robot can turn lets the in-place rotation that follows
+    take it out of the gap."""
     ex, ey, eth = tp.escape_pose
     dth = abs((eth - th + math.pi) % (2 * math.pi) - math.pi)
+    dist = math.hypot(x - ex, y - ey)
+    reset = tp.params.escape_reset_dist
     if (
-        math.hypot(x - ex, y - ey) > tp.params.escape_reset_dist
+        (dist > reset and can_turn)
+        or dist > ESCAPE_ROOM * reset
         or dth > tp.params.escape_reset_theta
     ):
         tp.escaping = False
@@ -164,7 +180,10 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
     if not tp.escaping and cost > -2.0:
         tp.escape_pose = (x, y, th)
         tp.escaping = True
-    _end_escape_when_clear(tp, x, y, th)
+    # backing on is for a robot wedged where it cannot turn, and only while the map says the
+    # backward rollout is free (the escape itself is taken blind)
+    can_turn = bool((costs[g["in_place"]] >= 0).any()) or cost < 0.0
+    _end_escape_when_clear(tp, x, y, th, can_turn)
     if cost == -1.0:
         cost = 1.0
     return tuple(samples[i]), cost, i

@@ -29,6 +29,20 @@ def test_reference_path_and_metric_follow_the_readme():
     assert barn.metric_of(False, 30.0, 10.0) == 0.0
 
 
+def test_the_tuning_split_is_the_first_half_by_number(tmp_path):
+    for w in (3, 9, 15, 21, 27, 153, 159, 165, 171, 177):
+        (tmp_path / f"world_{w}.world").write_text("")
+    assert barn.half_worlds(tmp_path, "tuning") == [3, 9, 15, 21, 27]
+    assert barn.half_worlds(tmp_path, "held-out") == [153, 159, 165, 171, 177]
+    assert barn.split_name(tmp_path, "held-out") == "held-out half of the split, worlds 153-177 (5)"
+    if barn.BARN_DIR.is_dir():  # the shared worlds: tuned on 3-147, held out 153-297
+        tuning, held = (
+            barn.half_worlds(barn.BARN_DIR, "tuning"),
+            barn.half_worlds(barn.BARN_DIR, "held-out"),
+        )
+        assert (tuning[0], tuning[-1], held[0], held[-1]) == (3, 147, 153, 297)
+
+
 def test_summary_rates():
     r = [
         barn.RunResult(3, outcome, 10.0, 5.0, 0.25 if outcome == "success" else 0.0, 0.5, 1.0)

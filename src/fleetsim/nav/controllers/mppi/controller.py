@@ -212,6 +212,10 @@ class MPPIController(LocalPlanner):
         inscribed rule (then samples may leave it without getting nearer to an obstacle; see
         `critic_kernels.pose_cost`), else -1."""
         m = self.costmap
+        if self.clearance2.shape != m.costs.shape:
+            # not computed for this costmap yet (the kernel below does not check bounds: a
+            # stale grid would be read past its end)
+            self.clearance2 = squared_distances_to(m.costs == LETHAL_OBSTACLE)
         use_fp = self.uses_footprint
         c, s = math.cos(robot[2]), math.sin(robot[2])
         args = (m.costs, self.clearance2, m.origin_x, m.origin_y, m.resolution, self.outline)

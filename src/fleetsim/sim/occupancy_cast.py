@@ -212,21 +212,35 @@ def _beam_span(bx0, by0, bx1, by1, a0, span, ida):
 
 
 @numba.njit(cache=True, inline="always")
+def _turns(lo, hi, span):
+    """The whole turns ``m`` for which angles ``[lo, hi] + 2 pi m`` meet the beams' ``[0,
+    span]`` (an extent repeats every 2 pi)."""
+    two_pi = 2.0 * np.pi
+    return int(np.ceil(-hi / two_pi)), int(np.floor((span - lo) / two_pi))
+
+
+@numba.njit(cache=True, inline="always")
+def _beams_in(lo, hi, m, ida, n):
+    """First and last beam ``k`` (at angle ``k / ida``) within ``[lo, hi] + 2 pi m``; every
+    beam for a single-beam laser (``ida`` 0)."""
+    if ida == 0.0:
+        return 0, n - 1
+    two_pi = 2.0 * np.pi
+    k0 = max(int(np.ceil((lo + m * two_pi) * ida)), 0)
+    k1 = min(int(np.floor((hi + m * two_pi) * ida)), n - 1)
+    return k0, k1
+
+
+@numba.njit(cache=True, inline="always")
 def _occluded(bx0, by0, bx1, by1, dmin, a0, span, ida, n, hit):
     """Whether every beam that can cross a tile (corners relative to the origin, which lies
     outside it, nearest point ``dmin`` away) already hits something nearer than ``dmin``: then
     nothing in the tile can lower a range (a box reaching out of the tile is listed in the
     other tiles it overlaps too)."""
-    two_pi = 2.0 * np.pi
     lo, hi = _beam_span(bx0, by0, bx1, by1, a0, span, ida)
-    m0 = int(np.ceil(-hi / two_pi))
-    m1 = int(np.floor((span - lo) / two_pi))
+    m0, m1 = _turns(lo, hi, span)
     for m in range(m0, m1 + 1):
-        if ida == 0.0:
-            k0, k1 = 0, n - 1
-        else:
-            k0 = max(int(np.ceil((lo + m * two_pi) * ida)), 0)
-            k1 = min(int(np.floor((hi + m * two_pi) * ida)), n - 1)
+        k0, k1 = _beams_in(lo, hi, m, ida, n)
         for k in range(k0, k1 + 1):
             if hit[k] >= dmin:
                 return False
@@ -238,7 +252,6 @@ def _cast_tile(
     start, items, boxes, seen, q, ox, oy, tmin, tmax, tmax2, a0, span, ida, n, ibx, iby, hit, t_i
 ):  # fmt: skip
     """Lower ``hit`` (cell units) by the boxes of tile ``t_i`` not yet seen by laser ``q``."""
-    two_pi = 2.0 * np.pi
     for j in range(start[t_i], start[t_i + 1]):
         b = items[j]
         if seen[b] == q:
@@ -257,15 +270,9 @@ def _cast_tile(
             hi = span
         else:
             lo, hi = _beam_span(bx0, by0, bx1, by1, a0, span, ida)
-        # beams k cover angles k * da in [0, span]; the extent repeats every 2 pi
-        m0 = int(np.ceil(-hi / two_pi))
-        m1 = int(np.floor((span - lo) / two_pi))
+        m0, m1 = _turns(lo, hi, span)
         for m in range(m0, m1 + 1):
-            if ida == 0.0:
-                k0, k1 = 0, n - 1
-            else:
-                k0 = max(int(np.ceil((lo + m * two_pi) * ida)), 0)
-                k1 = min(int(np.floor((hi + m * two_pi) * ida)), n - 1)
+            k0, k1 = _beams_in(lo, hi, m, ida, n)
             for k in range(k0, k1 + 1):
                 t1 = bx0 * ibx[k]
                 t2 = bx1 * ibx[k]

@@ -9,6 +9,7 @@ sample collides the cost critics raise `CriticData.fail`.
 from __future__ import annotations
 
 import math
+from abc import ABC, abstractmethod
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -49,7 +50,7 @@ class CriticData:
         return math.hypot(self.goal[0] - self.robot[0], self.goal[1] - self.robot[1])
 
 
-class Critic:
+class Critic(ABC):
     """Base of critics: ``Params`` is the critic's parameter dataclass."""
 
     Params: type = object
@@ -61,8 +62,9 @@ class Critic:
         p = self.params
         data.costs += (p.cost_weight * term) ** p.cost_power
 
+    @abstractmethod
     def score(self, data: CriticData) -> None:
-        raise NotImplementedError
+        """Add this critic's cost of every sampled trajectory to ``data.costs``."""
 
 
 class ConstraintCritic(Critic):

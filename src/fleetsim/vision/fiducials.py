@@ -7,9 +7,9 @@ the face toward the camera: ``(-L/2, L/2, 0), (L/2, L/2, 0), (L/2, -L/2, 0), (-L
 bottom-right, bottom-left).
 
 The fiducials package calls ``solvePnP`` with its default (iterative) method; we use
-``SOLVEPNP_IPPE_SQUARE``, OpenCV's solver made for exactly these four points (the same pose
-where the iterative one converges, and faster), and fall back to the package's iterative
-method only when IPPE_SQUARE's reprojection error is large (`FALLBACK_ERROR`).
+``SOLVEPNP_IPPE_SQUARE``'s two solutions (OpenCV's solver made for exactly these four points,
+one per ambiguity basin) beside the package's iterative one, and polish the one that
+reprojects best by Levenberg-Marquardt (see `_best_pose` for why one solver is not enough).
 
 ``image_error`` is the mean of the squared corner reprojection errors in px^2 (the package's
 comment says RMS, but it takes no root); ``object_error`` converts it to metres as the package
@@ -26,11 +26,6 @@ import numpy as np
 from scipy.spatial.transform import Rotation
 
 from fleetsim.errors import ParameterError
-
-#: mean squared reprojection error (px^2) above which IPPE_SQUARE's answer is checked against
-#: the iterative solver's: on exactly noise-free fronto-parallel corners IPPE_SQUARE can return
-#: a pose flipped upside down (every corner tens of pixels off) or tilted by degrees
-FALLBACK_ERROR = 1e-4
 
 #: aruco_detect's ``dictionary`` integer -> OpenCV's predefined dictionary (ROS wiki order)
 DICTIONARIES: tuple[str, ...] = (
@@ -147,20 +142,61 @@ def marker_poses(
     for i in range(n):
         obj = marker_object_points(float(lengths[i]))
         img = np.asarray(corners[i], dtype=np.float64).reshape(4, 2)
-        best = (np.inf, None, None)
-        for method in (cv2.SOLVEPNP_IPPE_SQUARE, cv2.SOLVEPNP_ITERATIVE):
-            ok, rvec, tvec = cv2.solvePnP(obj, img, camera_matrix, dist_coeffs, flags=method)
-            if ok:
-                proj, _ = cv2.projectPoints(obj, rvec, tvec, camera_matrix, dist_coeffs)
-                err = float(np.mean(np.sum((proj.reshape(4, 2) - img) ** 2, axis=1)))
-                if err < best[0]:
-                    best = (err, rvec, tvec)
-            if best[0] < FALLBACK_ERROR:
-                break
+        best = _best_pose(obj, img, camera_matrix, dist_coeffs)
         errors[i] = best[0]  # inf: neither method solved it; the caller reports it unseen
         if best[1] is not None:
             rvecs[i], tvecs[i] = best[1].ravel(), best[2].ravel()
     return rvecs, tvecs, errors
+
+
+def _reprojection_error(obj, img, rvec, tvec, camera_matrix, dist_coeffs) -> float:
+    proj, _ = cv2.projectPoints(obj, rvec, tvec, camera_matrix, dist_coeffs)
+    return float(np.mean(np.sum((proj.reshape(4, 2) - img) ** 2, axis=1)))
+
+
+#: the LM polish runs to machine precision (its default, 20 steps to float32's epsilon, leaves
+#: face-on poses milliradians off)
+_LM_CRITERIA = (cv2.TERM_CRITERIA_EPS + cv2.TERM_CRITERIA_COUNT, 200, 1e-15)
+
+
+def _best_pose(obj, img, camera_matrix, dist_coeffs):
+    """(error px^2, rvec, tvec) of the pose that reprojects best, or (inf, None, None).
+
+    Candidates are both IPPE_SQUARE solutions (one per ambiguity basin) and the iterative
+    solver's (the package's method); the best of them is polished by Levenberg-Marquardt. One
+    solver is not enough: near fronto-parallel OpenCV's IPPE_SQUARE can answer tenths of a
+    radian off with a sub-0.1 px error, or NaN, and in oblique close views pixels off; the
+    iterative solver can stop short of the minimum. Poses behind the camera (the mirror image,
+    which projects the same) and non-finite ones are dropped.
+    """
+    n, rvecs, tvecs, _ = cv2.solvePnPGeneric(
+        obj, img, camera_matrix, dist_coeffs, flags=cv2.SOLVEPNP_IPPE_SQUARE
+    )
+    seeds = [(rvecs[k], tvecs[k]) for k in range(n)]
+    ok, rvec, tvec = cv2.solvePnP(
+        obj, img, camera_matrix, dist_coeffs, flags=cv2.SOLVEPNP_ITERATIVE
+    )
+    if ok:
+        seeds.append((rvec, tvec))
+    best = (np.inf, None, None)
+    for rvec, tvec in seeds:
+        if _in_front(rvec, tvec):
+            err = _reprojection_error(obj, img, rvec, tvec, camera_matrix, dist_coeffs)
+            if err < best[0]:
+                best = (err, rvec, tvec)
+    if best[1] is not None:
+        rvec, tvec = cv2.solvePnPRefineLM(
+            obj, img, camera_matrix, dist_coeffs, best[1].copy(), best[2].copy(), _LM_CRITERIA
+        )
+        if _in_front(rvec, tvec):
+            err = _reprojection_error(obj, img, rvec, tvec, camera_matrix, dist_coeffs)
+            if err <= best[0]:
+                best = (err, rvec, tvec)
+    return best
+
+
+def _in_front(rvec: np.ndarray, tvec: np.ndarray) -> bool:
+    return bool(np.all(np.isfinite(rvec)) and np.all(np.isfinite(tvec)) and tvec.ravel()[2] > 0)
 
 
 def object_errors(

@@ -12,8 +12,10 @@ control cycle (``compute_velocity_commands``):
    sampled around the current one (Gaussian noise, ``vx_std``/``vy_std``/``wz_std``, drawn
    once and kept unless ``regenerate_noises``), clamped to the velocity limits, made
    followable within the acceleration limits and integrated by the motion model every
-   ``model_dt`` s (`kernels.rollouts`); every critic scores the whole batch; the sequence
-   becomes the samples' softmax average (``temperature``, with the control cost ``gamma``);
+   ``model_dt`` s (`kernels.rollouts`); with ``primitive_samples`` (a fleetsim addition,
+   `primitives`) the batch's last rows are stand-still, straight, turn and turn-then-drive
+   sequences instead; every critic scores the whole batch; the sequence becomes the samples'
+   softmax average (``temperature``, with the control cost ``gamma``);
 4. the command is the sequence's first control; the sequence is shifted by one control
    period (warm start) for the next cycle.
 
@@ -48,6 +50,7 @@ from fleetsim.nav.controllers.mppi.kernels import (
 from fleetsim.nav.controllers.mppi.loading import load_mppi
 from fleetsim.nav.controllers.mppi.params import AckermannConstraints, MPPIParams
 from fleetsim.nav.controllers.mppi.path import blocked_points, furthest_reached, pruned_path
+from fleetsim.nav.controllers.mppi.primitives import noise_with_primitives, primitive_sequences
 from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE, Costmap2D
 from fleetsim.nav.costmap.footprint import footprint_radii, outline_points
 from fleetsim.nav.costmap.inflation_layer import squared_distances_to
@@ -102,6 +105,12 @@ class MPPIController(LocalPlanner):
         self.vels = np.empty(shape)
         self.poses = np.empty(shape)
         self.headings = np.empty((p.batch_size, p.time_steps, 2))
+        self.primitives = (
+            primitive_sequences(p.time_steps, p.model_dt, p.vx_max, p.wz_max)
+            if p.primitive_samples
+            else np.zeros((0, p.time_steps, 3))
+        )
+        self._sampled = np.empty(shape)  # the noise with the primitives' rows (per iteration)
         self.plan = np.zeros((0, 3))
         self.local_plan = np.zeros((0, 3))
         self.reached_goal = False
@@ -230,7 +239,10 @@ class MPPIController(LocalPlanner):
         for _ in range(p.iteration_count):
             if p.regenerate_noises:
                 self.noise = self._draw_noise()
-            data = self._evaluate(self.sequence, self.noise, robot, vel, path, blocked)
+            noise = self.noise
+            if self.primitives.shape[0]:
+                noise = noise_with_primitives(noise, self.sequence, self.primitives, self._sampled)
+            data = self._evaluate(self.sequence, noise, robot, vel, path, blocked)
             if data.fail:
                 return data
             softmax_sequence(

@@ -58,6 +58,11 @@ class MPPIParams:
     regenerate_noises: bool = param(
         False, help="new noise every cycle (else one draw, kept until a reset)"
     )
+    primitive_samples: bool = param(
+        False,
+        help="fleetsim addition: stand-still, straight, turn-on-the-spot and turn-then-drive "
+        "sequences replace the batch's last samples (mppi.primitives); off: Nav2's sampling",
+    )
     # path handler
     prune_distance: float = param(
         1.5, unit="m", range=(0.0, None), help="path kept ahead of the nearest path point"

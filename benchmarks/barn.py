@@ -34,6 +34,11 @@ on a cluster (``--address``); results in OUTDIR/results.parquet, plots with
 
     PYTHONPATH=src .venv/bin/python benchmarks/barn.py --all --batch barn_out           # 50 x 10
     PYTHONPATH=src .venv/bin/python benchmarks/barn.py --worlds 3,9 --runs 2 --batch out --workers 2
+    PYTHONPATH=src .venv/bin/python benchmarks/barn.py --half heldout --batch out --runs 3
+
+``--half tuning|held-out`` (also ``heldout``) picks one half of the tuning split, with or
+without ``--batch``; a run over both halves (``--all``) prints each half's figures as well,
+named by the split.
 """
 
 from __future__ import annotations
@@ -212,17 +217,21 @@ def batch_main(a, worlds: list[int]) -> None:
     print(f"{len(rows)} runs ({len(errors)} failed to run) in {a.batch}")
     for r in errors[:5]:
         print(f"  world {r['arg_world']} seed {r['seed']}: {r['error']}")
-    print_summary(results)
+    print_by_half(results, a.barn_dir)
     print(f"plots: fleetsim batch report {a.batch}")
 
 
-def print_summary(results: list[RunResult]) -> None:
+def print_rates(results: list[RunResult]) -> None:
     s = summary(results)
     print(
         f"runs {s['runs']}: success {100 * s['success']:.1f} %, collision "
         f"{100 * s['collision']:.1f} %, timeout {100 * s['timeout']:.1f} %, "
         f"mean metric {s['metric']:.3f}"
     )
+
+
+def print_summary(results: list[RunResult]) -> None:
+    print_rates(results)
     print(
         "reference (ROS move_base + DWA, 50 test worlds): success 85.0 %, collision 5.6 %, "
         "timeout 9.4 %; target >= 90 % success"
@@ -236,6 +245,37 @@ def available_worlds(barn_dir: Path) -> list[int]:
 #: the held-out discipline: parameters and planner changes are tuned on the first half of the
 #: shared worlds by number (3-147), the second half (153-297) only measured
 HALVES = ("tuning", "held-out")
+#: other spellings of a half accepted by --half
+HALF_ALIASES = {"heldout": "held-out", "held_out": "held-out", "tune": "tuning"}
+
+
+def half_name(text: str) -> str:
+    """The half ``text`` names (`HALVES` or an alias); argparse's type for --half."""
+    name = HALF_ALIASES.get(text.strip().lower(), text.strip().lower())
+    if name not in HALVES:
+        raise argparse.ArgumentTypeError(
+            f"--half {text!r} is not a half of the split; use one of {', '.join(HALVES)}"
+        )
+    return name
+
+
+def half_of(barn_dir: Path, world: int) -> str | None:
+    """The half world ``world`` belongs to (None if it is not in ``barn_dir``)."""
+    for half in HALVES:
+        if world in half_worlds(barn_dir, half):
+            return half
+    return None
+
+
+def print_by_half(results: list[RunResult], barn_dir: Path) -> None:
+    """The summary of ``results``, then of each half of the split they cover, named."""
+    print_summary(results)
+    by_half = {h: [r for r in results if half_of(barn_dir, r.world) == h] for h in HALVES}
+    if sum(bool(v) for v in by_half.values()) < 2:
+        return
+    for half, rs in by_half.items():
+        print(f"{split_name(barn_dir, half)}:", end=" ")
+        print_rates(rs)
 
 
 def half_worlds(barn_dir: Path, half: str) -> list[int]:
@@ -255,7 +295,10 @@ def main() -> None:
     ap.add_argument("--worlds", help="comma-separated world numbers, e.g. 3,9,15")
     ap.add_argument("--all", action="store_true", help="every world in --barn-dir")
     ap.add_argument(
-        "--half", choices=HALVES, help="one half of the tuning split (tuning: first by number)"
+        "--half",
+        type=half_name,
+        metavar="{tuning,held-out}",
+        help="one half of the tuning split (tuning: first by number; also heldout)",
     )
     ap.add_argument("--barn-dir", type=Path, default=BARN_DIR)
     ap.add_argument("--seed", type=int, default=0)
@@ -297,7 +340,7 @@ def main() -> None:
             f"{r.final_gap:6.2f} {r.wall:6.1f}",
             flush=True,
         )
-    print_summary(results)
+    print_by_half(results, a.barn_dir)
 
 
 if __name__ == "__main__":

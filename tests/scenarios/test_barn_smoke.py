@@ -59,3 +59,23 @@ def test_jackal_sets_off_towards_the_goal_in_world_3():
     assert r.outcome in ("timeout", "success"), r  # no collision, no aborted goal
     start_gap = math.dist(barn.START, barn.GOAL)
     assert r.final_gap < start_gap - 1.0, r  # at least 1 m closer to the goal
+
+
+def test_half_names_and_the_summary_of_each_half(tmp_path, capsys):
+    for w in (3, 9, 153, 159):
+        (tmp_path / f"world_{w}.world").write_text("")
+    assert barn.half_name("heldout") == barn.half_name("held-out") == "held-out"
+    assert barn.half_name("Tuning") == "tuning"
+    with pytest.raises(Exception, match="'test' is not a half of the split; use one of"):
+        barn.half_name("test")
+    assert [barn.half_of(tmp_path, w) for w in (3, 159, 4)] == ["tuning", "held-out", None]
+    runs = [
+        barn.RunResult(w, outcome, 10.0, 5.0, 0.25 if outcome == "success" else 0.0, 0.5, 1.0)
+        for w, outcome in ((3, "success"), (9, "success"), (153, "success"), (159, "timeout"))
+    ]
+    barn.print_by_half(runs, tmp_path)
+    out = capsys.readouterr().out
+    assert "tuning half of the split, worlds 3-9 (2): runs 2: success 100.0 %" in out
+    assert "held-out half of the split, worlds 153-159 (2): runs 2: success 50.0 %" in out
+    barn.print_by_half(runs[:2], tmp_path)  # one half only: no per-half lines
+    assert "half of the split" not in capsys.readouterr().out

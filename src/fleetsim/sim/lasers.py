@@ -16,6 +16,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import mujoco
+import numba
 import numpy as np
 
 from fleetsim.sim import occupancy_cast, raycast
@@ -167,14 +168,52 @@ class LaserBatch:
                 lay.rmax, centres, radii, ids, start, prims,
             )  # fmt: skip
         # Gaussian noise on the beams that hit, drawn in laser order as the sensors would
-        hit = np.flatnonzero(lay.noisy & np.isfinite(ranges))
-        if len(hit):
-            noisy = (
-                ranges[hit] + lay.mean[hit] + lay.std[hit] * engine.rng.standard_normal(len(hit))
-            )
-            ranges[hit] = np.clip(noisy, lay.beam_rmin[hit], lay.beam_rmax[hit])
-        out = ranges.astype(np.float32)
+        z = engine.rng.standard_normal(noisy_hit_count(ranges, lay.noisy))
+        out = np.empty(len(ranges), np.float32)
+        noisy_ranges(ranges, lay.noisy, lay.mean, lay.std, lay.beam_rmin, lay.beam_rmax, z, out)
         return [
             lz.reading(out[o : o + k], t)
             for lz, o, k in zip(lasers, lay.offsets.tolist(), lay.nb.tolist())
         ]
+
+
+@numba.njit(cache=True)
+def noisy_hit_count(ranges, noisy):
+    """How many beams get noise: those of noisy lasers that hit something (finite range).
+
+    Parameters
+    ----------
+    ranges : (R,) float64 m, inf where nothing is hit; noisy : (R,) bool.
+    """
+    n = 0
+    for i in range(ranges.shape[0]):
+        if noisy[i] and np.isfinite(ranges[i]):
+            n += 1
+    return n
+
+
+@numba.njit(cache=True)
+def noisy_ranges(ranges, noisy, mean, std, rmin, rmax, z, out):
+    """Ranges with Gaussian noise on the beams that hit, as float32, into ``out``.
+
+    The ``k``-th noisy beam that hits (in beam order) gets ``(range + mean) + std z[k]``
+    clipped to its laser's ``[rmin, rmax]``, in float64 and in that order, then rounded to
+    float32: bit for bit what ``np.clip(r[hit] + mean[hit] + std[hit] * z, rmin[hit],
+    rmax[hit]).astype(np.float32)`` gives, in one pass instead of seven array operations.
+
+    Parameters
+    ----------
+    ranges : (R,) float64 m, inf where nothing is hit; noisy : (R,) bool.
+    mean, std, rmin, rmax : (R,) float64 m, per beam (its laser's).
+    z : (noisy_hit_count(ranges, noisy),) float64 standard normal draws.
+    out : (R,) float32 m.
+    """
+    k = 0
+    for i in range(ranges.shape[0]):
+        r = ranges[i]
+        if noisy[i] and np.isfinite(r):
+            v = (r + mean[i]) + std[i] * z[k]
+            k += 1
+            out[i] = min(max(v, rmin[i]), rmax[i])
+        else:
+            out[i] = r

@@ -42,3 +42,20 @@ def test_a_robot_on_cost_starts_from_the_nearest_free_cell_and_off_the_grid_sees
     on_cost = frontiers_from_grid(grid(), 0.1, (0.0, 0.0), (0.65, 0.65))
     assert len(on_cost) == 1
     assert frontiers_from_grid(grid(), 0.1, (0.0, 0.0), (-1.0, 1.0)) == []
+
+
+def test_a_door_with_a_little_inflation_cost_does_not_hide_the_frontiers_beyond_it():
+    # the robot in a closed room whose only door carries cost 1 (inflation from the door
+    # posts); beyond the door a known corridor with an unknown end. explore_lite's walk
+    # through free cells only stops at the door and finds nothing (m-explore #26)
+    d = np.full((20, 30), -1, dtype=np.int8)
+    d[:, :10] = 0  # the room
+    d[:, 10] = 100  # its wall ...
+    d[9:11, 10] = 1  # ... with a door of cost 1
+    d[:, 11:20] = 0  # the corridor, unknown beyond x = 2.0 m
+    d[2:4, 5] = 99  # inscribed cost: impassable, the walk goes round it
+    fs = frontiers_from_grid(d, 0.1, (0.0, 0.0), (0.35, 1.05))
+    assert [f.size for f in fs] == [20]
+    assert fs[0].centroid == pytest.approx((2.05, 1.0))
+    d[9:11, 10] = 99  # a door the robot does not fit through: nothing reachable beyond
+    assert frontiers_from_grid(d, 0.1, (0.0, 0.0), (0.35, 1.05)) == []

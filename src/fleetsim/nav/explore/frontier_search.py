@@ -2,9 +2,15 @@
 
 explore_lite walks breadth-first from the robot's cell through cells whose cost does not rise
 (from free space that means free cells only) and marks as frontier every unknown cell with a
-free 4-neighbour; 8-connected frontier cells form one frontier. Here the free region reachable
-from the robot is the 4-connected component of free cells holding the robot's cell (or the
-nearest free cell), found with `scipy.ndimage.label` instead of a queue, as are the frontiers.
+free 4-neighbour; 8-connected frontier cells form one frontier. fleetsim walks through every
+cell the robot's centre may occupy (cost below the inscribed cost, published as
+`INSCRIBED`) instead of free cells only: explore_lite's walk stops at a door whose middle
+carries a little inflation cost (a 1 m door with the hunter's 1 m inflation radius), so a
+robot that has entered a room finds no frontier beyond it and stops with most of the world
+unknown (m-explore issues #26 and #33 report exactly that; frontier_exploration issue #32
+asks for this very change). Frontier cells are still unknown cells with a *free* 4-neighbour
+in that region. The region is the 4-connected component holding the robot's cell (or the
+nearest such cell), found with `scipy.ndimage.label` instead of a queue, as are the frontiers.
 A frontier's ``cost = potential_scale * min_distance * res - gain_scale * size * res``; those
 smaller than ``min_frontier_size`` m are dropped, and the list is sorted by cost.
 """
@@ -18,6 +24,8 @@ from scipy import ndimage
 
 FOUR = ndimage.generate_binary_structure(2, 1)
 EIGHT = ndimage.generate_binary_structure(2, 2)
+#: costmap_2d's inscribed cost (253) as the costmap publisher writes it; lethal is 100
+INSCRIBED = 99
 
 
 @dataclass(frozen=True)
@@ -45,6 +53,7 @@ def frontiers_from_grid(
     """Frontiers of the (H, W) int8 grid ``data`` (-1 unknown, 0 free, >0 cost), cheapest first.
 
     ``robot`` is the robot's position (m) in the grid's frame; a robot off the grid sees none.
+    The robot reaches every cell of cost below `INSCRIBED` connected to it.
     """
     data = np.asarray(data)
     h, w = data.shape
@@ -53,14 +62,15 @@ def frontiers_from_grid(
     if not (0 <= rx < w and 0 <= ry < h):
         return []
     free = data == 0
+    passable = (data >= 0) & (data < INSCRIBED)
     if not free.any():
         return []
-    labels, _ = ndimage.label(free, structure=FOUR)
+    labels, _ = ndimage.label(passable, structure=FOUR)
     start = labels[ry, rx]
     if start == 0:  # the robot stands on cost: start from the nearest free cell, as explore_lite
         _, (iy, ix) = ndimage.distance_transform_edt(~free, return_indices=True)
         start = labels[iy[ry, rx], ix[ry, rx]]
-    reachable = labels == start
+    reachable = (labels == start) & free
     unknown = data < 0
     frontier = unknown & ndimage.binary_dilation(reachable, structure=FOUR)
     groups, count = ndimage.label(frontier, structure=EIGHT)

@@ -52,11 +52,10 @@ def _hits_at(pool, table, p, ix, iy):
 
 
 @numba.njit(cache=True, fastmath=True, error_model="numpy")
-def _match(pool, table, p, pose, laser, ranges, cos_a, sin_a, geom, kernel, sigma, lsigma, skip,
-           want_l):  # fmt: skip
+def _match(pool, table, p, pose, laser, ex, ey, geom, kernel, sigma, lsigma, skip, want_l):
     """gmapping's score (and, when want_l, likelihood) of ``pose`` for particle p.
 
-    ``cos_a``/``sin_a`` (B,) are the cosines and sines of the beam angles (laser frame).
+    ``ex``/``ey`` (B,) are the beam endpoints in the laser frame (m).
     """
     ox, oy, delta = geom[0], geom[1], geom[2]
     inv = 1.0 / delta
@@ -65,44 +64,46 @@ def _match(pool, table, p, pose, laser, ranges, cos_a, sin_a, geom, kernel, sigm
     ly = pose[1] + s * laser[0] + c * laser[1]
     cl, sl = math.cos(pose[2] + laser[2]), math.sin(pose[2] + laser[2])
     no_hit = NULL_LIKELIHOOD / lsigma
+    inv_sigma = 1.0 / sigma
+    ty_n, tx_n = table.shape[1], table.shape[2]
     score = 0.0
     like = 0.0
-    for b in range(0, ranges.shape[0], skip + 1):
-        r = ranges[b]
-        ca = cl * cos_a[b] - sl * sin_a[b]
-        sa = sl * cos_a[b] + cl * sin_a[b]
-        hx, hy = lx + r * ca, ly + r * sa
+    for b in range(0, ex.shape[0], skip + 1):
+        hx = lx + cl * ex[b] - sl * ey[b]
+        hy = ly + sl * ex[b] + cl * ey[b]
         ihx = math.floor((hx - ox) * inv)
         ihy = math.floor((hy - oy) * inv)
-        found = False
-        best = 0.0
-        tx0, tx1 = (ihx - kernel) >> _SHIFT, (ihx + kernel) >> _SHIFT
-        ty0, ty1 = (ihy - kernel) >> _SHIFT, (ihy + kernel) >> _SHIFT
-        one_tile = (
-            tx0 == tx1 and ty0 == ty1 and ihx - kernel >= 0 and ihy - kernel >= 0
-            and ty0 < table.shape[1] and tx0 < table.shape[2]
-        )  # fmt: skip
-        if one_tile and table[p, ty0, tx0] < 0:
-            pass  # the whole window lies in a tile this particle never hit: no match
+        x0, x1 = ihx - kernel, ihx + kernel
+        y0, y1 = ihy - kernel, ihy + kernel
+        tx0, tx1 = x0 >> _SHIFT, x1 >> _SHIFT
+        ty0, ty1 = y0 >> _SHIFT, y1 >> _SHIFT
+        best = FAR * FAR  # an empty cell's mean lies FAR away: no test for emptiness
+        if tx0 == tx1 and ty0 == ty1 and x0 >= 0 and y0 >= 0 and ty0 < ty_n and tx0 < tx_n:
+            # the window lies in one tile: look it up once (a tile never hit: no match)
+            t = table[p, ty0, tx0]
+            if t >= 0:
+                for cy in range(y0 & _MASK, (y1 & _MASK) + 1):
+                    for cx in range(x0 & _MASK, (x1 & _MASK) + 1):
+                        mx = hx - pool[t, cy, cx, 1]
+                        my = hy - pool[t, cy, cx, 2]
+                        d = mx * mx + my * my
+                        if d < best:
+                            best = d
         else:
-            # branch-free: an empty cell's mean lies FAR away (whether a cell is empty is a
-            # coin toss along a wall, and a branch on it mispredicts)
-            best = FAR * FAR
-            for xx in range(-kernel, kernel + 1):
-                cx = ihx + xx
-                for yy in range(-kernel, kernel + 1):
-                    cy = ihy + yy
-                    t = table[p, ty0, tx0] if one_tile else _hits_at(pool, table, p, cx, cy)
+            for cy in range(y0, y1 + 1):
+                for cx in range(x0, x1 + 1):
+                    t = _hits_at(pool, table, p, cx, cy)
                     if t < 0:
                         continue
                     mx = hx - pool[t, cy & _MASK, cx & _MASK, 1]
                     my = hy - pool[t, cy & _MASK, cx & _MASK, 2]
                     best = min(best, mx * mx + my * my)
-            found = best < NO_HIT
-        if found:
-            score += math.exp(-best / sigma)
-        if want_l:
-            like += -best / lsigma if found else no_hit
+        if best < NO_HIT:
+            score += math.exp(-best * inv_sigma)
+            if want_l:
+                like -= best / lsigma
+        elif want_l:
+            like += no_hit
     return score, like
 
 
@@ -129,7 +130,7 @@ def matched_poses(
     scores = np.zeros(n)
     likes = np.zeros(n)
     cand = np.empty(3)
-    cos_a, sin_a = np.cos(angles), np.sin(angles)
+    ex, ey = ranges * np.cos(angles), ranges * np.sin(angles)
     for p in range(n):
         cur = poses[p].copy()
         cur_score, _ = _match(
@@ -138,9 +139,8 @@ def matched_poses(
             p,
             cur,
             laser,
-            ranges,
-            cos_a,
-            sin_a,
+            ex,
+            ey,
             geom,
             kernel,
             sigma,
@@ -177,7 +177,7 @@ def matched_poses(
                 else:
                     cand[2] -= ad
                 sc, _ = _match(
-                    pool, table, p, cand, laser, ranges, cos_a, sin_a, geom, kernel, sigma,
+                    pool, table, p, cand, laser, ex, ey, geom, kernel, sigma,
                     lsigma, skip, False,
                 )  # fmt: skip
                 if sc > cur_score:
@@ -197,9 +197,8 @@ def matched_poses(
             p,
             out[p],
             laser,
-            ranges,
-            cos_a,
-            sin_a,
+            ex,
+            ey,
             geom,
             kernel,
             sigma,

@@ -88,3 +88,20 @@ def test_messages_of_one_stamp_share_no_parts():
     assert b.header.stamp.sec == 2 and c.header.stamp.sec == 2
     assert b.pose.covariance[0] == 0.01 and a.twist.covariance[0] == 0.01
     assert a.header is not b.header and a.pose.pose is not b.pose.pose
+
+
+def test_scan_message_equals_the_field_by_field_construction():
+    from fleetsim.msgs import builtin_interfaces, cdr, sensor_msgs
+    from fleetsim.sim.plugins.base import ScanReading
+
+    ranges = np.linspace(0.2, 9.0, 360, dtype=np.float32)
+    r = ScanReading(3.025, "scan", "r/laser", -1.5, 1.5, 0.01, 0.0, 0.025, 0.1, 30.0, ranges)
+    want = sensor_msgs.LaserScan()
+    want.header.stamp = builtin_interfaces.Time.from_sec(3.025)
+    want.header.frame_id = "r/laser"
+    want.angle_min, want.angle_max, want.angle_increment = -1.5, 1.5, 0.01
+    want.time_increment, want.scan_time, want.range_min, want.range_max = 0.0, 0.025, 0.1, 30.0
+    want.ranges = ranges
+    got = messages.scan_msg(r)
+    assert cdr.serialize(got) == cdr.serialize(want)
+    assert got.ranges is ranges and got.intensities.dtype == np.float32

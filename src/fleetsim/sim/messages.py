@@ -42,6 +42,7 @@ _Point, _Quaternion, _Vector3 = geometry_msgs.Point, geometry_msgs.Quaternion, g
 _Pose, _Twist, _Transform = geometry_msgs.Pose, geometry_msgs.Twist, geometry_msgs.Transform
 _PoseCov, _TwistCov = geometry_msgs.PoseWithCovariance, geometry_msgs.TwistWithCovariance
 _Odometry, _TransformStamped = nav_msgs.Odometry, geometry_msgs.TransformStamped
+_LaserScan = sensor_msgs.LaserScan
 _last_stamp: tuple[float, int, int] = (float("nan"), 0, 0)
 _zeros = np.zeros
 
@@ -74,15 +75,11 @@ def odometry_tf(r: OdometryReading) -> geometry_msgs.TransformStamped:
 
 
 def scan_msg(r: ScanReading) -> sensor_msgs.LaserScan:
-    msg = sensor_msgs.LaserScan()
-    msg.header.stamp = stamp(r.stamp)
-    msg.header.frame_id = r.frame_id
-    msg.angle_min, msg.angle_max = r.angle_min, r.angle_max
-    msg.angle_increment, msg.time_increment = r.angle_increment, r.time_increment
-    msg.scan_time, msg.range_min, msg.range_max = r.scan_time, r.range_min, r.range_max
-    msg.ranges = r.ranges
-    msg.intensities = r.intensities
-    return msg
+    return _LaserScan(
+        _Header(stamp(r.stamp), r.frame_id),
+        r.angle_min, r.angle_max, r.angle_increment, r.time_increment, r.scan_time,
+        r.range_min, r.range_max, r.ranges, r.intensities,
+    )  # fmt: skip
 
 
 def image_msg(t: float, frame_id: str, img: np.ndarray, encoding: str) -> sensor_msgs.Image:

@@ -195,3 +195,21 @@ def test_an_escape_that_cannot_turn_yet_backs_on_past_escape_reset_dist():
     tp.escaping = True
     _end_escape_when_clear(tp, 1.0, 1.0, tp.params.escape_reset_theta + 0.1, False)
     assert not tp.escaping  # turned far enough
+
+
+def test_dwa_offers_in_place_rotations_either_way_while_turning():
+    from fleetsim.nav.controllers.selection import velocity_samples
+
+    pose, turning = (1.0, 1.0, 0.0), (0.0, 0.0, 0.3)  # faster than one period can stop
+    for dwa in (True, False):
+        tp = make(corridor(), dwa=dwa, acc_lim_theta=3.0, sim_time=1.5)
+        tp.set_plan(np.array([[1.0, 1.0, 0.0], [5.0, 1.0, 0.0]]))
+        samples, groups, dvth = velocity_samples(tp, pose, turning)
+        in_place = samples[groups["in_place"], 2]
+        forward = samples[groups["forward"], 2]
+        # the in-place window is sim_time's either way (DWA's one-period window [0, 0.6]
+        # held only left turns, the slowest raised to min_in_place_vel_theta)
+        assert in_place.min() == pytest.approx(-1.0) and in_place.max() == pytest.approx(1.0)
+        assert dvth == pytest.approx(2.0 / 19)
+        if dwa:  # the forward samples keep DWA's window of one control period
+            assert forward.min() >= 0.0 and forward.max() <= 0.6 + 1e-12

@@ -19,7 +19,8 @@ if TYPE_CHECKING:
 def velocity_samples(
     tp: TrajectoryPlanner, pose, vel
 ) -> tuple[np.ndarray, dict[str, slice], float]:
-    """Every sample, grouped: (S, 3) (vx, vy, vtheta), the group slices, and dvtheta."""
+    """Every sample, grouped: (S, 3) (vx, vy, vtheta), the group slices, and the in-place
+    samples' dvtheta."""
     p = tp.params
     x, y = pose[0], pose[1]
     max_vx = p.max_vel_x
@@ -40,9 +41,14 @@ def velocity_samples(
     forward[:, :, 0] = vxs[:, None]
     forward[:, 1:, 2] = vths[None, :-1]  # each vx first with vtheta 0, then the sweep
     strafe = np.array([[0.1, 0.1, 0.0], [0.1, -0.1, 0.0]]) if p.holonomic_robot else None
+    in_place_vths, in_place_dvth = vths, dvth
+    if p.dwa:
+        in_place_vths, in_place_dvth = _in_place_window(p, vel[2])
     in_place = np.zeros((p.vtheta_samples, 3))
     mn = p.min_in_place_vel_theta
-    in_place[:, 2] = np.where(vths > 0, np.maximum(vths, mn), np.minimum(vths, -mn))
+    in_place[:, 2] = np.where(
+        in_place_vths > 0, np.maximum(in_place_vths, mn), np.minimum(in_place_vths, -mn)
+    )
     sideways = None
     if p.holonomic_robot:
         sideways = np.zeros((len(p.y_vels), 3))
@@ -63,8 +69,25 @@ def velocity_samples(
         n += k
         if k:
             parts.append(part)
-    tp._in_place_raw = vths
-    return np.concatenate(parts, axis=0), groups, dvth
+    tp._in_place_raw = in_place_vths
+    return np.concatenate(parts, axis=0), groups, in_place_dvth
+
+
+def _in_place_window(p, vth: float) -> tuple[np.ndarray, float]:
+    """The in-place rotation rates sampled with ``dwa``: the window of ``sim_time``, not of one
+    control period, and its spacing.
+
+    Departure from base_local_planner, which samples them in DWA's window of one period.
+    A robot already turning faster than it can stop in one period then has only rotations
+    the same way to choose from (the slowest one even raised to min_in_place_vel_theta, faster
+    than it turns now): wedged at a gap with every forward rollout illegal it spun past the
+    heading it needed, and back (BARN world 141, heading swinging 0.4-2.0 rad for 85 s). The
+    rollouts still start from the robot's velocity within the acceleration limits, so a
+    rotation the other way is checked as the base would brake into it."""
+    lo = max(p.min_vel_theta, vth - p.acc_lim_theta * p.sim_time)
+    hi = min(p.max_vel_theta, vth + p.acc_lim_theta * p.sim_time)
+    d = (hi - lo) / (p.vtheta_samples - 1) if p.vtheta_samples > 1 else 0.0
+    return lo + np.arange(p.vtheta_samples) * d, d
 
 
 def _ahead_goal_dist(tp: TrajectoryPlanner, index: int) -> float | None:

@@ -11,8 +11,8 @@ from fleetsim.nav.controllers.mppi import MPPIController, load_mppi
 from fleetsim.nav.controllers.mppi.primitives import (
     SPEED_FRACTIONS,
     TURN_TIMES,
-    noise_with_primitives,
     primitive_sequences,
+    set_primitive_rows,
 )
 from fleetsim.nav.costmap import Costmap2D
 from fleetsim.nav.costmap.footprint import footprint_at, padded_footprint
@@ -38,12 +38,14 @@ def test_the_primitives_stand_drive_turn_and_turn_then_drive():
 def test_primitives_replace_the_last_rows_of_the_noise():
     rng = np.random.default_rng(0)
     noise, sequence = rng.normal(size=(50, 8, 3)), rng.normal(size=(8, 3))
+    before = noise.copy()
     prims = primitive_sequences(8, 0.05, 0.5, 1.0)
-    out = noise_with_primitives(noise, sequence, prims, np.empty_like(noise))
+    set_primitive_rows(noise, sequence, prims)
     k = prims.shape[0]
-    assert np.array_equal(out[:-k], noise[:-k])
-    assert np.allclose(sequence + out[-k:], prims)
-    few = noise_with_primitives(noise[:3], sequence, prims, np.empty_like(noise[:3]))
+    assert np.array_equal(noise[:-k], before[:-k])
+    assert np.allclose(sequence + noise[-k:], prims)
+    few = before[:3].copy()
+    set_primitive_rows(few, sequence, prims)
     assert np.allclose(sequence + few, prims[:3])  # a batch smaller than the primitives
 
 

@@ -50,7 +50,7 @@ from fleetsim.nav.controllers.mppi.kernels import (
 from fleetsim.nav.controllers.mppi.loading import load_mppi
 from fleetsim.nav.controllers.mppi.params import AckermannConstraints, MPPIParams
 from fleetsim.nav.controllers.mppi.path import blocked_points, furthest_reached, pruned_path
-from fleetsim.nav.controllers.mppi.primitives import noise_with_primitives, primitive_sequences
+from fleetsim.nav.controllers.mppi.primitives import primitive_sequences, set_primitive_rows
 from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE, Costmap2D
 from fleetsim.nav.costmap.footprint import footprint_radii, outline_points
 from fleetsim.nav.costmap.inflation_layer import squared_distances_to
@@ -110,7 +110,6 @@ class MPPIController(LocalPlanner):
             if p.primitive_samples
             else np.zeros((0, p.time_steps, 3))
         )
-        self._sampled = np.empty(shape)  # the noise with the primitives' rows (per iteration)
         self.plan = np.zeros((0, 3))
         self.local_plan = np.zeros((0, 3))
         self.reached_goal = False
@@ -239,10 +238,9 @@ class MPPIController(LocalPlanner):
         for _ in range(p.iteration_count):
             if p.regenerate_noises:
                 self.noise = self._draw_noise()
-            noise = self.noise
             if self.primitives.shape[0]:
-                noise = noise_with_primitives(noise, self.sequence, self.primitives, self._sampled)
-            data = self._evaluate(self.sequence, noise, robot, vel, path, blocked)
+                set_primitive_rows(self.noise, self.sequence, self.primitives)
+            data = self._evaluate(self.sequence, self.noise, robot, vel, path, blocked)
             if data.fail:
                 return data
             softmax_sequence(

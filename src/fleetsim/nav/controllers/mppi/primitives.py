@@ -58,14 +58,10 @@ def primitive_sequences(time_steps: int, dt: float, vx_max: float, wz_max: float
     return np.stack(out)
 
 
-def noise_with_primitives(
-    noise: np.ndarray, sequence: np.ndarray, primitives: np.ndarray, out: np.ndarray
-) -> np.ndarray:
-    """``noise`` (B, T, 3) with its last K rows replaced so that ``sequence`` (T, 3) plus them
-    gives the (K, T, 3) ``primitives``, written into ``out`` (B, T, 3) and returned. With
-    K >= B, only the first B primitives are used."""
-    np.copyto(out, noise)
+def set_primitive_rows(noise: np.ndarray, sequence: np.ndarray, primitives: np.ndarray) -> None:
+    """Overwrite the last K rows of ``noise`` (B, T, 3) in place so that ``sequence`` (T, 3)
+    plus them gives the (K, T, 3) ``primitives`` (those rows are the primitives' for good; no
+    copy of the batch). With K >= B, only the first B primitives are used."""
     k = min(primitives.shape[0], noise.shape[0])
     if k:
-        out[-k:] = primitives[:k] - sequence
-    return out
+        np.subtract(primitives[:k], sequence, out=noise[noise.shape[0] - k :])

@@ -108,3 +108,25 @@ def test_wall_tiles_list_every_box_in_every_tile_it_overlaps():
     assert len(wt.boxes) == 1 and (wt.th, wt.tw) == (4, 4)
     holding = [k for k in range(16) if wt.start[k + 1] > wt.start[k]]
     assert holding == [0, 1, 2, 3]
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    x0=st.floats(-5, 5), y0=st.floats(-5, 5), w=st.floats(0.01, 3), h=st.floats(0.01, 3),
+    a0=st.floats(-4, 4),
+)  # fmt: skip
+def test_beam_span_covers_a_rectangles_angular_extent(x0, y0, w, h, a0):
+    """From its two silhouette corners, the span holds the directions of all four corners
+    (exact arctangents), widened by no more than the margin plus the polynomial's error."""
+    bx0, by0, bx1, by1 = x0, y0, x0 + w, y0 + h
+    if bx0 <= 0 <= bx1 and by0 <= 0 <= by1:
+        return  # the origin inside: the caller casts every beam
+    lo, hi = occupancy_cast._beam_span(bx0, by0, bx1, by1, a0, 2 * np.pi, 1.0)
+    assert 0 <= lo + occupancy_cast._MARGIN < 2 * np.pi + 1e-9 and hi - lo < np.pi + 1e-3
+    corners = np.arctan2([by0, by0, by1, by1], [bx0, bx1, bx0, bx1]) - a0
+    mid = (lo + hi) / 2  # each corner's direction, unwrapped next to the span's middle
+    rel = corners - 2 * np.pi * np.round((corners - mid) / (2 * np.pi))
+    assert np.all(rel >= lo + occupancy_cast._MARGIN - 2e-5)
+    assert np.all(rel <= hi - occupancy_cast._MARGIN + 2e-5)
+    assert rel.min() <= lo + occupancy_cast._MARGIN + 2e-5
+    assert rel.max() >= hi - occupancy_cast._MARGIN - 2e-5

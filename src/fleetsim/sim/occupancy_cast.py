@@ -190,23 +190,44 @@ def ranges_from_walls(
 def _beam_span(bx0, by0, bx1, by1, a0, span, ida):
     """The angles (lo, hi) relative to the first beam, within ``[0, 2 pi)`` for ``lo``, that a
     rectangle (corners relative to the origin, which lies outside it) subtends, widened by the
-    arctangent's margin."""
+    arctangent's margin.
+
+    The extent's ends are the directions of the rectangle's two silhouette corners, which the
+    side of each axis the origin lies on names: two arctangents instead of one per corner and
+    one for the centre. (A corner not on the silhouette lies within the extent, so it never
+    widens it; the beams chosen are then tested exactly, and the margin is far wider than the
+    rounding of either way.)
+    """
     two_pi = 2.0 * np.pi
-    # the corners' directions about the centre's (the extent is < pi)
-    ac = _atan2(by0 + by1, bx0 + bx1)
-    lo = 0.0
-    hi = 0.0
-    for corner in range(4):
-        px = bx0 if corner & 1 == 0 else bx1
-        py = by0 if corner & 2 == 0 else by1
-        d = _atan2(py, px) - ac
-        if d > np.pi:
-            d -= two_pi
-        elif d < -np.pi:
-            d += two_pi
-        lo = min(lo, d)
-        hi = max(hi, d)
-    rel = ac - a0
+    # x of the corners: the near vertical edge when the rectangle lies wholly to one side,
+    # else both ends of the near horizontal edge (and likewise for y)
+    if bx0 > 0.0:  # rectangle right of the origin
+        if by0 > 0.0:
+            px, py, qx, qy = bx1, by0, bx0, by1
+        elif by1 < 0.0:
+            px, py, qx, qy = bx0, by0, bx1, by1
+        else:
+            px, py, qx, qy = bx0, by0, bx0, by1
+    elif bx1 < 0.0:  # left of it
+        if by0 > 0.0:
+            px, py, qx, qy = bx1, by1, bx0, by0
+        elif by1 < 0.0:
+            px, py, qx, qy = bx0, by1, bx1, by0
+        else:
+            px, py, qx, qy = bx1, by1, bx1, by0
+    elif by0 > 0.0:  # above, across x = 0
+        px, py, qx, qy = bx1, by0, bx0, by0
+    else:  # below, across x = 0
+        px, py, qx, qy = bx0, by1, bx1, by1
+    ap = _atan2(py, px)
+    d = _atan2(qy, qx) - ap  # counter-clockwise from p to q, the extent being < pi
+    if d > np.pi:
+        d -= two_pi
+    elif d < -np.pi:
+        d += two_pi
+    lo = min(d, 0.0)
+    hi = max(d, 0.0)
+    rel = ap - a0
     rel -= two_pi * np.floor(rel / two_pi)
     return lo + rel - _MARGIN, hi + rel + _MARGIN
 

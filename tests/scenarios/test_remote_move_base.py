@@ -77,13 +77,6 @@ def send_and_wait(navs: dict[str, Navigator], timeout: float) -> dict[str, tuple
     return {m: (nav.get_result(), nav.get_status_text()) for m, nav in navs.items()}
 
 
-@pytest.mark.xfail(
-    strict=False,
-    reason="in two full clean-clone runs (pytest -n 2) the remote node reached the goal but did "
-    "not exit within 45 s of Ctrl-C; alone, and in the full suite in the main checkout, it "
-    "passes. Suspect: the Zenoh tests added beside it (compute_cartesian_path, position "
-    "sharing) running on the other worker at the same time; not investigated yet",
-)
 def test_move_base_in_another_process_drives_lizi_to_its_goal():
     endpoint = free_endpoint()
     with RunningSimulation(endpoint, {"robots": "1"}, rate=2.0) as sim:
@@ -96,8 +89,9 @@ def test_move_base_in_another_process_drives_lizi_to_its_goal():
                 assert "/lizi1/move_base" in client.graph()["nodes"]
                 assert "/lizi1/move_base" not in sim.runtime.graph.nodes
                 results = send_and_wait({"lizi1": Navigator(client, "/lizi1")}, timeout=45.0)
-            # a generous grace: on a loaded 2-core machine the node took over 15 s to wind down
-            # its Zenoh session once; a node that ignores Ctrl-C still fails here
+            # Ctrl-C stops it between scheduler steps (a stop event, not KeyboardInterrupt
+            # raised inside a callback: that once left its Zenoh session unable to close); a
+            # generous grace for a loaded 2-core machine, a node that ignores Ctrl-C still fails
             code = mb.stop(signal.SIGINT, timeout=45.0)
         finally:
             mb.close()

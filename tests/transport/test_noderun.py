@@ -9,6 +9,7 @@ from pathlib import Path
 import pytest
 
 from fleetsim.errors import LaunchError, TransportError
+from fleetsim.transport import SimulationClient
 from fleetsim.transport.noderun import load_node_class, parse_assignments, run_node
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -79,3 +80,30 @@ def test_node_in_another_process_exchanges_messages(sim):
     assert len(back) >= 5
     assert all(b.startswith("from-sim:t=") for b in back)  # the simulation's parameter
     assert sim.talker.calls >= 1  # the remote node called the simulation's service
+
+
+@pytest.mark.parametrize(("sig", "status"), [("SIGINT", 130), ("SIGTERM", 0)])
+def test_the_command_stops_cleanly_on_ctrl_c_and_sigterm(sim, sig, status):
+    """``fleetsim node run`` joined to a simulation: Ctrl-C exits 130 (as a shell expects of an
+    interrupted command), SIGTERM 0 (a supervisor's clean stop), both through a stop event."""
+    import signal
+
+    env = dict(os.environ, PYTHONPATH=f"{ROOT / 'src'}{os.pathsep}{ROOT / 'tests'}")
+    cmd = [sys.executable, "-m", "fleetsim.cli.main", "node", "run"]
+    cmd += ["transport.helper_nodes:Echo", "--ns", "/lizi1", "--connect", sim.endpoint]
+    p = subprocess.Popen(cmd, env=env, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    try:
+        with SimulationClient(sim.endpoint, timeout=5.0) as client:
+            deadline = time.monotonic() + 60
+            while time.monotonic() < deadline and "/lizi1/echo" not in client.graph()["nodes"]:
+                assert p.poll() is None, p.communicate()[0]
+                time.sleep(0.2)
+            assert "/lizi1/echo" in client.graph()["nodes"], "the node never joined"
+        p.send_signal(getattr(signal, sig))
+        out, _ = p.communicate(timeout=45)
+    finally:
+        if p.poll() is None:
+            p.kill()
+            p.wait()
+    assert p.returncode == status, out
+    assert "Traceback" not in out

@@ -251,21 +251,51 @@ def node_run(
     remap: list[str] | None = REMAPS,
     seed: int = typer.Option(0, "--seed", help="Seed of this process's random numbers."),
     until: float | None = typer.Option(None, "--until", help="Stop at this sim time (s)."),
+    clock_timeout: float = typer.Option(
+        30.0, "--clock-timeout", help="Wall seconds to wait for the simulation's first /clock."
+    ),
     connect: str | None = Connect,
 ) -> None:
-    """Run a node in this process on the simulation's /clock, joined to its graph."""
+    """Run a node in this process on the simulation's /clock, joined to its graph.
+
+    Ctrl-C (exit status 130) and SIGTERM (0) stop it between scheduler steps: the signal sets
+    an event the clock-following loop checks, rather than raising KeyboardInterrupt wherever
+    the main thread happens to be (inside a callback, holding a lock a Zenoh thread waits for,
+    which then kept the session's close from returning). A second Ctrl-C interrupts at once.
+    """
+    import signal
+    import threading
+
     from fleetsim.transport.noderun import parse_assignments, run_node
 
-    run_node(
-        spec,
-        ns,
-        name=name,
-        params=parse_assignments(param or [], "--param"),
-        remaps=parse_assignments(remap or [], "--remap"),
-        connect=connect,
-        seed=seed,
-        until=until,
-    )
+    stop = threading.Event()
+    got: list[int] = []
+
+    def on_signal(signum, _frame) -> None:
+        if signum == signal.SIGINT and got:
+            raise KeyboardInterrupt  # asked twice: no more waiting
+        got.append(signum)
+        stop.set()
+
+    previous = {s: signal.signal(s, on_signal) for s in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        run_node(
+            spec,
+            ns,
+            name=name,
+            params=parse_assignments(param or [], "--param"),
+            remaps=parse_assignments(remap or [], "--remap"),
+            connect=connect,
+            seed=seed,
+            until=until,
+            stop=stop,
+            clock_timeout=clock_timeout,
+        )
+    finally:
+        for s, handler in previous.items():
+            signal.signal(s, handler)
+    if got and got[0] == signal.SIGINT:
+        raise typer.Exit(130)
 
 
 # -- tf ---------------------------------------------------------------------------------------

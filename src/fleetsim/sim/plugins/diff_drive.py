@@ -205,9 +205,14 @@ class WheeledDrive(DrivePlugin):
             out = batch.encoder_odometry(slots, t)
             rows = zip(out[:, 0:3], out[:, 3:7], out[:, 7:10], out[:, 10:13])
             parts = dict(zip(map(id, enc), rows))
+        true = [p for p in plugins if not p.encoder]
+        if true:
+            roots = np.fromiter((p.root for p in true), np.int64, len(true))
+            pos, quat, lin, ang = true_odometries(engine.model, engine.data, roots)
+            parts.update(zip(map(id, true), zip(pos, quat, lin, ang)))
         readings = []
         for p in plugins:
-            pos, quat, lin, ang = parts[id(p)] if p.encoder else p._true_odometry(engine)
+            pos, quat, lin, ang = parts[id(p)]
             readings.append(
                 OdometryReading(
                     t,
@@ -224,16 +229,6 @@ class WheeledDrive(DrivePlugin):
             )
         return readings
 
-    def _true_odometry(self, engine) -> tuple[np.ndarray, ...]:
-        """World pose (x, y, z; quaternion x, y, z, w) and body-frame twist of the base."""
-        d = engine.data
-        pos = d.xpos[self.root].copy()
-        w, qx, qy, qz = d.xquat[self.root]
-        quat = np.array([qx, qy, qz, w])
-        vel = np.zeros(6)
-        mujoco.mj_objectVelocity(engine.model, d, mujoco.mjtObj.mjOBJ_XBODY, self.root, vel, 1)
-        return pos, quat, vel[3:].copy(), vel[:3].copy()
-
 
 @register("libgazebo_ros_diff_drive.so")
 class DiffDrivePlugin(WheeledDrive):
@@ -249,3 +244,44 @@ class DiffDrivePlugin(WheeledDrive):
         self.encoder = p.odometrySource == "encoder"
         self.publish_tf = p.publishOdomTF and p.publishTf
         self._setup()
+
+
+def true_odometries(model, data, roots: np.ndarray) -> tuple[np.ndarray, ...]:
+    """World poses and body-frame twists of the bodies ``roots`` ((B,) int64 body ids), as
+    ``mj_objectVelocity(..., mjOBJ_XBODY, root, vel, flg_local=1)`` gives them one body at a
+    time, bit for bit: the same operations in MuJoCo's order (``mju_transformSpatial``: the
+    com-based velocity moved to the body's origin, then rotated into its frame), over the batch.
+
+    Returns
+    -------
+    pos : (B, 3) m, world; quat : (B, 4) x, y, z, w, world;
+    lin : (B, 3) m/s and ang : (B, 3) rad/s, in each body's frame.
+    """
+    pos = data.xpos[roots]
+    quat = data.xquat[roots][:, [1, 2, 3, 0]]
+    cvel = data.cvel[roots]
+    w0, w1, w2 = cvel[:, 0], cvel[:, 1], cvel[:, 2]
+    dif = pos - data.subtree_com[model.body_rootid[roots]]
+    d0, d1, d2 = dif[:, 0], dif[:, 1], dif[:, 2]
+    # linear velocity at the body's origin: v - dif x w
+    v0 = cvel[:, 3] - (d1 * w2 - d2 * w1)
+    v1 = cvel[:, 4] - (d2 * w0 - d0 * w2)
+    v2 = cvel[:, 5] - (d0 * w1 - d1 * w0)
+    r = data.xmat[roots]  # (B, 9) row-major body-to-world; R^T v in the body frame
+    lin = np.stack(
+        [
+            r[:, 0] * v0 + r[:, 3] * v1 + r[:, 6] * v2,
+            r[:, 1] * v0 + r[:, 4] * v1 + r[:, 7] * v2,
+            r[:, 2] * v0 + r[:, 5] * v1 + r[:, 8] * v2,
+        ],
+        axis=1,
+    )
+    ang = np.stack(
+        [
+            r[:, 0] * w0 + r[:, 3] * w1 + r[:, 6] * w2,
+            r[:, 1] * w0 + r[:, 4] * w1 + r[:, 7] * w2,
+            r[:, 2] * w0 + r[:, 5] * w1 + r[:, 8] * w2,
+        ],
+        axis=1,
+    )
+    return pos, quat, lin, ang

@@ -194,7 +194,7 @@ def parse_seeds(value: Any, where: str) -> list[int]:
 # -- scenarios ------------------------------------------------------------------------------
 def resolve_scenario(name: str, workdir: Path) -> Path:
     """The launch file of a scenario: a file (relative to ``workdir``) or a shipped name."""
-    from fleetsim.cli.launch import scenarios
+    from fleetsim.launch.scenarios import scenarios
 
     p = Path(name) if Path(name).is_absolute() else workdir / name
     if p.is_file():

@@ -18,30 +18,9 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from fleetsim.errors import LaunchError
+from fleetsim.launch.scenarios import resolve_launch_file, scenarios
 
-SCENARIOS = Path(__file__).resolve().parent.parent / "assets" / "launch"
 console = Console(stderr=True)
-
-
-def scenarios() -> dict[str, Path]:
-    """Shipped scenarios: name -> launch file."""
-    out = {}
-    for p in sorted(SCENARIOS.glob("*.launch")) + sorted(SCENARIOS.glob("*.launch.yaml")):
-        out[p.name.split(".")[0]] = p
-    return out
-
-
-def resolve_launch_file(name: str) -> Path:
-    p = Path(name)
-    if p.is_file():
-        return p
-    known = scenarios()
-    if name in known:
-        return known[name]
-    raise LaunchError(
-        f"'{name}' is neither a launch file nor a shipped scenario; scenarios: "
-        f"{', '.join(known) or 'none'} (fleetsim launch --list)"
-    )
 
 
 def parse_launch_args(items: list[str]) -> dict[str, str]:

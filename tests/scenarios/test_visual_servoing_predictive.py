@@ -120,12 +120,6 @@ def test_circle_patrol_the_marker_stays_in_view_and_the_tracker_knows_where_it_i
         no_mujoco_warnings(s)
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="passed before the physics moved to MuJoCo's implicit integrator (59ada15); since then "
-    "the follower loses the marker once (~20 s, about karl's first stop, where karl turns in "
-    "place) and explores: detected 68.5 % in this 45 s run. Not yet looked into",
-)
 def test_building_patrol_it_follows_karl_through_the_gap_between_the_barriers():
     with session(follower="predictive", patrol="building", **BEHIND_KARL) as s:
         w = Watch(s)

@@ -213,3 +213,41 @@ def test_dwa_offers_in_place_rotations_either_way_while_turning():
         assert dvth == pytest.approx(2.0 / 19)
         if dwa:  # the forward samples keep DWA's window of one control period
             assert forward.min() >= 0.0 and forward.max() <= 0.6 + 1e-12
+
+
+def _turn_to_a_near_goal(th0: float, bearing: float) -> tuple[bool, float]:
+    """A burger (turtlebot3's DWA limits) 0.2 m from its goal in open space, facing ``th0``;
+    the goal lies at ``bearing`` and faces along it. (reached, largest |net turn| on the way)."""
+    p = TrajectoryPlannerParams(
+        holonomic_robot=False, max_vel_x=0.22, min_vel_x=0.05, max_vel_theta=2.75,
+        min_in_place_vel_theta=1.37, acc_lim_x=2.5, acc_lim_theta=3.2, xy_goal_tolerance=0.05,
+        yaw_goal_tolerance=0.17, sim_time=2.0, vx_samples=20, vtheta_samples=40, dwa=True,
+        meter_scoring=True, occdist_scale=0.02, heading_lookahead=0.325,
+    )  # fmt: skip
+    tp = TrajectoryPlanner(Costmap2D(120, 120, 0.05), footprint_from_radius(0.1), p)
+    gx, gy = 3.0 + 0.2 * math.cos(bearing), 3.0 + 0.2 * math.sin(bearing)
+    tp.set_plan(
+        np.stack([np.linspace(3.0, gx, 10), np.linspace(3.0, gy, 10), np.full(10, bearing)], 1)
+    )
+    x, y, th, v, dt = 3.0, 3.0, th0, (0.0, 0.0, 0.0), 0.1
+    worst = 0.0
+    for _ in range(400):
+        v = tp.compute_velocity_commands((x, y, th), v)
+        x += v.vx * math.cos(th) * dt
+        y += v.vx * math.sin(th) * dt
+        th += v.vtheta * dt
+        worst = max(worst, abs(th - th0))
+        if tp.is_goal_reached():
+            return True, worst
+    return False, worst
+
+
+@pytest.mark.parametrize(("th0", "bearing"), [(-45, -60), (90, 49), (135, 120), (-90, 0)])
+def test_an_in_place_rotation_turns_the_short_way_to_a_near_goal(th0, bearing):
+    """Rotations sampled over sim_time's window can turn past a half turn in their rollout;
+    judged by where their end points, a burger beside its goal spun 300 degrees the long way
+    round (the building patrol's karl); judged by the best heading passed, and how soon, not."""
+    reached, worst = _turn_to_a_near_goal(math.radians(th0), math.radians(bearing))
+    need = abs(math.remainder(math.radians(bearing - th0), 2 * math.pi))
+    assert reached
+    assert worst < need + math.radians(35), f"turned {math.degrees(worst):.0f} degrees"

@@ -100,6 +100,32 @@ def _ahead_goal_dist(tp: TrajectoryPlanner, index: int) -> float | None:
     return None if cell is None else float(tp.goal_dist[cell[1], cell[0]])
 
 
+def _ahead_goal_dist_turning(tp: TrajectoryPlanner, index: int) -> tuple[float, int] | None:
+    """For an in-place rotation: the least goal distance ``heading_lookahead`` ahead of any
+    pose of its rollout, and the first step that reaches it; None if none is on the map.
+
+    Departure from base_local_planner, which looks ahead of the rollout's end only. With
+    in-place rates sampled over sim_time's window a rollout can turn past a half turn, and its
+    end then points anywhere: a burger 0.2 m from its goal with the goal 90 degrees to its
+    left chose the rotation whose end, after 315 degrees to the right, pointed at the goal,
+    and spun the long way round. Judged by the best heading it passes and how soon, the
+    rotation toward the goal wins.
+    """
+    n = int(tp._steps[index])
+    poses = tp._poses[index, :n]
+    look = tp.params.heading_lookahead
+    xs = poses[:, 0] + look * np.cos(poses[:, 2])
+    ys = poses[:, 1] + look * np.sin(poses[:, 2])
+    best: tuple[float, int] | None = None
+    for k in range(n):
+        cell = tp.costmap.world_to_map(float(xs[k]), float(ys[k]))
+        if cell is not None:
+            d = float(tp.goal_dist[cell[1], cell[0]])
+            if best is None or d < best[0]:
+                best = (d, k)
+    return best
+
+
 #: how many escape_reset_dist a robot that cannot turn in place backs up at most
 ESCAPE_ROOM = 5.0
 
@@ -167,17 +193,18 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
         if legal.any():
             best = g["forward"].start + int(np.argmin(np.where(legal, first, np.inf)))
             best_cost = costs[best]
-    heading_dist = math.inf
+    heading: tuple[float, int] = (math.inf, 0)  # rotations: (goal distance, step) ahead
     raw = tp._in_place_raw
     for k, i in enumerate(range(g["in_place"].start, g["in_place"].stop)):
         v = raw[k]
         ok = costs[i] >= 0 and (best_cost < 0 or costs[i] <= best_cost or samples[best, 1] != 0.0)
         if ok and (v > dvth or v < -dvth):
-            ahead = _ahead_goal_dist(tp, i)
+            ahead = _ahead_goal_dist_turning(tp, i)
             free_side = (v < 0 and not tp.stuck_left) or (v > 0 and not tp.stuck_right)
-            if ahead is not None and ahead < heading_dist and free_side:
+            if ahead is not None and ahead < heading and free_side:
                 best, best_cost = i, costs[i]
-                heading_dist = ahead
+                heading = ahead
+    heading_dist = heading[0]
     if best_cost >= 0:
         _bookkeep(tp, samples[best], pose)
         return tuple(samples[best]), float(best_cost), best

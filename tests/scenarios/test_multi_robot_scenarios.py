@@ -90,6 +90,18 @@ def test_circle_of_eight_reaches_the_antipodes(monkeypatch, tmp_path):
         assert_clean_success(s, tmp_path)
 
 
+def test_swap_through_a_corridor_too_narrow_for_two(monkeypatch, tmp_path):
+    """width:=1.0: the corridor's middle 6 m are too narrow for two lizis. They meet nose to
+    nose; lizi2 (lower priority) sees the passage is too narrow, backs out into its wide end,
+    waits aside until lizi1 has gone by, then both finish: no contact, no abort."""
+    monkeypatch.chdir(tmp_path)
+    with session("swap_corridor", robots="2", width="1.0", gui="false") as s:
+        s.run(duration=90.0, until_goals=True)
+        assert_clean_success(s, tmp_path)
+        rules = {ns: s.nodes[f"/{ns}/move_base"].controller.deadlock for ns in ("lizi1", "lizi2")}
+        assert rules["lizi2"].yields == 1 and rules["lizi1"].yields == 0
+
+
 def test_plain_trajectory_planner_runs_into_the_other_robot(monkeypatch, tmp_path):
     """The failure this issue fixes: lizis cannot see each other (their lasers sweep above the
     other bodies), so with TrajectoryPlannerROS the corridor swap ends in a collision."""

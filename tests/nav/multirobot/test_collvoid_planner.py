@@ -15,7 +15,11 @@ from fleetsim.nav.controllers.collvoid_planner import CollvoidLocalPlanner
 from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE, Costmap2D
 from fleetsim.nav.move_base_plugins import LOCAL_PLANNERS
 from fleetsim.nav.multirobot.deadlock import DeadlockRule, priority_key
-from fleetsim.nav.multirobot.holonomic import obstacle_points, tracking_command
+from fleetsim.nav.multirobot.holonomic import (
+    detour_velocity,
+    obstacle_points,
+    tracking_command,
+)
 from fleetsim.runtime import Node, Runtime
 
 LIZI = np.array([[-0.19, -0.16], [-0.19, 0.16], [0.19, 0.16], [0.19, -0.16]])
@@ -121,14 +125,19 @@ def test_corridor_swap_keeps_off_the_walls():
 
 def test_in_a_corridor_too_narrow_to_pass_the_lower_priority_robot_backs_off():
     """0.9 m between the walls: the lizis cannot pass, ORCA stalls them nose to nose. Without
-    the rule they stay put; with it robot2 (lower priority) backs away and robot1 advances.
-    (Backing off for ``yield_time`` does not clear a 12 m corridor: such a swap still needs a
-    longer retreat or a reservation, which the rule does not do.)"""
+    the rule they stay put; with it robot2 (lower priority) backs away along its plan and robot1
+    advances (test_yielding.py: the whole swap, with wide ends to back out into)."""
     walls = [(-8, 0.45, 8, 0.65), (-8, -0.65, 8, -0.45)]
     swap = ([(-3, 0, 0), (3, 0, math.pi)], [(3, 0, 0), (-3, 0, math.pi)])
 
     def standoff(deadlock_time):
-        f = Fleet(*swap, walls=walls, deadlock_time=deadlock_time, yield_time=4.0)
+        f = Fleet(
+            *swap,
+            walls=walls,
+            deadlock_time=deadlock_time,
+            narrow_deadlock_time=deadlock_time,
+            yield_time=4.0,
+        )
         f.run(16.0)  # nose to nose by ~10 s; no progress for 8 s
         before = f.state[:, 0].copy()
         f.run(6.0)
@@ -140,6 +149,47 @@ def test_in_a_corridor_too_narrow_to_pass_the_lower_priority_robot_backs_off():
     f, moved = standoff(8.0)
     assert moved[1] > 0.5 and moved[0] > 0.3  # robot2 retreats east, robot1 follows
     assert f.planners[1].deadlock.yields >= 1 and f.planners[0].deadlock.yields == 0
+
+
+@pytest.mark.parametrize("detour", [True, False])
+def test_robots_parked_in_the_way_are_gone_round(detour, monkeypatch):
+    """robot2 stands on robot1's straight path, robot3 beside it on the right, too close for
+    robot1 to pass between (their goals are where they stand): ORCA alone leads robot1 into the
+    gap and stops it there; the preferred velocity turned onto the nearest clear tangent takes
+    it round on the left."""
+    if not detour:
+        monkeypatch.setattr("fleetsim.nav.controllers.collvoid_planner.DETOUR_REACH", 0.0)
+    parked = [(0.0, 0.0, math.pi / 2), (0.0, -0.62, math.pi / 2)]
+    f = Fleet([(-3, 0, 0), *parked], [(3, 0, 0), *parked])
+    assert f.run(30.0) is detour
+    assert f.min_gap > 0.0
+    if detour:
+        assert f.paths[0] < 6.0 * 1.15
+        assert f.state[1:] == pytest.approx(np.array(parked))
+
+
+def test_detour_velocity_takes_the_tangent_on_the_side_the_ray_leans_to():
+    pref = np.array([0.5, 0.0])
+    ahead = np.array([[1.0, 0.05]])  # a disc just left of the ray: pass it on the right
+    v, k = detour_velocity(pref, ahead, np.array([0.6]), 1.5)
+    assert k == 0 and np.hypot(*v) == pytest.approx(0.5)
+    assert v[1] < 0 and math.atan2(v[1], v[0]) == pytest.approx(
+        math.atan2(0.05, 1.0) - math.asin(0.6 / math.hypot(1.0, 0.05)), abs=2e-3
+    )
+    v, k = detour_velocity(pref, np.array([[1.0, -0.05]]), np.array([0.6]), 1.5)
+    assert v[1] > 0  # leans right: pass on the left
+    # a second disc closing the right-hand way: the left tangent, though farther round
+    pair = np.array([[1.0, 0.05], [1.0, -1.0]])
+    v, k = detour_velocity(pref, pair, np.array([0.6, 0.6]), 1.5)
+    assert k == 0 and v[1] > 0
+    # walled in: unchanged
+    ring = np.array([[math.cos(a), math.sin(a)] for a in np.linspace(0, 2 * math.pi, 9)[:-1]])
+    v, k = detour_velocity(pref, ring, np.full(8, 0.6), 1.5)
+    assert k == -1 and v is pref
+    # beyond reach, behind, or off the ray: unchanged
+    for rel in ([[2.5, 0.0]], [[-1.0, 0.0]], [[1.0, 0.8]]):
+        v, k = detour_velocity(pref, np.array(rel), np.array([0.6]), 1.5)
+        assert k == -1 and v is pref
 
 
 def test_deadlock_rule_yields_to_the_lower_id_only_after_no_progress():

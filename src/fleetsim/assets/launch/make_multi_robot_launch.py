@@ -4,6 +4,8 @@
   ``robots`` 2 or 4. With 2, lizi1 at the west end and lizi2 at the east end exchange places;
   with 4, two robots queue at each end (1.2 m apart) and each goes to the start of its
   counterpart at the other end.
+  ``width`` 2.0 (default) or 1.0: world ``corridor_narrow``, the middle 6 m (x 4..10) only
+  1.0 m wide, too narrow for two lizis: the deadlock rule makes one back out into a wide end.
 * ``circle`` (world ``open_room``): arg ``robots`` 8 or 16 on a circle of 6 m diameter around
   (7, 7), facing its centre; each goes to the antipodal point.
 
@@ -66,7 +68,25 @@ def _group(k: int, robot: tuple, minimum: int) -> str:
   </group>"""
 
 
-def scenario(name: str, doc: str, world: str, counts: tuple[int, int], robots: list) -> str:
+#: swap_corridor's ``width`` arg: corridor width (m) -> world
+CORRIDOR_WORLDS = {2.0: "corridor", 1.0: "corridor_narrow"}
+
+
+def _world_arg(world: str | dict[float, str]) -> str:
+    """The ``map`` arg: one world, or one per ``width`` (a launch error names other widths)."""
+    if isinstance(world, str):
+        return f"""  <arg name="map" default="$(find fleetsim_maps)/{world}.yaml"/>"""
+    widths = sorted(world, reverse=True)
+    choice = " else ".join(f"'{world[w]}' if float(width) == {w}" for w in widths)
+    names = "_or_".join(f"{w:g}".replace(".", "_") for w in widths)
+    return f"""  <arg name="width" default="{widths[0]}"
+       doc="corridor width, m: {" or ".join(f"{w:g}" for w in widths)} (narrowed for its middle 6 m:
+            too narrow for two lizis to pass; one backs out into a wide end)"/>
+  <arg name="world" value="$(eval {choice} else width_must_be_{names})"/>
+  <arg name="map" default="$(find fleetsim_maps)/$(arg world).yaml"/>"""
+
+
+def scenario(name: str, doc: str, world: str | dict, counts: tuple[int, int], robots: list) -> str:
     small, large = counts
     # an unknown name in $(eval) is a launch error that names it: robots_must_be_2_or_4
     bad = f"robots_must_be_{small}_or_{large}"
@@ -83,7 +103,7 @@ def scenario(name: str, doc: str, world: str, counts: tuple[int, int], robots: l
   <arg name="localization" default="fake" doc="fake | amcl"/>
   <arg name="start_delay" default="2.0" doc="sim seconds before the goals go out"/>
   <arg name="solo" default="" doc="run only this robot (e.g. lizi3): its time and path alone"/>
-  <arg name="map" default="$(find fleetsim_maps)/{world}.yaml"/>
+{_world_arg(world)}
   <arg name="gui" default="true" doc="open the live view when run with --viz"/>
   <arg name="robots_checked" value="{check}"/>
 
@@ -104,8 +124,9 @@ def write(outdir: Path) -> list[Path]:
     files = {
         "swap_corridor.launch": scenario(
             "swap_corridor",
-            "Robots exchange the ends of a 12 m long, 2 m wide corridor (robots:=2 or 4).",
-            "corridor",
+            "Robots exchange the ends of a 12 m long, 2 m wide corridor (robots:=2 or 4;\n"
+            "       width:=1.0 narrows its middle 6 m to 1.0 m).",
+            CORRIDOR_WORLDS,
             (2, 4),
             swap_corridor_robots(4),
         ),

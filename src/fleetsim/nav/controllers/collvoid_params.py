@@ -90,10 +90,18 @@ class CollvoidParams:
     deadlock_time: float = param(
         10.0, unit="s", range=(0.0, None), help="no progress this long near a robot: stuck"
     )
+    narrow_deadlock_time: float = param(
+        3.0, unit="s", range=(0.0, None), help="the same in a passage too narrow for two"
+    )
     deadlock_progress: float = param(
         0.2, unit="m", range=(0.0, None), help="progress that resets the deadlock clock"
     )
     deadlock_radius: float = param(
         2.0, unit="m", range=(0.0, None), help="robots this close take part in a deadlock"
     )
-    yield_time: float = param(4.0, unit="s", range=(0.0, None), help="how long a robot yields")
+    yield_time: float = param(
+        30.0,
+        unit="s",
+        range=(0.0, None),
+        help="longest a yield lasts (it ends when the robot yielded to has gone by)",
+    )

@@ -47,6 +47,7 @@ from fleetsim.nav.controllers.collvoid_params import CollvoidParams
 from fleetsim.nav.costmap.footprint import footprint_radii
 from fleetsim.nav.multirobot.deadlock import DeadlockRule
 from fleetsim.nav.multirobot.holonomic import (
+    detour_velocity,
     obstacle_points,
     plan_carrot,
     preferred_velocity,
@@ -57,6 +58,7 @@ from fleetsim.nav.multirobot.holonomic import (
 from fleetsim.nav.multirobot.orca import orca_halfplanes, orca_velocity
 from fleetsim.nav.multirobot.position_share import PositionShare
 from fleetsim.nav.multirobot.uncertainty import uncertainty_radius
+from fleetsim.nav.multirobot.yielding import Retreat, has_passed, too_narrow
 from fleetsim.runtime import load_params
 
 _log = logging.getLogger("fleetsim.nav.collvoid")
@@ -67,6 +69,10 @@ STILL_SPEED = 0.02
 OBSTACLE_SECTORS = 24
 #: share of acc_lim_x used to slow down towards the goal
 DECELERATION = 0.25
+#: m added to the combined radius of a robot standing in the way when going round it
+DETOUR_MARGIN = 0.05
+#: m: a robot standing in the way nearer than this is gone round
+DETOUR_REACH = 1.0
 #: no truncation: the velocity obstacle's horizon, s
 UNTRUNCATED = 1e3
 
@@ -98,7 +104,12 @@ class CollvoidLocalPlanner(LocalPlanner):
         self.body_radius = p.footprint_radius or footprint_radii(costmap_ros.footprint)[1]
         self.share = PositionShare(node)
         self.deadlock = DeadlockRule(
-            self.robot_id, p.deadlock_time, p.deadlock_progress, p.deadlock_radius, p.yield_time
+            self.robot_id,
+            p.deadlock_time,
+            p.deadlock_progress,
+            p.deadlock_radius,
+            p.yield_time,
+            p.narrow_deadlock_time,
         )
         self._particles: np.ndarray | None = None
         node.create_subscription(geometry_msgs.PoseArray, "particlecloud", self._on_cloud, 1)
@@ -113,6 +124,8 @@ class CollvoidLocalPlanner(LocalPlanner):
         self.last_cmd = (0.0, 0.0)
         self.last_holo = np.zeros(2)
         self.yielding_to: str | None = None
+        self.plan_index = 0
+        self.retreat = Retreat()  # the way back and the refuge of a yield
         self.lines = (np.zeros((0, 2)), np.zeros((0, 2)), 0)  # this cycle's half-planes
         self.feasible = True
 
@@ -138,6 +151,7 @@ class CollvoidLocalPlanner(LocalPlanner):
             self.reached_goal = False
             self.xy_tolerance_latch = False
             self.deadlock.reset(self.node.now())
+            self.retreat.reset()
 
     def is_goal_reached(self) -> bool:
         return self.reached_goal
@@ -154,7 +168,9 @@ class CollvoidLocalPlanner(LocalPlanner):
                 self.xy_tolerance_latch = True
             return self._at_goal(yaw, float(velocity[2]), gyaw)
         self.rotating_to_goal = False
-        carrot, _, remaining = plan_carrot(self.plan[:, :2], xy, p.carrot_distance)
+        carrot, self.plan_index, remaining = plan_carrot(self.plan[:, :2], xy, p.carrot_distance)
+        if self.yielding_to is None:
+            self.retreat.extend(xy)
         vel_body = np.array([float(velocity[0]), float(velocity[1])])
         vel = rotated(vel_body, yaw)
         holo = self.holonomic_velocity(xy, yaw, vel, carrot, remaining)
@@ -212,15 +228,30 @@ class CollvoidLocalPlanner(LocalPlanner):
         own_r = self.own_radius(speed, map_xy)
         dist = np.hypot(pos[:, 0] - xy[0], pos[:, 1] - xy[1])
         active = {k: d for k, d, c in zip(ids, dist.tolist(), controlled) if c}
-        self.yielding_to = self.deadlock.update(now, remaining, active)
+        narrow = False
+        if active and self.yielding_to is None:
+            heading = carrot - xy
+            n = float(np.hypot(*heading))
+            cm = self.costmap
+            narrow = n > 1e-6 and too_narrow(
+                cm.costs,
+                (cm.origin_x, cm.origin_y),
+                cm.resolution,
+                xy,
+                heading / n,
+                own_r,
+                float(radii[controlled].max()),
+            )
+        self.yielding_to = self.deadlock.update(now, remaining, active, narrow)
         if self.yielding_to is not None:
             k = ids.index(self.yielding_to)
-            resp[k] = 1.0
-            away = xy - pos[k]
-            away = away / max(float(np.hypot(*away)), 1e-9)
-            pref = rotated(away, -math.pi / 3) * (0.5 * p.max_vel_x)
-        elif ids and self._oncoming(pos - xy, nvel - vel, pref, dist, remaining + own_r).any():
-            pref = rotated(pref, p.left_pref)
+            pref = self._yield_velocity(xy, carrot - xy, pos[k], own_r, radii[k], remaining, pref)
+            if self.yielding_to is not None:
+                resp[k] = 1.0
+        if self.yielding_to is None and ids:
+            if self._oncoming(pos - xy, nvel, vel, pref, dist, remaining + own_r).any():
+                pref = rotated(pref, p.left_pref)
+            pref = self._around_still(pref, xy, pos - xy, nvel, own_r + radii, controlled)
         lines_p, lines_d = [], []
         obst = obstacle_points(
             self.costmap.costs,
@@ -264,11 +295,37 @@ class CollvoidLocalPlanner(LocalPlanner):
         self.last_holo = holo
         return holo
 
+    def _yield_velocity(self, xy, to_goal, other, own_r, other_r, remaining, pref):
+        """Yielding (`fleetsim.nav.multirobot.yielding`): to the refuge back along the plan,
+        then wait there; the yield ends (``pref`` again) once the other robot has gone by."""
+        p, now = self.params, self.node.now()
+        if has_passed(other - xy, to_goal, own_r + other_r):
+            self.deadlock.release(now, remaining)
+            self.yielding_to = None
+            return pref
+        decel = DECELERATION * p.acc_lim_x
+        return self.retreat.velocity(self.costmap, xy, own_r, other_r, p.max_vel_x, decel)
+
+    def _around_still(self, pref, xy, rel, nvel, radii, controlled) -> np.ndarray:
+        """``pref`` turned round the nearest robot standing in its way (`detour_velocity`),
+        unless that robot stands on the goal (then ORCA stops us short of it)."""
+        still = (np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED) | ~controlled
+        if not still.any():
+            return pref
+        r = radii[still] + DETOUR_MARGIN
+        to_goal = self.plan[-1, :2] - xy
+        free = np.hypot(*(rel[still] - to_goal).T) > r
+        idx = np.flatnonzero(still)[free]
+        out, _ = detour_velocity(pref, rel[idx], radii[idx] + DETOUR_MARGIN, DETOUR_REACH)
+        return out
+
     @staticmethod
-    def _oncoming(rel, rel_vel, pref, dist, reach) -> np.ndarray:
+    def _oncoming(rel, nvel, vel, pref, dist, reach) -> np.ndarray:
         """(N,) robots ahead (along ``pref``), nearer than ``reach`` m, moving and closing in:
-        the meetings keeping right resolves (a robot parked ahead is simply avoided)."""
-        moving = np.hypot(rel_vel[:, 0], rel_vel[:, 1]) >= STILL_SPEED
+        the meetings keeping right resolves (a robot standing still ahead is gone round,
+        `_around_still`)."""
+        rel_vel = nvel - vel
+        moving = np.hypot(nvel[:, 0], nvel[:, 1]) >= STILL_SPEED
         closing = np.einsum("ij,ij->i", rel, rel_vel) < 0.0
         return (rel @ pref > 0) & (dist < reach) & moving & closing
 

@@ -7,6 +7,7 @@
 - `orca`: ORCA half-planes and linear programs (`orca_halfplanes`, `orca_velocity`);
 - `holonomic`: preferred velocity, static obstacle points, differential-drive tracking;
 - `deadlock`: the priority rule above ORCA (`DeadlockRule`);
+- `yielding`: where a robot that yields goes (`refuge`, back along its way to a wide place);
 - `uncertainty`: amcl's particle spread as a radius (`uncertainty_radius`).
 
 The local planner plugin is `fleetsim.nav.controllers.collvoid_planner.CollvoidLocalPlanner`,
@@ -24,6 +25,7 @@ from fleetsim.nav.multirobot.position_share import (
     neighbour_from_msg,
 )
 from fleetsim.nav.multirobot.uncertainty import uncertainty_radius
+from fleetsim.nav.multirobot.yielding import passage_width, refuge, too_narrow
 
 __all__ = [
     "TOPIC",
@@ -36,6 +38,9 @@ __all__ = [
     "neighbour_from_msg",
     "orca_halfplanes",
     "orca_velocity",
+    "passage_width",
     "priority_key",
+    "refuge",
+    "too_narrow",
     "uncertainty_radius",
 ]

@@ -7,14 +7,18 @@ measurement with RVO2: exact head-on pairs and 0.6 m corridors never finish). Ea
 
 1. progress is the remaining distance to the goal; when it has not shrunk by
    ``deadlock_progress`` m for ``deadlock_time`` s while another robot is within
-   ``deadlock_radius`` m, the robot is *stuck*;
+   ``deadlock_radius`` m, the robot is *stuck*; in a passage too narrow for two (the planner
+   measures it) after ``narrow_time`` s already: no reciprocal method resolves that, waiting
+   longer only loses time;
 2. a stuck robot looks at the robots around it that are navigating (``controlled`` on
    /position_share; a robot parked at its goal will not move, waiting for it is pointless):
    priority goes by robot id (natural order, so ``lizi2`` before ``lizi10``); every robot sees
    the same ids, so all reach the same verdict without talking. If one of them has priority
-   over it, it *yields* to the nearest such robot
-   for ``yield_time`` s: it backs away from it, off to its right, and takes full
-   responsibility for avoiding it (the priority robot keeps its half and drives on);
+   over it, it *yields* to the nearest such robot: it takes full responsibility for avoiding
+   it (the priority robot keeps its half and drives on), retreats along its own plan to a place
+   wide enough for both and waits there, aside, until that robot has gone by
+   (`fleetsim.nav.multirobot.yielding`; the planner calls `release`), or at most
+   ``yield_time`` s;
 3. after yielding, the progress clock restarts, so a robot that is still stuck yields again.
 
 The robot with the highest priority among those stuck never yields, so a group always has one
@@ -40,7 +44,8 @@ class DeadlockRule:
     deadlock_time: float = 10.0
     deadlock_progress: float = 0.2
     deadlock_radius: float = 2.0
-    yield_time: float = 4.0
+    yield_time: float = 30.0
+    narrow_time: float = 3.0
 
     def __post_init__(self) -> None:
         self.reset(0.0)
@@ -53,11 +58,19 @@ class DeadlockRule:
         self.yield_until = -float("inf")
         self.yields = 0
 
-    def update(self, now: float, remaining: float, nearby: dict[str, float]) -> str | None:
+    def release(self, now: float, remaining: float) -> None:
+        """The robot yielded to has gone by: the yield ends, the progress clock restarts."""
+        self.yield_to = None
+        self.yield_until = -float("inf")
+        self.best, self.best_time = remaining, now
+
+    def update(
+        self, now: float, remaining: float, nearby: dict[str, float], narrow: bool = False
+    ) -> str | None:
         """The robot to yield to this cycle, or None.
 
         remaining : m to the goal; nearby : robot id -> distance (m) of the navigating robots
-        around.
+        around; narrow : the robot stands in a passage too narrow for two.
         """
         if remaining < self.best - self.deadlock_progress:
             self.best, self.best_time = remaining, now
@@ -67,7 +80,8 @@ class DeadlockRule:
             self.yield_to = None
             self.best, self.best_time = remaining, now
         close = {k: d for k, d in nearby.items() if d <= self.deadlock_radius}
-        if not close or now - self.best_time < self.deadlock_time:
+        patience = min(self.narrow_time, self.deadlock_time) if narrow else self.deadlock_time
+        if not close or now - self.best_time < patience:
             return None
         mine = priority_key(self.robot_id)
         higher = [k for k in close if priority_key(k) < mine]

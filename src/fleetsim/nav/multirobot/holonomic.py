@@ -58,6 +58,54 @@ def preferred_velocity(
     return to / n * speed
 
 
+def rays_blocked(
+    directions: np.ndarray, rel_pos: np.ndarray, radii: np.ndarray, reach: float
+) -> np.ndarray:
+    """(M,) whether each unit ray in ``directions`` (M, 2) enters one of the discs (rel_pos
+    (N, 2) m, radii (N,) m) within ``reach`` m of the robot (at the origin)."""
+    along = directions @ rel_pos.T  # (M, N)
+    side = directions[:, :1] * rel_pos[None, :, 1] - directions[:, 1:] * rel_pos[None, :, 0]
+    inside = radii[None, :] ** 2 - side**2
+    entry = along - np.sqrt(np.maximum(inside, 0.0))
+    return np.any((along > 1e-9) & (inside > 0.0) & (entry < reach), axis=1)
+
+
+def detour_velocity(
+    pref: np.ndarray, rel_pos: np.ndarray, radii: np.ndarray, reach: float
+) -> tuple[np.ndarray, int]:
+    """``pref`` turned to the nearest heading whose ray is clear of every disc within ``reach``.
+
+    Robots standing still in the way make ORCA's velocity nearest ``pref`` (which points at
+    them) a standstill: a permitted half-plane square to ``pref``, or two parked robots whose
+    gap is too narrow. Going round them is the preferred velocity's job (a velocity obstacle of
+    the still robots over ``reach``): the candidate headings are the tangents to each disc, and
+    the one nearest ``pref`` whose ray enters no disc wins (the right one on a tie, the side
+    oncoming traffic keeps to).
+
+    pref : (2,) m/s; rel_pos : (N, 2) disc centres relative to the robot, m; radii : (N,) m
+    (combined: own + theirs + margin). Returns (the velocity (2,) m/s, same speed; the index of
+    the disc whose tangent it follows, or -1 when ``pref`` is clear or no heading is).
+    """
+    speed = float(np.hypot(*pref))
+    if speed < 1e-9 or rel_pos.shape[0] == 0:
+        return pref, -1
+    u = pref / speed
+    if not rays_blocked(u[None, :], rel_pos, radii, reach)[0]:
+        return pref, -1
+    d = np.hypot(rel_pos[:, 0], rel_pos[:, 1])
+    bearing = np.arctan2(rel_pos[:, 1], rel_pos[:, 0])
+    half = np.arcsin(np.clip(radii / np.maximum(d, 1e-9), 0.0, 1.0)) + 1e-3
+    heading = np.concatenate([bearing - half, bearing + half])  # right tangents, then left
+    turn = np.remainder(heading - math.atan2(u[1], u[0]) + math.pi, 2 * math.pi) - math.pi
+    order = np.argsort(np.abs(turn) + 1e-6 * (turn > 0), kind="stable")
+    dirs = np.stack([np.cos(heading[order]), np.sin(heading[order])], axis=1)
+    free = ~rays_blocked(dirs, rel_pos, radii, reach)
+    if not free.any():
+        return pref, -1
+    first = int(np.argmax(free))
+    return speed * dirs[first], int(order[first] % rel_pos.shape[0])
+
+
 def rotated(v: np.ndarray, angle: float) -> np.ndarray:
     c, s = math.cos(angle), math.sin(angle)
     return np.array([c * v[0] - s * v[1], s * v[0] + c * v[1]])

@@ -251,3 +251,25 @@ def test_an_in_place_rotation_turns_the_short_way_to_a_near_goal(th0, bearing):
     need = abs(math.remainder(math.radians(bearing - th0), 2 * math.pi))
     assert reached
     assert worst < need + math.radians(35), f"turned {math.degrees(worst):.0f} degrees"
+
+
+def test_the_escape_backs_on_a_curve_that_faces_the_robot_along_its_way():
+    from fleetsim.nav.controllers.selection import _escape_choice, velocity_samples
+
+    tp = make(corridor(), dwa=True, acc_lim_theta=3.0, sim_time=1.5, escape_vel=-0.1)
+    tp.set_plan(np.array([[x, 1.0, 0.0] for x in np.arange(1.0, 5.0, 0.05)]))
+    pose, vel = (1.5, 1.0, 0.6), (0.0, 0.0, 0.0)  # 0.6 rad off the corridor's axis
+    tp._update_maps(tp.plan, pose, vel)
+    samples, g, dvth = velocity_samples(tp, pose, vel)
+    costs = tp._score(samples, pose, vel)
+    turns = samples[g["escape_turn"]]
+    assert np.all(turns[:, 0] == -0.1) and turns[:, 2].min() < 0 < turns[:, 2].max()
+    i = _escape_choice(tp, costs, g, dvth)
+    # backing while turning right leaves it facing down the corridor: better than straight
+    assert g["escape_turn"].start <= i < g["escape_turn"].stop and samples[i, 2] < 0
+    assert tp._poses[i, tp._steps[i] - 1, 2] < 0.6 - 0.3
+    # no legal turning back-up: base_local_planner's straight one (taken even when illegal)
+    costs[g["escape_turn"]] = -1.0
+    assert _escape_choice(tp, costs, g, dvth) == g["escape"].start
+    costs[g["escape"]] = -1.0
+    assert _escape_choice(tp, costs, g, dvth) == g["escape"].start

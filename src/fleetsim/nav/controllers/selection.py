@@ -54,6 +54,10 @@ def velocity_samples(
         sideways = np.zeros((len(p.y_vels), 3))
         sideways[:, 1] = np.asarray(p.y_vels, dtype=np.float64)
     escape = np.array([[p.escape_vel, 0.0, 0.0]])
+    # backing while turning (a fleetsim addition, see `_escape_choice`): the in-place rates
+    escape_turn = np.zeros((p.vtheta_samples, 3))
+    escape_turn[:, 0] = p.escape_vel
+    escape_turn[:, 2] = in_place_vths
     groups: dict[str, slice] = {}
     parts = []
     n = 0
@@ -63,6 +67,7 @@ def velocity_samples(
         ("in_place", in_place),
         ("sideways", sideways),
         ("escape", escape),
+        ("escape_turn", escape_turn),
     ):
         k = 0 if part is None else part.shape[0]
         groups[name] = slice(n, n + k)
@@ -181,6 +186,28 @@ def _bookkeep(tp: TrajectoryPlanner, sample, pose) -> None:
     _end_escape_when_clear(tp, x, y, th)
 
 
+def _escape_choice(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: float) -> int:
+    """The escape sample: ROS's straight back-up, or a legal back-up that turns the robot
+    to face the way to the goal better (chosen by in-place rotation's rule: the least goal
+    distance a heading_lookahead ahead of the rollout's end).
+
+    Departure from base_local_planner, which only backs straight: a robot that entered a gap
+    barely wider than itself at a slant (BARN world 105, the jackal 0.6 rad off the gap's
+    axis) backs out straight, drives in again at the same slant and is wedged again; backing
+    on a curve straightens it out of the gap as a driver's three-point turn does."""
+    best = g["escape"].start
+    best_ahead = _ahead_goal_dist(tp, best) if costs[best] >= 0 else None
+    best_ahead = math.inf if best_ahead is None else best_ahead
+    raw = tp._in_place_raw
+    for k, i in enumerate(range(g["escape_turn"].start, g["escape_turn"].stop)):
+        if costs[i] < 0 or -dvth <= raw[k] <= dvth:
+            continue
+        ahead = _ahead_goal_dist(tp, i)
+        if ahead is not None and ahead < best_ahead:
+            best, best_ahead = i, ahead
+    return best
+
+
 def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
     """The chosen sample, its cost and its batch index (cost < 0: nothing legal)."""
     samples, g, dvth = velocity_samples(tp, pose, vel)
@@ -222,7 +249,7 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
         _bookkeep(tp, samples[best], pose)
         return tuple(samples[best]), float(best_cost), best
     # back up slowly, even if the map says it is blocked
-    i = g["escape"].start
+    i = _escape_choice(tp, costs, g, dvth)
     cost = float(costs[i])
     x, y, th = pose
     if math.hypot(x - tp.prev[0], y - tp.prev[1]) > tp.params.oscillation_reset_dist:

@@ -13,7 +13,9 @@ Each cycle (``compute_velocity_commands``):
    (distances in cells, or metres with ``meter_scoring``);
 4. the best is chosen as TrajectoryPlanner::createTrajectories does: forward samples
    (``vx_samples`` x ``vtheta_samples``), holonomic strafes, rotations in place towards open
-   space (with oscillation flags), sideways moves, and finally backing up at ``escape_vel``.
+   space (with oscillation flags), sideways moves, and finally backing up at ``escape_vel``
+   (on a curve that turns the robot towards its way when one is legal, a departure from
+   ROS; see `selection`).
 
 Rollout velocities: ``[vx - acc_lim_x * T, vx + acc_lim_x * T]`` within ``[min_vel_x,
 max_vel_x]`` (likewise theta), with T = ``sim_time``, or the control period when ``dwa``.

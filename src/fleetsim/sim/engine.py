@@ -17,6 +17,7 @@ import numpy as np
 from fleetsim.errors import SimulationError
 from fleetsim.sim import sdf
 from fleetsim.sim.build import add_sdf_model, spec_from_world
+from fleetsim.sim.contacts import sync_floor_pairs
 from fleetsim.sim.drives import DriveBatch
 from fleetsim.sim.health import SolverGuard, WarningWatch, physics_error, route_mujoco_warnings
 from fleetsim.sim.lasers import LaserBatch
@@ -106,6 +107,7 @@ class Engine(StateQueries):
 
     # -------------------------------------------------------------------- building
     def _compile(self) -> None:
+        sync_floor_pairs(self.spec)  # floor contacts of the models added or removed (sim.contacts)
         try:
             if self.model is None:
                 self.model = self.spec.compile()

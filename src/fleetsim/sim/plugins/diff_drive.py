@@ -20,6 +20,7 @@ import numpy as np
 
 from fleetsim.errors import SimulationError
 from fleetsim.runtime.params import param
+from fleetsim.sim.contacts import frictionless_wheels
 from fleetsim.sim.drives import rotor_armature
 from fleetsim.sim.plugins.base import (
     DrivePlugin,
@@ -107,6 +108,10 @@ class WheeledDrive(DrivePlugin):
     def build(self, spec, engine) -> None:
         if self.held_rotor:
             self._set_rotor_armature(spec)
+        # traction only on the floor: a spinning wheel climbed walls and other robots as a tread
+        frictionless_wheels(
+            [spec.joint(f"{self.ctx.model}/{j}").parent for j in self.left + self.right]
+        )
         for j in self.left + self.right:
             a = spec.add_actuator(
                 name=f"{self.ctx.model}/{self.name}/{j}",

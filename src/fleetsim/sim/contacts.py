@@ -5,17 +5,20 @@ Why. MuJoCo's contact model is convex (Todorov 2014), so it cannot be exactly Co
 contact slides at speed ``v`` the solver pushes the two surfaces apart, at an acceleration of
 about ``mu * b * v`` where ``b = 2 / (dmax * timeconst)`` is the reference damping of the
 friction rows (``solref``). With the default 0.02 s (``b`` ~ 105 /s) a 7 kg box sliding at
-5 m/s over a plane leaves it at 1 m/s (5 cm up; at 1 m/s 2 mm); a lizi held by a wall with its
-wheels spinning at 2-3 m/s hopped 5-10 cm again and again, and in the 10-lizi soak two lizis
-were thrown up at ~5 m/s from a pile-up. A stiffer contact (smaller ``timeconst``) makes it
-worse, a smaller physics step only better in proportion (and costs as much). Two rules:
+5 m/s over a plane leaves it at 1 m/s (5 cm up; at 1 m/s 2 mm); a robot held by a wall with its
+wheels spinning at top speed hopped again and again (lizi 6 cm, jackal 12, pioneer3at 17), and
+in the 10-lizi soak two lizis were thrown up at ~5 m/s from a pile-up. A stiffer contact
+(smaller ``timeconst``) makes it worse, a smaller physics step better only in proportion (and
+costs as much). Two rules:
 
 - **Floor contacts**: every movable collision geom touches every floor plane through an
   explicit ``<pair>`` (MuJoCo then skips the pair in its dynamic collision pass) whose
-  ``solreffriction`` time constant is `FLOOR_FRICTION_TIMECONST`: slip is damped ~5x more
-  gently, which makes the push apart ~10x smaller (the 5 m/s box: 0.2 m/s, 4 mm), while the
-  cone still bounds friction by ``mu`` times the normal force (the box stops within 3 % of
-  the Coulomb distance ``v^2 / (2 mu g)``). The normal direction keeps the geom's ``solref``.
+  ``solreffriction`` time constant is `FLOOR_FRICTION_TIMECONST`: slip is damped 10x more
+  gently and the push apart is ~10x smaller (the 5 m/s box: 0.1 m/s, 1 mm; the blocked
+  robots: at most 5 mm; 0.1 s still let them hop 2-7 cm). The cone still bounds friction by
+  ``mu`` times the normal force: the 5 m/s box stops within 3 % of the Coulomb distance
+  ``v^2 / (2 mu g)``; what the gentler reference costs is ~0.1 s of slip before friction
+  holds (the 1 m/s box slides 9 cm instead of 5). The normal direction keeps ``solref``.
   Friction, ``condim`` (3), ``solref`` and ``solimp`` are the movable geom's, as the dynamic
   contact took them (movable geoms have the higher priority, ``sim.build``).
 - **Drive wheels** (`frictionless_wheels`, called by the wheeled drive plugins): their geoms get

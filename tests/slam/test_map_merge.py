@@ -91,3 +91,18 @@ def test_a_robot_without_an_initial_pose_is_left_out_and_estimation_is_refused(c
     rt.params.set("/map_merge2/known_init_poses", False)
     with pytest.raises(ParameterError, match="known_init_poses false"):
         MapMerge(rt, "map_merge2")
+
+
+def test_the_first_merged_map_goes_out_when_the_first_map_arrives():
+    rt = Runtime()
+    rt.params.set("/map_merge/merging_rate", 0.1)  # every 10 s
+    rt.params.set("/robot1/map_merge/init_pose_x", 0.0)
+    rt.params.set("/robot1/map_merge/init_pose_y", 0.0)
+    rt.params.set("/robot1/map_merge/init_pose_yaw", 0.0)
+    pub = Node(rt, "r").create_publisher(nav_msgs.OccupancyGrid, "/robot1/map", 1, latch=True)
+    merge = MapMerge(rt)
+    rt.run(duration=0.5)
+    assert merge.merged is None  # the robot has published nothing yet
+    pub.publish(grid_msg_from_map(OccupancyMap(world(), RES, (0.0, 0.0, 0.0))))
+    rt.run(duration=0.1)
+    assert merge.merged is not None and rt.now() < 1.0

@@ -6,7 +6,9 @@ placed in ``world_frame`` by its initial pose, read from ``/<ns>/map_merge/init_
 (m, m, rad); a robot without one is left out with a warning (map_merge's behaviour with
 ``known_init_poses``). Every ``1 / merging_rate`` s the maps are resampled onto one grid at the
 finest robot resolution and combined cell by cell with ``max`` (occupied over free over unknown,
-as map_merge's ``greater`` merge), and published latched on ``merged_map_topic``.
+as map_merge's ``greater`` merge), and published latched on ``merged_map_topic``; the first
+merged map goes out as soon as a robot's first map arrives (fleetsim addition: costmaps reading
+the merged map wait for it, and ``merging_rate`` may be slow).
 Pose estimation (``known_init_poses: false``) is not implemented and refused.
 """
 
@@ -120,9 +122,14 @@ class MapMerge(Node):
                 continue
             self.maps[topic] = None  # type: ignore[assignment]
             self.create_subscription(
-                nav_msgs.OccupancyGrid, topic, lambda m, t=topic: self.maps.__setitem__(t, m), 1
+                nav_msgs.OccupancyGrid, topic, lambda m, t=topic: self.on_map(t, m), 1
             )
             self.get_logger().info(f"merging the map of {ns} ({topic})")
+
+    def on_map(self, topic: str, msg: nav_msgs.OccupancyGrid) -> None:
+        self.maps[topic] = msg
+        if self.merged is None:  # the first merged map at once: costmaps wait for it
+            self.merge()
 
     def _init_pose(self, topic: str) -> tuple[float, float, float] | None:
         ns = topic.rsplit("/", 1)[0]

@@ -4,9 +4,10 @@ Every ``1 / planner_frequency`` s the node finds the frontiers of the costmap it
 (``costmap_topic``, usually ``move_base/global_costmap/costmap``), drops those on its blacklist
 (within 5 cells of a goal that failed), and sends the cheapest frontier's centroid to
 ``move_base``. A goal move_base aborts is blacklisted; so is one the robot makes no progress
-towards (its distance to it does not shrink) for ``progress_timeout`` s. When no frontier is
-left the node stops (``finished``), as explore_lite does ("All frontiers traversed/tried out,
-stopping"). With ``visualize`` it publishes ``~frontiers`` (visualization_msgs/MarkerArray).
+towards (its distance to the frontier's nearest cell does not shrink) for ``progress_timeout``
+s. When no frontier is left the node stops (``finished``), as explore_lite does ("All
+frontiers traversed/tried out, stopping"). With ``visualize`` it publishes ``~frontiers``
+(visualization_msgs/MarkerArray).
 
 For ``fleetsim launch --until-goals`` the node is a goal sender (``sends_goals``, ``done`` once
 it has stopped): the run ends when exploration does, and succeeds when every goal it sent was
@@ -139,7 +140,9 @@ class Explore(Node):
             return
         target = candidates[0].centroid
         same = self.goal is not None and math.dist(target, self.goal) < 1e-6
-        distance = math.dist(robot, target)
+        # progress as explore_lite measures it: towards the frontier's nearest cell (its
+        # centroid may lie behind a wall the robot has to go round)
+        distance = candidates[0].min_distance
         now = self.now()
         if not same or distance < self._best_distance:
             self._best_distance = distance

@@ -121,7 +121,10 @@ class CollvoidLocalPlanner(LocalPlanner):
         self.reached_goal = False
         self.xy_tolerance_latch = False
         self.rotating_to_goal = False
-        self.last_cmd = (0.0, 0.0)
+        #: rad/s last commanded: the reference of the turn-rate limit (a skid-steer base turns
+        #: slower than commanded, its wheels slip; limited from the measured rate, the command
+        #: settled near measured + acc_lim_theta * dt, ~0.4 rad/s for a lizi asked for 1.0)
+        self.last_w = 0.0
         self.last_holo = np.zeros(2)
         self.yielding_to: str | None = None
         self.plan_index = 0
@@ -166,7 +169,7 @@ class CollvoidLocalPlanner(LocalPlanner):
         if self.xy_tolerance_latch or math.hypot(gx - x, gy - y) <= p.xy_goal_tolerance:
             if p.latch_xy_goal_tolerance:
                 self.xy_tolerance_latch = True
-            return self._at_goal(yaw, float(velocity[2]), gyaw)
+            return self._at_goal(yaw, gyaw)
         self.rotating_to_goal = False
         carrot, self.plan_index, remaining = plan_carrot(self.plan[:, :2], xy, p.carrot_distance)
         if self.yielding_to is None:
@@ -338,12 +341,13 @@ class CollvoidLocalPlanner(LocalPlanner):
             v, w = tracking_command(holo, yaw, p.time_to_holo, p.max_vel_x, p.max_vel_theta)
             v = speed_along_heading(*self.lines, yaw, v, p.max_vel_x)
             cmd = (v, 0.0, _clamp(w, p.min_vel_theta, p.max_vel_theta))
-        v0, vy0, w0 = (float(c) for c in velocity)
+        v0, vy0 = float(velocity[0]), float(velocity[1])
         dv, dw = p.acc_lim_x * self.dt, p.acc_lim_theta * self.dt
         dvy = p.acc_lim_y * self.dt
         vx = _clamp(cmd[0], v0 - dv, v0 + dv)
         vy = _clamp(cmd[1], vy0 - dvy, vy0 + dvy)
-        w = _clamp(cmd[2], w0 - dw, w0 + dw)
+        w = _clamp(cmd[2], self.last_w - dw, self.last_w + dw)
+        self.last_w = w
         self.local_plan = self._rollout(pose, vx, vy, w)
         return VelocityCommand(vx, vy, w)
 
@@ -359,7 +363,7 @@ class CollvoidLocalPlanner(LocalPlanner):
             x, y, th = x + (c * vx - s * vy) * dt, y + (s * vx + c * vy) * dt, th + w * dt
         return out
 
-    def _at_goal(self, yaw: float, w0: float, goal_yaw: float) -> VelocityCommand:
+    def _at_goal(self, yaw: float, goal_yaw: float) -> VelocityCommand:
         p = self.params
         ang = math.remainder(goal_yaw - yaw, 2 * math.pi)
         if abs(ang) <= p.yaw_goal_tolerance:
@@ -367,9 +371,12 @@ class CollvoidLocalPlanner(LocalPlanner):
             self.xy_tolerance_latch = False
             self.reached_goal = True
             self.local_plan = np.zeros((0, 3))
+            self.last_w = 0.0
             return VelocityCommand()
         self.rotating_to_goal = True
         v = _clamp(abs(ang), p.min_in_place_vel_theta, p.max_vel_theta)
-        v = min(v, math.sqrt(2 * p.acc_lim_theta * abs(ang)), abs(w0) + p.acc_lim_theta * self.dt)
+        ramp = max(0.0, self.last_w if ang > 0 else -self.last_w) + p.acc_lim_theta * self.dt
+        v = min(v, math.sqrt(2 * p.acc_lim_theta * abs(ang)), ramp)
         v = max(v, p.min_in_place_vel_theta)
-        return VelocityCommand(0.0, 0.0, math.copysign(v, ang))
+        self.last_w = math.copysign(v, ang)
+        return VelocityCommand(0.0, 0.0, self.last_w)

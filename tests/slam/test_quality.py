@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 from scipy import ndimage
 
-from fleetsim.slam.quality import ate, occupancy_precision_recall, surface_cells
+from fleetsim.slam.quality import ate, occupancy_precision_recall, surface_cells, visible_cells
 
 RES = 0.05
 
@@ -65,3 +65,17 @@ def test_ate_is_zero_for_a_rigidly_moved_trajectory():
     est = truth @ np.array([[c, s], [-s, c]]) + (1.0, -2.0)
     assert ate(est, truth) == pytest.approx(0.0, abs=1e-9)
     assert ate(est + rng.normal(0, 0.1, est.shape), truth) == pytest.approx(0.14, abs=0.04)
+
+
+def test_visible_cells_are_the_walls_a_route_passes_in_sight_of():
+    occ = room()  # the desk spans x 1.5-2.5 m, y 1.0-1.5 m
+    west = visible_cells(occ, RES, (0.0, 0.0), [(0.6, 1.25)], max_range=10.0, beams=2000)
+    assert west[20:30, 30].all() and not west[20:30, 49].any()  # its near face, not its far one
+    assert not west[54:66, 94:106].any()  # nothing inside the closed cupboard
+    both = visible_cells(occ, RES, (0.0, 0.0), [(0.6, 1.25), (3.5, 1.25)], 10.0, beams=2000)
+    assert both[20:30, 49].all() and (both & ~surface_cells(occ, (40, 10))).sum() == 0
+    short = visible_cells(occ, RES, (0.0, 0.0), [(0.6, 1.25)], max_range=0.5)
+    assert short.sum() > 0 and not short[:, 30:].any()  # nothing beyond 0.5 m
+    # recall over what the route saw: a map of exactly that scores 1
+    p, r, _ = occupancy_precision_recall(centres(west), occ, RES, (0, 0), None, visible=west)
+    assert (p, r) == (1.0, 1.0)

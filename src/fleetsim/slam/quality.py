@@ -44,15 +44,46 @@ def surface_cells(occupied: np.ndarray, start: tuple[int, int]) -> np.ndarray:
     return occupied & near
 
 
+def visible_cells(
+    occupied: np.ndarray,
+    resolution: float,
+    origin: tuple[float, float],
+    positions: np.ndarray,
+    max_range: float,
+    beams: int = 720,
+) -> np.ndarray:
+    """(H, W) bool: the occupied cells a 360-degree laser of ``max_range`` m sees from any of the
+    (N, 2) ``positions`` (m): the first occupied cell along each of ``beams`` rays, stepped at
+    half a cell (a route that does not explore the whole world is scored on what it passed)."""
+    occ = np.asarray(occupied, bool)
+    h, w = occ.shape
+    seen = np.zeros_like(occ)
+    angles = np.linspace(0.0, 2 * np.pi, beams, endpoint=False)
+    steps = np.arange(0.0, max_range, resolution / 2)
+    dx, dy = np.cos(angles)[:, None] * steps, np.sin(angles)[:, None] * steps  # (B, S)
+    rows = np.arange(beams)
+    for x, y in np.asarray(positions, float).reshape(-1, 2):
+        cx = np.floor((x + dx - origin[0]) / resolution).astype(int)
+        cy = np.floor((y + dy - origin[1]) / resolution).astype(int)
+        inside = (cx >= 0) & (cy >= 0) & (cx < w) & (cy < h)
+        hit = np.zeros(cx.shape, dtype=bool)
+        hit[inside] = occ[cy[inside], cx[inside]]
+        first = hit.argmax(axis=1)
+        some = hit[rows, first]
+        seen[cy[rows[some], first[some]], cx[rows[some], first[some]]] = True
+    return seen
+
+
 def occupancy_precision_recall(
     slam_xy: np.ndarray,
     true_occupied: np.ndarray,
     resolution: float,
     origin: tuple[float, float],
-    start: tuple[float, float],
+    start: tuple[float, float] | None,
     tolerance: float = 0.1,
     shifts: float = 0.2,
     turns: float = np.radians(2.0),
+    visible: np.ndarray | None = None,
 ) -> tuple[float, float, tuple[float, float, float]]:
     """Occupied-cell precision and recall of a SLAM map against the true occupancy.
 
@@ -62,7 +93,7 @@ def occupancy_precision_recall(
     true_occupied : (H, W) bool, the true occupancy at ``resolution`` m/cell, cell (0, 0)'s
         corner at ``origin`` (m).
     start : where the robot started (m): the true cells it could see are those of
-        `surface_cells` from there.
+        `surface_cells` from there (unused with ``visible``).
 
     Returns
     -------
@@ -71,13 +102,17 @@ def occupancy_precision_recall(
     precision + recall): precision is the share of SLAM cells within ``tolerance`` m of a true
     occupied cell, recall the share of the visible true cells within ``tolerance`` of a SLAM
     cell. Recall counts every visible wall of the world, seen or not, so a run that leaves part
-    of the world unexplored scores low.
+    of the world unexplored scores low; give ``visible`` (H, W) bool (`visible_cells` of a route)
+    to count only those cells instead.
     """
     slam_xy = np.asarray(slam_xy, float).reshape(-1, 2)
     occ = np.asarray(true_occupied, bool)
     h, w = occ.shape
-    sc = (int((start[1] - origin[1]) // resolution), int((start[0] - origin[0]) // resolution))
-    ty, tx = np.nonzero(surface_cells(occ, sc))
+    if visible is None:
+        sc = (int((start[1] - origin[1]) // resolution), int((start[0] - origin[0]) // resolution))
+        ty, tx = np.nonzero(surface_cells(occ, sc))
+    else:
+        ty, tx = np.nonzero(visible & occ)
     true_xy = np.c_[origin[0] + (tx + 0.5) * resolution, origin[1] + (ty + 0.5) * resolution]
     dist_true = ndimage.distance_transform_edt(~occ) * resolution
     best = (0.0, 0.0, (0.0, 0.0, 0.0))

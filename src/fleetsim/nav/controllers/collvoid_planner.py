@@ -73,6 +73,9 @@ DECELERATION = 0.25
 DETOUR_MARGIN = 0.05
 #: m: a robot standing in the way nearer than this is gone round
 DETOUR_REACH = 1.0
+#: m: closer to the goal than this, no more keeping right (it only pushed arriving robots off
+#: their goal, to come back to it from the side and turn there)
+KEEP_RIGHT_UNTIL = 1.5
 #: no truncation: the velocity obstacle's horizon, s
 UNTRUNCATED = 1e3
 
@@ -252,7 +255,8 @@ class CollvoidLocalPlanner(LocalPlanner):
             if self.yielding_to is not None:
                 resp[k] = 1.0
         if self.yielding_to is None and ids:
-            if self._oncoming(pos - xy, nvel, vel, pref, dist, remaining + own_r).any():
+            near_goal = remaining < KEEP_RIGHT_UNTIL
+            if not near_goal and self._oncoming(pos - xy, nvel, vel, pref, dist, remaining).any():
                 pref = rotated(pref, p.left_pref)
             pref = self._around_still(pref, xy, pos - xy, nvel, own_r + radii, controlled)
         lines_p, lines_d = [], []

@@ -134,3 +134,51 @@ def test_noisy_ranges_equal_numpys_bit_for_bit():
     noisy_ranges(ranges, noisy, mean, std, rmin, rmax, z, got)
     assert got.tobytes() == want.tobytes()
     assert (got[hit] == 0.1).sum() > 10 and (got[hit] == np.float32(10.0)).sum() > 10
+
+
+def test_bounding_circles_equal_the_numpy_grouping():
+    """The compiled grouping gives what a stable sort, ``unique`` and ``reduceat`` over the
+    primitives' bounding boxes gave, bit for bit."""
+    from fleetsim.sim import raycast
+    from fleetsim.sim.lasers import bounding_circles
+
+    rng = np.random.default_rng(5)
+    owner = np.sort(rng.integers(3, 9, 40)).astype(np.int64)
+    prims = np.zeros((40, 7))
+    prims[:, 0] = rng.integers(0, 2, 40)  # segments and circles
+    prims[:, 1:5] = rng.normal(0.0, 3.0, (40, 4))
+    prims[:, 3] = np.where(prims[:, 0] == raycast.SEGMENT, prims[:, 3], abs(prims[:, 3]))
+    centres, radii, ids, start = bounding_circles(prims, owner)
+    want_ids, first = np.unique(owner, return_index=True)
+    want_start = np.append(first, len(owner))
+    seg = prims[:, 0] == raycast.SEGMENT
+    lo = np.where(
+        seg[:, None], np.minimum(prims[:, 1:3], prims[:, 3:5]), prims[:, 1:3] - prims[:, 3:4]
+    )
+    hi = np.where(
+        seg[:, None], np.maximum(prims[:, 1:3], prims[:, 3:5]), prims[:, 1:3] + prims[:, 3:4]
+    )
+    lo_b, hi_b = np.minimum.reduceat(lo, first, axis=0), np.maximum.reduceat(hi, first, axis=0)
+    assert ids.tolist() == want_ids.tolist() and start.tolist() == want_start.tolist()
+    assert centres.tobytes() == ((lo_b + hi_b) / 2).tobytes()
+    assert radii.tobytes() == (np.linalg.norm(hi_b - lo_b, axis=1) / 2).tobytes()
+    empty = bounding_circles(np.zeros((0, 7)), np.zeros(0, np.int64))
+    assert [a.shape for a in empty] == [(0, 2), (0,), (0,), (1,)]
+
+
+def test_robot_bodies_group_the_primitives_of_each_model(diffbot):
+    """A laser's view of the other robots: one group per robot, every primitive of its geoms."""
+    e = Engine(WILLOW)
+    for i in range(3):
+        e.spawn_robot(f"r{i}", diffbot, (10.0 + i, 10.0, 0, 0, 0, 0.5 * i))
+    e.advance(0.1)
+    centres, radii, ids, start, prims = e.lasers.bodies(e)
+    assert sorted(e._model_names[k] for k in ids) == ["r0", "r1", "r2"]
+    for k, b in enumerate(ids):
+        mine = prims[start[k] : start[k + 1]]
+        assert len(mine) > 0
+        ends = np.where(mine[:, :1] == 0, mine[:, 3:5], mine[:, 1:3])  # segments' far ends
+        xy = np.concatenate([mine[:, 1:3], ends])
+        assert np.all(np.linalg.norm(xy - centres[k], axis=1) <= radii[k] + 1e-12)
+        spawned_x = 10.0 + int(e._model_names[b][1:])
+        assert abs(centres[k, 0] - spawned_x) < 0.5 and abs(centres[k, 1] - 10.0) < 0.5

@@ -10,8 +10,8 @@ import pytest
 from fleetsim.cli.launch import resolve_launch_file
 from fleetsim.launch.registry import resolve_node
 from fleetsim.launch.runner import LaunchSession, load_plan
-from fleetsim.msgs import nav_msgs, std_msgs, visualization_msgs
-from fleetsim.nav.explore import Explore
+from fleetsim.msgs import geometry_msgs, move_base_msgs, nav_msgs, std_msgs, visualization_msgs
+from fleetsim.nav.explore import Explore, frontiers_from_grid
 from fleetsim.nav.map_io import load_map
 from fleetsim.runtime import Node, Runtime
 from fleetsim.tf import StaticTransformBroadcaster, make_transform_stamped
@@ -94,22 +94,67 @@ def test_slam_explore_two_hunters_explore_through_the_merged_map(caplog, tmp_pat
         own = [s.nodes[f"/hunter{i}/slam_gmapping"].grid_msg for i in (1, 2)]
         costmap = s.nodes["/hunter2/move_base"].global_costmap
         engine = s.monitor.sim.engine
-        starts = [engine.model_pose(f"hunter{i}")[0] for i in (1, 2)]
+        starts = [engine.model_pose(f"hunter{i}")[0] for i in (1, 2)]  # where they are now
     # each maps on its own, in its own frame ...
     assert [g.header.frame_id for g in own] == ["hunter1/map", "hunter2/map"]
     # ... the merged map (frame map) holds both, and each explorer works on it
     assert merged is not None and merged.header.frame_id == "map"
     data = np.asarray(merged.data).reshape(merged.info.height, merged.info.width)
     o, res = merged.info.origin.position, merged.info.resolution
-    for x, y in ((4.0, 10.0), (26.0, 10.0)):  # both robots' starts are mapped
-        assert data[int((y - o.y) / res), int((x - o.x) / res)] == 0
+    for x, y, _ in starts:  # the space round both robots is mapped (their lasers look ahead)
+        i, j = int((y - o.y) / res), int((x - o.x) / res)
+        assert np.count_nonzero(data[i - 20 : i + 20, j - 20 : j + 20] == 0) > 400
     known = [np.count_nonzero(np.asarray(g.data) >= 0) for g in own]
-    assert np.count_nonzero(data >= 0) > 1.5 * max(known)
+    assert np.count_nonzero(data >= 0) > max(known) + 0.5 * min(known)  # both contribute
     assert costmap.global_frame == "map"
     for ex in explorers:
         assert ex.goals_sent >= 1 and ex.grid.header.frame_id == "map"
+    # both drove away from their starts, west and east of the corridor
     assert all(math.hypot(p[0] - x0, p[1] - 10.0) > 1.0 for p, x0 in zip(starts, (4.0, 26.0)))
+    assert starts[0][0] < starts[1][0]
     saved = load_map(out.with_suffix(".yaml"))  # the merged map is the one saved
     assert saved.data.shape == data.shape
     assert not caplog.records, [r.getMessage() for r in caplog.records]
     assert not Path("MUJOCO_LOG.TXT").exists()
+
+
+class GoalSink(Node):
+    """A move_base that accepts every goal and never finishes one."""
+
+    def __init__(self, rt):
+        super().__init__(rt, "move_base")
+        self.goals = []
+        self.server = self.create_action_server(
+            move_base_msgs.MoveBase, "move_base", goal_callback=self.on_goal
+        )
+
+    def on_goal(self):
+        p = self.server.accept_new_goal().target_pose.pose.position
+        self.goals.append((round(p.x, 2), round(p.y, 2)))
+
+
+def test_a_frontier_a_peer_explorer_heads_for_is_left_to_it():
+    data = np.full((20, 30), -1, dtype=np.int8)
+    data[:, :10] = 0  # known room x < 1 m: its east edge (20 cells) is the big frontier
+    data[:4, :6] = -1  # ... and a small one round an unknown corner at its south-west
+    big, small = frontiers_from_grid(data, 0.1, (0.0, 0.0), (0.35, 1.05))
+    big_goal, small_goal = (tuple(round(v, 2) for v in f.centroid) for f in (big, small))
+    rt = Runtime(seed=0)
+    rt.params.set("/explore/peer_goals", ["/peer/goal"])
+    rt.params.set("/explore/peer_radius", 0.5)
+    FakeWorld(rt, data)
+    sink = GoalSink(rt)
+    peer = Node(rt, "peer").create_publisher(
+        geometry_msgs.PointStamped, "/peer/goal", 1, latch=True
+    )
+    announced = []
+    rt.graph.subscribe("/explore/goal", geometry_msgs.PointStamped, announced.append)
+    peer.publish(geometry_msgs.PointStamped(point=geometry_msgs.Point(x=1.2, y=1.0)))
+    Explore(rt)
+    rt.run(duration=1.5)
+    assert sink.goals == [small_goal]  # the big frontier is the peer's
+    assert (announced[-1].point.x, announced[-1].point.y) == pytest.approx(small.centroid)
+    # the peer is done: the big frontier is free again
+    peer.publish(geometry_msgs.PointStamped(point=geometry_msgs.Point(x=math.nan, y=math.nan)))
+    rt.run(duration=1.0)
+    assert sink.goals[-1] == big_goal

@@ -14,6 +14,10 @@ it has stopped): the run ends when exploration does, and succeeds when every goa
 reached (a blacklisted frontier, aborted or without progress, means it gave up on part of the
 world).
 
+Explorers sharing one map (slam_explore ``robots:=2``) would all head for the same best
+frontier; fleetsim adds ``peer_goals``: each explorer announces its goal on ``~goal`` and leaves
+frontiers within ``peer_radius`` of a peer's goal to that peer, unless every frontier is.
+
 ``costmap_updates_topic`` is accepted but fleetsim's costmaps publish whole grids only (see
 `fleetsim.nav.costmap.costmap_ros`), so it is not subscribed. ``orientation_scale`` is accepted
 and, as in explore_lite, unused.
@@ -60,6 +64,11 @@ class ExploreParams:
     min_frontier_size: float = param(
         0.5, unit="m", range=(0.0, None), help="smallest frontier considered"
     )
+    # fleetsim additions: explorers that share a map leave each other's frontiers alone
+    peer_goals: list = param([], help="other explorers' ~goal topics (geometry_msgs/PointStamped)")
+    peer_radius: float = param(
+        3.0, unit="m", range=(0.0, None), help="frontiers this close to a peer's goal are its"
+    )
 
 
 class Explore(Node):
@@ -81,6 +90,16 @@ class Explore(Node):
         self._best_distance = math.inf
         self._last_progress = 0.0
         self.frontiers: list[Frontier] = []
+        self.peers: dict[str, tuple[float, float] | None] = {}
+        self.goal_pub = self.create_publisher(geometry_msgs.PointStamped, "~goal", 1, latch=True)
+        for topic in p.peer_goals:
+            self.peers[str(topic)] = None
+            self.create_subscription(
+                geometry_msgs.PointStamped,
+                str(topic),
+                lambda m, t=str(topic): self.on_peer(t, m),
+                1,
+            )
         _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now
         self.create_subscription(nav_msgs.OccupancyGrid, p.costmap_topic, self.on_costmap, 1)
         self.move_base = self.create_action_client(move_base_msgs.MoveBase, "move_base")
@@ -97,6 +116,20 @@ class Explore(Node):
 
     def on_costmap(self, msg: nav_msgs.OccupancyGrid) -> None:
         self.grid = msg
+
+    def on_peer(self, topic: str, msg: geometry_msgs.PointStamped) -> None:
+        x, y = msg.point.x, msg.point.y
+        self.peers[topic] = (x, y) if math.isfinite(x) and math.isfinite(y) else None
+
+    def _announce(self, goal: tuple[float, float] | None, frame: str = "") -> None:
+        """Publish the goal on ~goal for peer explorers (NaN: none)."""
+        x, y = goal if goal is not None else (math.nan, math.nan)
+        self.goal_pub.publish(
+            geometry_msgs.PointStamped(
+                header=std_msgs.Header(stamp=self.now_msg(), frame_id=frame),
+                point=geometry_msgs.Point(x=float(x), y=float(y), z=0.0),
+            )
+        )
 
     def _robot_position(self, frame: str) -> tuple[float, float] | None:
         try:
@@ -138,6 +171,11 @@ class Explore(Node):
         if not candidates:
             self.stop("all frontiers traversed/tried out, stopping")
             return
+        taken = [g for g in self.peers.values() if g is not None]
+        mine = [
+            f for f in candidates if all(math.dist(f.centroid, g) >= p.peer_radius for g in taken)
+        ]
+        candidates = mine or candidates  # all taken by peers: help with the best one
         target = candidates[0].centroid
         same = self.goal is not None and math.dist(target, self.goal) < 1e-6
         # progress as explore_lite measures it: towards the frontier's nearest cell (its
@@ -162,6 +200,7 @@ class Explore(Node):
             self._warn_once("move_base", f"waiting for move_base at {self.move_base.name}")
             return
         self.goal = target
+        self._announce(target, frame)
         pose = pose_stamped(target[0], target[1], 0.0, frame, self.now_msg())
         self.goals_sent += 1
         self._handle = self.move_base.send_goal(
@@ -177,6 +216,7 @@ class Explore(Node):
             self.get_logger().info(f"move_base aborted the goal {goal}; blacklisting it")
             self.blacklist.append(goal)
         self.goal = None
+        self._announce(None)
         self.runtime.call_later(0.0, self.make_plan)  # explore_lite replans on reaching a goal
 
     def stop(self, why: str) -> None:
@@ -184,6 +224,7 @@ class Explore(Node):
         if self._handle is not None:
             self.move_base.cancel_all_goals()
         self.timer.cancel()
+        self._announce(None)
         self.get_logger().info(why)
 
     def _publish_markers(self, frame: str) -> None:

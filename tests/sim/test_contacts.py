@@ -115,9 +115,9 @@ def test_blocked_robot_spinning_its_wheels_stays_on_the_floor(path):
     drive = drive_of(entry)
     settle(e)
     creep = highest_lift(e, ["r"], 750, lambda: drive.command(0.3, 0.0, e.time))
-    assert creep < 0.01
+    assert creep < 0.005
     v = top_speed(entry, drive)
-    assert highest_lift(e, ["r"], 750, lambda: drive.command(v, 0.0, e.time)) < 0.01
+    assert highest_lift(e, ["r"], 750, lambda: drive.command(v, 0.0, e.time)) < 0.02
 
 
 @pytest.mark.parametrize("path", FILES, ids=IDS)
@@ -129,6 +129,11 @@ def test_four_robots_pushing_into_each_other_stay_on_the_floor(path):
 
 @pytest.mark.parametrize("path", FILES, ids=IDS)
 def test_pile_up_at_top_speed_lifts_no_robot_more_than_a_few_cm(path):
+    """At top speed (the wheels' velocity limit: lizi 2.3 m/s, pioneer3at 3.2) robots pile up
+    against each other and the wall without being thrown up (lizis rose 22-39 cm). Wedging
+    stays possible where wheels stand proud of the body (a pioneer3at rode up another's
+    wheels in 1-2 of 6 seeds with other floor settings, at < 0.7 m/s): two round wheels
+    meeting at an angle are a ramp even without friction."""
     assert max(pile_up(path, math.inf, 3.0, seed) for seed in range(2)) < 0.04
 
 
@@ -146,5 +151,6 @@ def test_floor_contacts_are_explicit_pairs_with_the_movable_geoms_friction():
     assert m.pair_friction[k, 0] == m.pair_friction[k, 1] == 1.0  # the wheel's mu1
     assert m.pair_dim[k] == 3
     assert m.pair_solreffriction[k, 0] == FLOOR_FRICTION_TIMECONST
+    assert tuple(m.pair_solref[k]) == tuple(m.geom_solref[wheel])
     # drive wheels touch everything else without friction, whatever wins the mixing
     assert m.geom_condim[wheel] == 1 and m.geom_priority[wheel] > 1

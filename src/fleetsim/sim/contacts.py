@@ -11,16 +11,19 @@ in the 10-lizi soak two lizis were thrown up at ~5 m/s from a pile-up. A stiffer
 (smaller ``timeconst``) makes it worse, a smaller physics step better only in proportion (and
 costs as much). Two rules:
 
-- **Floor contacts**: every movable collision geom touches every floor plane through an
-  explicit ``<pair>`` (MuJoCo then skips the pair in its dynamic collision pass) whose
-  ``solreffriction`` time constant is `FLOOR_FRICTION_TIMECONST`: slip is damped 10x more
-  gently and the push apart is ~10x smaller (the 5 m/s box: 0.1 m/s, 1 mm; the blocked
-  robots: at most 5 mm; 0.1 s still let them hop 2-7 cm). The cone still bounds friction by
-  ``mu`` times the normal force: the 5 m/s box stops within 3 % of the Coulomb distance
-  ``v^2 / (2 mu g)``; what the gentler reference costs is ~0.1 s of slip before friction
-  holds (the 1 m/s box slides 9 cm instead of 5). The normal direction keeps ``solref``.
-  Friction, ``condim`` (3), ``solref`` and ``solimp`` are the movable geom's, as the dynamic
-  contact took them (movable geoms have the higher priority, ``sim.build``).
+- **Floor contacts**: every movable collision geom touches every floor plane through an explicit
+  ``<pair>`` (MuJoCo then skips the pair in its dynamic collision pass) whose friction directions
+  have their own reference time constant, `FLOOR_FRICTION_TIMECONST` (0.15 s: ``b`` 7.5x smaller,
+  and the push apart with it). Robots held by a wall with their wheels at top speed now lift no
+  wheel more than 1.5 cm off the floor (pioneer3at; lizi and jackal < 5 mm). Friction is still
+  bounded by ``mu`` times the normal force (a 5 m/s box stops within 1 % of the Coulomb distance
+  ``v^2 / (2 mu g)``); the gentler reference lets a slip last a little longer before friction
+  holds (at 1 m/s the box slides ~1 cm further). Measured alternatives: 0.1 s leaves hops of 1-7
+  cm; 0.2 s changes how the turtlebots turn enough for the building-patrol follower to lose its
+  marker; a stiffer normal (0.01 s) cuts the push apart further, but robots spawned into the floor
+  (z = 0 with the root at axle height) then pop up to 0.9 m instead of 6-14 cm. Friction,
+  ``condim`` (3), ``solref`` and ``solimp`` are the movable geom's, as the dynamic contact took
+  them (movable geoms have the higher priority, ``sim.build``).
 - **Drive wheels** (`frictionless_wheels`, called by the wheeled drive plugins): their geoms get
   ``condim = 1`` and a priority above every other geom, so against walls, other robots and
   objects they push without friction. A wheel spinning at full speed against another robot's
@@ -38,7 +41,7 @@ import mujoco
 
 #: s, reference time constant of the friction directions of floor contacts (MuJoCo's default
 #: contact time constant is 0.02 s; see the module docstring)
-FLOOR_FRICTION_TIMECONST = 0.2
+FLOOR_FRICTION_TIMECONST = 0.15
 #: geom priority of drive wheels: above movable (1) and static (0) geoms, so that a wheel's
 #: ``condim = 1`` decides its contacts with them
 WHEEL_PRIORITY = 2

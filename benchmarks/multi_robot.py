@@ -231,24 +231,25 @@ def main() -> None:
         f"{'scenario':<16}{'planner':<11}{'runs':>5}{'rob-rob':>8}{'rob-wall':>9}{'deadl':>6}"
         f"{'reached':>9}{'makespan s':>12}{'x alone':>8}{'extra path':>11}{'wall s':>8}"
     )
-    print(header)
     seeds = range(a.first_seed, a.first_seed + a.seeds)
     print(f"seeds {seeds.start}-{seeds.stop - 1} (collvoid tuned on 0-4; 5-9 held out)")
+    print(header)
     for item in a.scenarios.split(","):
         name, n, *rest = item.split(":")
-        n, extra = int(n), dict(kv.split("=", 1) for kv in rest)
+        n, launch_args = int(n), dict(kv.split("=", 1) for kv in rest)
         for planner in a.planners.split(","):
-            alone = [run_once(name, n, planner, 0, a.limit, 0.0, f"lizi{k}", extra) for k in
+            alone = [run_once(name, n, planner, 0, a.limit, 0.0, f"lizi{k}", launch_args) for k in
                      range(1, n + 1)]  # fmt: skip
             alone_time = max(r.makespan for r in alone)
             alone_path = {m: p for r in alone for m, p in r.paths.items()}
-            runs = [run_once(name, n, planner, s, a.limit, a.jitter, "", extra) for s in seeds]
+            runs = [run_once(name, n, planner, s, a.limit, a.jitter, "", launch_args)
+                    for s in seeds]  # fmt: skip
             spans = [r.makespan for r in runs]
             extra = [sum(r.paths.values()) / sum(alone_path[m] for m in r.paths) for r in runs]
             ok = [s for s in spans if not math.isnan(s)]
             span = f"{np.mean(ok):.1f}-{max(ok):.1f}" if ok else "-"
             ratio = f"{max(ok) / alone_time:.2f}" if ok and len(ok) == len(runs) else "-"
-            label = ":".join([name, str(n), *(v for v in extra.values())])
+            label = ":".join([name, str(n), *launch_args.values()])
             print(
                 f"{label:<16}{planner:<11}{len(runs):>5}"
                 f"{sum(r.robot_robot for r in runs):>8}{sum(r.robot_wall for r in runs):>9}"

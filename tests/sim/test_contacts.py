@@ -67,7 +67,7 @@ def highest_lift(e: Engine, names: list[str], steps: int, command) -> float:
     m = e.model
     floor = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_GEOM, "ground_plane/link/collision#0")
     collide = (m.geom_contype != 0) | (m.geom_conaffinity != 0)
-    robots = [np.flatnonzero(collide & (e.geom_model == e._model_names.index(n))) for n in names]
+    robots = [np.flatnonzero(collide & (e.geom_model == list(e.models).index(n))) for n in names]
     most = 0.0
     for k in range(steps):
         if k % 5 == 0:

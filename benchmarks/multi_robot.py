@@ -228,7 +228,7 @@ def main() -> None:
     if a.cycle_only:
         return
     header = (
-        f"{'scenario':<16}{'planner':<11}{'runs':>5}{'rob-rob':>8}{'rob-wall':>9}{'deadl':>6}"
+        f"{'scenario':<16} {'planner':<11}{'runs':>5}{'rob-rob':>8}{'rob-wall':>9}{'deadl':>6}"
         f"{'reached':>9}{'makespan s':>12}{'x alone':>8}{'extra path':>11}{'wall s':>8}"
     )
     seeds = range(a.first_seed, a.first_seed + a.seeds)
@@ -249,9 +249,9 @@ def main() -> None:
             ok = [s for s in spans if not math.isnan(s)]
             span = f"{np.mean(ok):.1f}-{max(ok):.1f}" if ok else "-"
             ratio = f"{max(ok) / alone_time:.2f}" if ok and len(ok) == len(runs) else "-"
-            label = ":".join([name, str(n), *launch_args.values()])
+            label = ":".join([name, str(n), *(f"{k}={v}" for k, v in launch_args.items())])
             print(
-                f"{label:<16}{planner:<11}{len(runs):>5}"
+                f"{label:<16} {planner:<11}{len(runs):>5}"
                 f"{sum(r.robot_robot for r in runs):>8}{sum(r.robot_wall for r in runs):>9}"
                 f"{sum(r.deadlocks for r in runs):>6}"
                 f"{sum(r.reached for r in runs):>5}/{n * len(runs):<3}{span:>12}{ratio:>8}"

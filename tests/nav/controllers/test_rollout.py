@@ -123,8 +123,8 @@ def test_skipping_footprints_changes_no_cost(seed):
         poses_a = np.zeros((300, int(steps.max()), 3))
         poses_b = np.zeros_like(poses_a)
         bounds = footprint_cost_bounds(costs, reach_offsets(outline, res))
-        a = trajectory_costs(*args, poses_a, bounds)
-        b = trajectory_costs(*args, poses_b, np.full(costs.shape, 255, np.uint8))
+        a = trajectory_costs(*args, poses_a, bounds, np.zeros(2))
+        b = trajectory_costs(*args, poses_b, np.full(costs.shape, 255, np.uint8), np.zeros(2))
         assert np.array_equal(a, b)
         assert np.array_equal(poses_a[a >= 0], poses_b[a >= 0])
         seen |= {float(np.sign(c)) for c in a}

@@ -273,3 +273,69 @@ def test_the_escape_backs_on_a_curve_that_faces_the_robot_along_its_way():
     assert _escape_choice(tp, costs, g, dvth) == g["escape"].start
     costs[g["escape"]] = -1.0
     assert _escape_choice(tp, costs, g, dvth) == g["escape"].start
+
+
+def _off_axis_in_corridor(**kw):
+    """A dwa planner in the corridor with its plan along the axis, the robot 0.6 rad off it."""
+    tp = make(corridor(), dwa=True, acc_lim_theta=3.0, sim_time=1.5, escape_vel=-0.1, **kw)
+    tp.set_plan(np.array([[x, 1.0, 0.0] for x in np.arange(1.0, 5.0, 0.05)]))
+    pose, vel = (1.5, 1.0, 0.6), (0.0, 0.0, 0.0)
+    tp._update_maps(tp.plan, pose, vel)
+    return tp, pose, vel
+
+
+def test_alignment_cost_penalises_ending_pointed_off_the_path():
+    samples = np.array([[0.3, 0.0, -0.4], [0.3, 0.0, 0.4]])  # back toward the axis, away
+    added = []
+    for scale in (0.0, 0.6):
+        tp, pose, vel = _off_axis_in_corridor(alignment_scale=scale, meter_scoring=True)
+        added.append(tp._score(samples, pose, vel))
+    extra = added[1] - added[0]
+    assert np.all(added[0] >= 0) and np.all(extra >= 0)
+    assert extra[1] > extra[0] + 0.01  # the one ending pointed away pays more
+    # near the goal the alignment cost is off (dwa_local_planner's rule)
+    tp, _, vel = _off_axis_in_corridor(alignment_scale=0.6)
+    assert tp._alignment((4.9, 1.0, 0.6))[0] == 0.0 < tp._alignment((1.5, 1.0, 0.6))[0]
+
+
+def test_alignment_cost_kernel_on_off_and_beside_the_path():
+    from fleetsim.nav.controllers.rollout import alignment_cost
+
+    m = corridor()
+    targets = np.array([[i, 20] for i in range(120)], dtype=np.int64)  # the axis, y = 1.0
+    dist = distances_from_targets(m.costs, targets, np.zeros(m.costs.shape, bool))
+    origin = np.array([0.0, 0.0])
+    along = alignment_cost(dist, origin, 0.05, 1.0, 1.0, 0.0, 0.325, 0.0)
+    across = alignment_cost(dist, origin, 0.05, 1.0, 1.0, 0.5, 0.325, 0.0)
+    assert along == 0.0 and 2.0 <= across <= 0.325 / 0.05
+    # pointing into the wall or off the map: the farthest the point can be, not a rejection
+    assert alignment_cost(dist, origin, 0.05, 1.0, 1.0, math.pi / 2, 0.65, 1.0) == 1.0 + 13.0
+    assert alignment_cost(dist, origin, 0.05, 0.1, 1.0, math.pi, 0.325, 0.0) == 6.5
+
+
+@pytest.mark.parametrize("aligning", [False, True])
+def test_escaping_with_alignment_backs_on_rather_than_turn_away_from_the_path(aligning):
+    from fleetsim.nav.controllers.selection import choose_trajectory, path_heading
+
+    tp, pose, vel = _off_axis_in_corridor(alignment_scale=0.6 if aligning else 0.0)
+    assert path_heading(tp, pose) == pytest.approx(0.0, abs=1e-9)  # along the axis
+    score = tp._score
+
+    def wedged(samples, pose, vel):  # every forward rollout and every turn toward the axis
+        costs = score(samples, pose, vel)
+        costs[samples[:, 0] > 0] = -1.0
+        costs[(samples[:, 0] == 0) & (samples[:, 2] < 0)] = -1.0
+        return costs
+
+    tp._score = wedged
+    # escaping, already escape_reset_dist back from where it was wedged
+    tp.escaping, tp.escape_pose = (
+        True,
+        (1.5 + 0.15 * math.cos(0.6), 1.0 + 0.15 * math.sin(0.6), 0.6),
+    )
+    (vx, _, vth), cost, _ = choose_trajectory(tp, pose, vel)
+    assert cost >= 0
+    if aligning:  # turning further off the axis leads nowhere: back on
+        assert vx == -0.1 and tp.escaping
+    else:  # base_local_planner: the escape ends and the robot turns away, the only legal way
+        assert vx == 0.0 and vth > 0 and not tp.escaping

@@ -149,6 +149,29 @@ def _heading_diff(costs, ox, oy, res, plan_cells, cx, cy, x, y, heading):
 
 
 @njit(cache=True)
+def alignment_cost(path_dist, origin, resolution, x, y, th, forward, path_d):
+    """Path distance (cells) of the point ``forward`` m ahead of pose (x, y, th).
+
+    dwa_local_planner's alignment cost (its MapGridCostFunction shifted by
+    ``forward_point_distance``): a rollout that ends on the path but pointing away from it
+    scores worse than one that ends pointing along it. Where the point is off the map or on an
+    obstacle (no path distance), dwa_local_planner rejects the rollout; here it scores as the
+    farthest the point can be from the path, ``path_d`` (the pose's own path distance) plus
+    ``forward`` in cells, so a robot close to obstacles still has legal choices.
+    """
+    h, w = path_dist.shape
+    fx = (x + forward * math.cos(th) - origin[0]) / resolution
+    fy = (y + forward * math.sin(th) - origin[1]) / resolution
+    worst = path_d + forward / resolution
+    if fx < 0.0 or fy < 0.0 or fx >= w or fy >= h:
+        return worst
+    d = path_dist[int(fy), int(fx)]
+    if d >= float(h * w):
+        return worst
+    return min(d, worst)
+
+
+@njit(cache=True)
 def num_steps_of(samples, sim_time, sim_granularity, angular_sim_granularity, heading_scoring):
     """Simulation steps of each sample (at least 1). samples : (S, 3). Returns (S,) int64."""
     out = np.empty(samples.shape[0], dtype=np.int64)
@@ -186,6 +209,7 @@ def trajectory_costs(
     final_goal,
     poses_out,
     bounds,
+    alignment,
 ):
     """Score every sample's rollout as TrajectoryPlanner::generateTrajectory.
 
@@ -209,6 +233,9 @@ def trajectory_costs(
     simple_attractor : score by squared distance to ``final_goal`` (2,) instead of the maps.
     poses_out : (S, T, 3) float64 written with each rollout's poses (T >= max num_steps).
     bounds : (H, W) uint8 from `footprint_cost_bounds` for ``costs`` and ``outline``.
+    alignment : (2,) weight (per cell of path distance; 0 = off) and forward distance (m) of
+        the alignment cost: the path distance of the point that far ahead of the rollout's
+        last pose (dwa_local_planner's alignment cost, `alignment_cost`).
 
     Returns
     -------
@@ -276,6 +303,18 @@ def trajectory_costs(
             out[s] = cost
             continue
         total = scales[0] * path_d + scales[1] * goal_d + scales[2] * occ
+        if alignment[0] > 0.0 and n > 0:
+            k = n - 1
+            total += alignment[0] * alignment_cost(
+                path_dist,
+                origin,
+                resolution,
+                poses_out[s, k, 0],
+                poses_out[s, k, 1],
+                poses_out[s, k, 2],
+                alignment[1],
+                path_d,
+            )
         if heading[0] > 0.5:
             total += 0.3 * hdiff
         out[s] = total

@@ -133,6 +133,51 @@ def _ahead_goal_dist_turning(tp: TrajectoryPlanner, index: int) -> tuple[float, 
 
 #: how many escape_reset_dist a robot that cannot turn in place backs up at most
 ESCAPE_ROOM = 5.0
+#: m: how far along its plan the point lies whose direction is "the path's direction"
+PATH_HEADING_DIST = 0.75
+#: rad: a robot this close to the path's direction counts as lined up with it
+ALIGNED = 0.2
+
+
+def _wrap(a):
+    return (a + math.pi) % (2 * math.pi) - math.pi
+
+
+def path_heading(tp: TrajectoryPlanner, pose) -> float | None:
+    """The direction (rad) from the robot to its plan ``PATH_HEADING_DIST`` ahead: from the
+    plan point nearest the robot on, the first at least that far from it (else the last).
+    None without a plan."""
+    plan = tp.plan
+    if plan.shape[0] == 0:
+        return None
+    d = np.hypot(plan[:, 0] - pose[0], plan[:, 1] - pose[1])
+    i = int(np.argmin(d))
+    far = np.flatnonzero(d[i:] >= PATH_HEADING_DIST)
+    j = i + int(far[0]) if far.shape[0] else plan.shape[0] - 1
+    if d[j] < 1e-9:
+        return None
+    return math.atan2(plan[j, 1] - pose[1], plan[j, 0] - pose[0])
+
+
+def _aligning(tp: TrajectoryPlanner) -> bool:
+    """Whether rotations and escapes are judged by the path's direction (``alignment_scale``
+    > 0, a fleetsim addition; see `choose_trajectory`)."""
+    return tp.params.alignment_scale > 0.0
+
+
+def _least_heading_error(tp: TrajectoryPlanner, index: int, direction: float) -> float:
+    """The least |heading - direction| (rad) over rollout ``index``'s poses."""
+    n = max(int(tp._steps[index]), 1)
+    return float(np.abs(_wrap(tp._poses[index, :n, 2] - direction)).min())
+
+
+def _turns_toward(tp: TrajectoryPlanner, index: int, th: float, direction: float | None) -> bool:
+    """Whether rollout ``index`` brings the robot nearer the path's direction (or it is
+    lined up already)."""
+    if direction is None:
+        return True
+    err = abs(_wrap(th - direction))
+    return err <= ALIGNED or _least_heading_error(tp, index, direction) < err - 0.5 * ALIGNED
 
 
 def _end_escape_when_clear(
@@ -195,17 +240,43 @@ def _escape_choice(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: floa
     barely wider than itself at a slant (BARN world 105, the jackal 0.6 rad off the gap's
     axis) backs out straight, drives in again at the same slant and is wedged again; backing
     on a curve straightens it out of the gap as a driver's three-point turn does."""
+    direction = path_heading(tp, tp._poses[g["escape"].start, 0]) if _aligning(tp) else None
+
+    def key(i: int):
+        ahead = _ahead_goal_dist(tp, i)
+        if ahead is None:
+            return None
+        if direction is None:
+            return (ahead,)
+        # with alignment: a look-ahead onto an obstacle tells the headings nothing apart, the
+        # heading at the end against the path's direction does
+        n = max(int(tp._steps[i]), 1)
+        size = float(tp.goal_dist.size)
+        return (min(ahead, size), abs(_wrap(tp._poses[i, n - 1, 2] - direction)))
+
     best = g["escape"].start
-    best_ahead = _ahead_goal_dist(tp, best) if costs[best] >= 0 else None
-    best_ahead = math.inf if best_ahead is None else best_ahead
+    best_key = key(best) if costs[best] >= 0 else None
     raw = tp._in_place_raw
     for k, i in enumerate(range(g["escape_turn"].start, g["escape_turn"].stop)):
         if costs[i] < 0 or -dvth <= raw[k] <= dvth:
             continue
-        ahead = _ahead_goal_dist(tp, i)
-        if ahead is not None and ahead < best_ahead:
-            best, best_ahead = i, ahead
+        ki = key(i)
+        if ki is not None and (best_key is None or ki < best_key):
+            best, best_key = i, ki
     return best
+
+
+def _escape_can_turn(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, pose) -> bool:
+    """Whether a legal in-place rotation lets the escape end: any one (base_local_planner's
+    escape ends after escape_reset_dist), or with alignment only one that turns the robot
+    toward the path's direction. A jackal wedged in a gap entered 0.6 rad off its axis could
+    turn only further off it (BARN world 45); ending the escape there, it turned away, drove in
+    at a slant again and backed out again for 90 s."""
+    legal = [i for i in range(g["in_place"].start, g["in_place"].stop) if costs[i] >= 0]
+    if not _aligning(tp):
+        return bool(legal)
+    direction = path_heading(tp, pose)
+    return any(_turns_toward(tp, i, pose[2], direction) for i in legal)
 
 
 def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
@@ -220,13 +291,24 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
         if legal.any():
             best = g["forward"].start + int(np.argmin(np.where(legal, first, np.inf)))
             best_cost = costs[best]
-    heading: tuple[float, int] = (math.inf, 0)  # rotations: (goal distance, step) ahead
+    heading: tuple = (math.inf, 0)  # rotations: (goal distance, step) ahead
     raw = tp._in_place_raw
+    direction = path_heading(tp, pose) if _aligning(tp) else None
+    size = float(tp.goal_dist.size)
     for k, i in enumerate(range(g["in_place"].start, g["in_place"].stop)):
         v = raw[k]
         ok = costs[i] >= 0 and (best_cost < 0 or costs[i] <= best_cost or samples[best, 1] != 0.0)
+        if ok and direction is not None and tp.escaping:
+            # escaping with alignment: a rotation away from the path's direction is no way
+            # out of a gap entered at a slant; back on instead (see `_escape_can_turn`)
+            ok = _turns_toward(tp, i, pose[2], direction)
         if ok and (v > dvth or v < -dvth):
             ahead = _ahead_goal_dist_turning(tp, i)
+            if ahead is not None and direction is not None:
+                # a look-ahead on an obstacle (distance >= the map's size) says nothing: then
+                # the rotation that comes nearest the path's direction, soonest
+                d, step = ahead
+                ahead = (min(d, size), _least_heading_error(tp, i, direction), step)
             free_side = (v < 0 and not tp.stuck_left) or (v > 0 and not tp.stuck_right)
             if ahead is not None and ahead < heading and free_side:
                 best, best_cost = i, costs[i]
@@ -259,7 +341,7 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
         tp.escaping = True
     # backing on is for a robot wedged where it cannot turn, and only while the map says the
     # backward rollout is free (the escape itself is taken blind)
-    can_turn = bool((costs[g["in_place"]] >= 0).any()) or cost < 0.0
+    can_turn = _escape_can_turn(tp, costs, g, pose) or cost < 0.0
     _end_escape_when_clear(tp, x, y, th, can_turn)
     if cost == -1.0:
         cost = 1.0

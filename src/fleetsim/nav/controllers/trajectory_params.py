@@ -70,6 +70,15 @@ class TrajectoryPlannerParams:
     heading_scoring_timestep: float = param(
         0.8, unit="s", range=(0.0, None), help="look-ahead time for heading scoring"
     )
+    # fleetsim addition: dwa_local_planner's alignment cost, which TrajectoryPlannerROS lacks
+    alignment_scale: float = param(
+        0.0,
+        range=(0.0, None),
+        help="weight of the path distance of a point ahead of the rollout's end (0: off)",
+    )
+    forward_point_distance: float = param(
+        0.325, unit="m", range=(0.0, None), help="how far ahead that point is (dwa_local_planner)"
+    )
     dwa: bool = param(False, help="Dynamic Window Approach (velocity window of one cycle)")
     simple_attractor: bool = param(False, help="follow the goal blindly (testing)")
     publish_cost_grid_pc: bool = param(False, help="publish the scoring grid as a cloud")

@@ -10,7 +10,9 @@ Each cycle (``compute_velocity_commands``):
 3. otherwise the path and goal distance maps are computed and every velocity sample is rolled
    out and scored in one batch (`rollout.trajectory_costs`):
    ``pdist_scale * path_dist + gdist_scale * goal_dist + occdist_scale * occ_cost``
-   (distances in cells, or metres with ``meter_scoring``);
+   (distances in cells, or metres with ``meter_scoring``), plus, with ``alignment_scale``
+   (a fleetsim addition, off by default), ``alignment_scale * path_dist`` of the point
+   ``forward_point_distance`` ahead of the rollout's end: dwa_local_planner's alignment cost;
 4. the best is chosen as TrajectoryPlanner::createTrajectories does: forward samples
    (``vx_samples`` x ``vtheta_samples``), holonomic strafes, rotations in place towards open
    space (with oscillation flags), sideways moves, and finally backing up at ``escape_vel``
@@ -287,7 +289,21 @@ class TrajectoryPlanner(LocalPlanner):
             self.final_goal,
             self._poses,
             self.cost_bounds,
+            self._alignment(pose),
         )
+
+    def _alignment(self, pose) -> np.ndarray:
+        """(weight per cell, forward distance m) of the alignment cost for this cycle.
+
+        Off within ``forward_point_distance`` of the goal, as in dwa_local_planner (near the
+        goal the point ahead passes it and every heading would be penalised)."""
+        p = self.params
+        weight = p.alignment_scale * (self.costmap.resolution if p.meter_scoring else 1.0)
+        if weight > 0.0 and self.plan.shape[0]:
+            gx, gy = self.plan[-1, 0], self.plan[-1, 1]
+            if math.hypot(gx - pose[0], gy - pose[1]) <= p.forward_point_distance:
+                weight = 0.0
+        return np.array([weight, p.forward_point_distance])
 
     def check_trajectory(self, pose, vel, sample) -> bool:
         """Whether one command's rollout is legal (TrajectoryPlanner::checkTrajectory)."""

@@ -328,13 +328,11 @@ class CollvoidLocalPlanner(LocalPlanner):
 
     @staticmethod
     def _oncoming(rel, nvel, vel, pref, dist, reach) -> np.ndarray:
-        """(N,) robots ahead (along ``pref``), nearer than ``reach`` m, closing in and moving
-        relative to us: the meetings keeping right resolves. A robot parked ahead counts too
-        (it moves relative to us): keeping right of it as well chose the open side in the
-        corridor of 4, where going straight let ORCA take the side by the wall and wedged the
-        robot between the parked one and the wall (held-out seed 8)."""
+        """(N,) robots ahead (along ``pref``), nearer than ``reach`` m, moving and closing in:
+        the meetings keeping right resolves (a robot standing still ahead is gone round,
+        `_around_still`)."""
         rel_vel = nvel - vel
-        moving = np.hypot(rel_vel[:, 0], rel_vel[:, 1]) >= STILL_SPEED
+        moving = np.hypot(nvel[:, 0], nvel[:, 1]) >= STILL_SPEED
         closing = np.einsum("ij,ij->i", rel, rel_vel) < 0.0
         return (rel @ pref > 0) & (dist < reach) & moving & closing
 

@@ -3,6 +3,11 @@
 All samples (forward, strafing, in-place, sideways, escape) are scored in one batch; the
 choice then replays base_local_planner's order and tie rules, including its oscillation
 flags (``stuck_left`` / ``stuck_right`` ...) and escape mode, kept on the planner.
+
+With ``alignment_scale`` > 0 (a fleetsim addition, off by default) rotations and escapes also
+weigh the path's direction (`path_heading`): an in-place rotation whose look-ahead lands on an
+obstacle is judged by how near it comes to that direction, and an escaping robot turns only
+toward it, else backs on (`_escape_can_turn`). With 0 every choice is base_local_planner's.
 """
 
 from __future__ import annotations
@@ -239,7 +244,9 @@ def _escape_choice(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: floa
     Departure from base_local_planner, which only backs straight: a robot that entered a gap
     barely wider than itself at a slant (BARN world 105, the jackal 0.6 rad off the gap's
     axis) backs out straight, drives in again at the same slant and is wedged again; backing
-    on a curve straightens it out of the gap as a driver's three-point turn does."""
+    on a curve straightens it out of the gap as a driver's three-point turn does. With
+    alignment, a look-ahead on an obstacle ties and the end heading against the path's
+    direction decides."""
     direction = path_heading(tp, tp._poses[g["escape"].start, 0]) if _aligning(tp) else None
 
     def key(i: int):

@@ -44,6 +44,18 @@ def no_mujoco_warnings(s: LaunchSession) -> None:
     assert {i: w.number for i, w in enumerate(engine.data.warning) if w.number} == {}
 
 
+def truth_in_the_followers_map(s: LaunchSession, point: np.ndarray) -> np.ndarray:
+    """A world point (x, y) where the follower's localisation puts it: the point relative to the
+    follower's true pose, placed at the pose its map -> base_footprint says."""
+    node = s.nodes["/predictive_follower"]
+    bx, by, byaw = node.tf_buffer.lookup_pose2d("map", node.base_frame)
+    pos, q = s.nodes["/gazebo"].engine.model_pose(FOLLOWER)
+    tyaw = 2.0 * math.atan2(q[3], q[0])
+    rel = np.asarray(point, float) - np.asarray(pos[:2], float)
+    c, sn = math.cos(byaw - tyaw), math.sin(byaw - tyaw)
+    return np.array([bx + c * rel[0] - sn * rel[1], by + sn * rel[0] + c * rel[1]])
+
+
 class Watch:
     """Per camera frame: detected or not, the true marker and follower positions."""
 
@@ -108,11 +120,16 @@ def test_circle_patrol_the_marker_stays_in_view_and_the_tracker_knows_where_it_i
         # the follower keeps about its distance behind the target
         gaps = [np.linalg.norm(m - b) for t, _, m, b in w.frames if t > 10.0]
         assert 0.5 < np.median(gaps) < 1.4 and max(gaps) < 2.0
-        # the published estimate is the true marker's position, with a covariance
+        # the published estimate is the true marker's position, with a covariance: in the
+        # follower's map, i.e. as its amcl pose sees it (amcl's own error, 0.1-0.2 m here, is
+        # not the tracker's), and near the world's truth
         est = w.poses[-1].pose
-        truth = np.asarray(s.nodes["/gazebo"].engine.model_pose(TARGET)[0][:2])
+        engine = s.nodes["/gazebo"].engine
+        truth = np.asarray(engine.model_pose(TARGET)[0][:2])
+        expected = truth_in_the_followers_map(s, truth)
         p = est.pose.position
-        assert math.hypot(p.x - truth[0], p.y - truth[1]) < 0.15
+        assert math.hypot(p.x - expected[0], p.y - expected[1]) < 0.1
+        assert math.hypot(p.x - truth[0], p.y - truth[1]) < 0.3
         cov = np.asarray(est.covariance).reshape(6, 6)
         assert 0 < cov[0, 0] < 0.05 and 0 < cov[1, 1] < 0.05
         path = w.paths[-1]

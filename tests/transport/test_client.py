@@ -83,6 +83,24 @@ def test_the_simulation_side_keeps_running_after_a_script_exits(endpoint):
             assert c.sim_time() >= 0.0
 
 
+def test_a_script_with_many_open_subscriptions_exits_without_aborting(endpoint):
+    """Closing at exit wakes each subscription's reader thread; one that re-entered Python
+    after finalisation began was ended by a forced unwind through zenoh's Rust frames, and the
+    process aborted ("FATAL: exception not rethrown", 6 of 15 such scripts before the readers
+    were joined at close)."""
+    rt = Runtime(seed=1)
+    with SimThread(rt, endpoint):
+        code = f"""
+            from fleetsim.transport import SimulationClient
+            c = SimulationClient({endpoint!r})
+            for i in range(30):
+                c.subscribe(f'/t{{i}}', lambda r: None, latched=False)
+        """
+        for _ in range(5):
+            r = run_script(code)
+            assert (r.returncode, r.stderr) == (0, "")
+
+
 def test_a_navigator_used_with_with_closes_its_subscriptions_not_the_client(sim):
     from fleetsim.nav.navigator import Navigator
 

@@ -111,8 +111,29 @@ class ToolPublisher:
             self._pub = None
 
 
-def _close_session(session: Any, subs: list, pubs: weakref.WeakSet) -> None:
-    """Undeclare a client's subscribers and publishers and close its session.
+#: wall seconds a closing client waits for each reader thread to finish its last callback
+READER_JOIN_TIMEOUT = 2.0
+
+
+def _join_readers(readers: list[threading.Thread]) -> None:
+    """Wait for undeclared subscriptions' reader threads to leave Python.
+
+    A reader woken by the undeclare re-enters the interpreter; at exit, one that does so after
+    Python has begun finalising is ended by a forced unwind through zenoh's Rust frames, which
+    aborts the process ("FATAL: exception not rethrown", SIGABRT: a script that never closed
+    its client, seen once in a loaded suite). Joined before finalisation, they end cleanly."""
+    me = threading.current_thread()
+    for thread in readers:
+        if thread is not me:  # a callback closing its own client cannot wait for itself
+            thread.join(READER_JOIN_TIMEOUT)
+    readers[:] = [t for t in readers if t.is_alive()]
+
+
+def _close_session(
+    session: Any, subs: list, pubs: weakref.WeakSet, readers: list[threading.Thread]
+) -> None:
+    """Undeclare a client's subscribers and publishers, wait for their readers, and close its
+    session.
 
     Holds no reference to the client, so that `weakref.finalize` (which calls it once) can
     call it at exit."""
@@ -121,6 +142,7 @@ def _close_session(session: Any, subs: list, pubs: weakref.WeakSet) -> None:
     for sub in subs:
         sub.undeclare()
     subs.clear()
+    _join_readers(readers)
     session.close()
 
 
@@ -157,11 +179,12 @@ class SimulationClient:
         self.keys = Keys(domain)
         self.timeout = timeout
         self._subs: list = []
+        self._readers: list[threading.Thread] = []
         self._pubs: weakref.WeakSet[ToolPublisher] = weakref.WeakSet()
         self.session = open_session("client", connect=[self.endpoint])
         # closes the session at garbage collection or interpreter exit if close() was not called
         self._finalizer = weakref.finalize(
-            self, _close_session, self.session, self._subs, self._pubs
+            self, _close_session, self.session, self._subs, self._pubs, self._readers
         )
         self.zid = str(self.session.zid())
         alive = [
@@ -230,7 +253,10 @@ class SimulationClient:
 
         sub = self.session.declare_subscriber(self.keys.topic(name))
         self._subs.append(sub)
-        _reader(sub, lambda s: decode(s.payload.to_bytes(), s.encoding, s.attachment), name)
+        self._readers[:] = [t for t in self._readers if t.is_alive()]  # closed ones' are done
+        self._readers.append(
+            _reader(sub, lambda s: decode(s.payload.to_bytes(), s.encoding, s.attachment), name)
+        )
         if latched:
             for reply in self.session.get(self.keys.latched_any(name), timeout=self.timeout):
                 if reply.ok is not None:

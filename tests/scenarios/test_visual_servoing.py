@@ -10,7 +10,6 @@ the camera is the launch's 640x360 at 10 Hz.
 from __future__ import annotations
 
 import itertools
-import logging
 import math
 
 import numpy as np
@@ -24,19 +23,9 @@ from fleetsim.record.reader import read_messages
 from fleetsim.tf.patience import GRACE
 from fleetsim.tf.quaternions import yaw_from_quaternion
 
-pytestmark = pytest.mark.scenario
+pytestmark = [pytest.mark.scenario, pytest.mark.usefixtures("quiet_run")]
 
 BEHIND_KARL = {"x": "-3.8", "y": "2.0", "yaw": "0.0"}
-
-
-@pytest.fixture(autouse=True)
-def quiet(tmp_path, monkeypatch, caplog):
-    monkeypatch.chdir(tmp_path)  # where MuJoCo would write MUJOCO_LOG.TXT
-    caplog.set_level(logging.INFO)
-    yield
-    noise = [f"{r.name}: {r.getMessage()}" for r in caplog.records if r.levelno >= logging.WARNING]
-    assert noise == []
-    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
 
 
 def session(name: str, **args: str) -> LaunchSession:

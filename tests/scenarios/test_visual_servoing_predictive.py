@@ -8,7 +8,6 @@ the camera is the launch's 640x360 at 10 Hz.
 
 from __future__ import annotations
 
-import logging
 import math
 
 import numpy as np
@@ -18,20 +17,10 @@ from fleetsim.cli.launch import resolve_launch_file
 from fleetsim.launch.runner import LaunchSession, load_plan
 from fleetsim.msgs import fiducial_msgs, geometry_msgs, move_base_msgs, nav_msgs
 
-pytestmark = pytest.mark.scenario
+pytestmark = [pytest.mark.scenario, pytest.mark.usefixtures("quiet_run")]
 
 BEHIND_KARL = {"x": "-3.8", "y": "2.0", "yaw": "0.0"}
 FOLLOWER, TARGET = "turtlebot3_waffle", "karl_marker"
-
-
-@pytest.fixture(autouse=True)
-def quiet(tmp_path, monkeypatch, caplog):
-    monkeypatch.chdir(tmp_path)  # where MuJoCo would write MUJOCO_LOG.TXT
-    caplog.set_level(logging.INFO)
-    yield
-    noise = [f"{r.name}: {r.getMessage()}" for r in caplog.records if r.levelno >= logging.WARNING]
-    assert noise == []
-    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
 
 
 def session(**args: str) -> LaunchSession:

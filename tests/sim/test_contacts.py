@@ -20,8 +20,9 @@ import pytest
 from fleetsim.description import load_robot
 from fleetsim.sim import Engine
 from fleetsim.sim.contacts import FLOOR_FRICTION_TIMECONST
-from fleetsim.sim.plugins.base import DrivePlugin
 from fleetsim.sim.world import GeomDesc, LinkDesc, ModelDesc, WorldDesc, ground_plane
+
+from .test_physics_health import drive_of, top_speed
 
 ROBOTS = Path(__file__).resolve().parents[2] / "src" / "fleetsim" / "assets" / "robots"
 FILES = sorted(ROBOTS.glob("*/urdf/*.urdf.xacro"))
@@ -36,16 +37,6 @@ def settle(e: Engine) -> None:
 
 
 pytestmark = pytest.mark.usefixtures("in_tmp_dir")
-
-
-def drive_of(entry) -> DrivePlugin:
-    return next(p for p in entry.plugins if isinstance(p, DrivePlugin))
-
-
-def top_speed(entry, drive) -> float:
-    """Wheel surface speed at the wheel joints' velocity limit, m/s."""
-    limits = [entry.robot.joints[j].limit for j in drive.left + drive.right]
-    return min(lim.velocity for lim in limits if lim is not None) * drive.radius
 
 
 def wall_world(x: float) -> WorldDesc:

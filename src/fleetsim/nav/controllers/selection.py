@@ -124,16 +124,14 @@ def _ahead_goal_dist_turning(tp: TrajectoryPlanner, index: int) -> tuple[float, 
     n = int(tp._steps[index])
     poses = tp._poses[index, :n]
     look = tp.params.heading_lookahead
-    xs = poses[:, 0] + look * np.cos(poses[:, 2])
-    ys = poses[:, 1] + look * np.sin(poses[:, 2])
-    best: tuple[float, int] | None = None
-    for k in range(n):
-        cell = tp.costmap.world_to_map(float(xs[k]), float(ys[k]))
-        if cell is not None:
-            d = float(tp.goal_dist[cell[1], cell[0]])
-            if best is None or d < best[0]:
-                best = (d, k)
-    return best
+    ahead = poses[:, :2] + look * np.stack([np.cos(poses[:, 2]), np.sin(poses[:, 2])], axis=1)
+    cells, inside = tp.costmap.cells_of(ahead)  # batched: up to ~80 poses x 40 rotations a cycle
+    steps = np.flatnonzero(inside)
+    if steps.size == 0:
+        return None
+    dists = tp.goal_dist[cells[steps, 1], cells[steps, 0]]
+    k = int(np.argmin(dists))  # the first of equal least distances, as a strict < scan
+    return float(dists[k]), int(steps[k])
 
 
 #: how many escape_reset_dist a robot that cannot turn in place backs up at most

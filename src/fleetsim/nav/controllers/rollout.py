@@ -295,8 +295,12 @@ def trajectory_costs(
             vx = _new_velocity(samples[s, 0], vx, acc[0], dt)
             vy = _new_velocity(samples[s, 1], vy, acc[1], dt)
             vth = _new_velocity(samples[s, 2], vth, acc[2], dt)
-            x = x + (vx * math.cos(th) + vy * math.cos(math.pi / 2.0 + th)) * dt
-            y = y + (vx * math.sin(th) + vy * math.sin(math.pi / 2.0 + th)) * dt
+            if vy != 0.0:
+                x = x + (vx * math.cos(th) + vy * math.cos(math.pi / 2.0 + th)) * dt
+                y = y + (vx * math.sin(th) + vy * math.sin(math.pi / 2.0 + th)) * dt
+            else:  # the same sums (a zero term adds nothing) without two of the four trig calls
+                x = x + vx * math.cos(th) * dt
+                y = y + vx * math.sin(th) * dt
             th = th + vth * dt
             t += dt
         if cost < 0.0:

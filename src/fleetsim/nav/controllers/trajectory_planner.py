@@ -141,10 +141,12 @@ class TrajectoryPlanner(LocalPlanner):
             raise EmptyPlan(f"set_plan: a plan must be (N, 3) x, y, yaw poses, got {poses.shape}")
         if poses.shape[1] == 2:
             poses = np.concatenate([poses, np.zeros((poses.shape[0], 1))], axis=1)
+        # plain floats: np.allclose costs ~20 us, and move_base hands the plan over on every
+        # control cycle when the local costmap's frame is not the plan's
         same_goal = (
             self.plan.shape[0] > 0
             and poses.shape[0] > 0
-            and np.allclose(self.plan[-1], poses[-1], rtol=0.0, atol=1e-6)
+            and all(abs(d) <= 1e-6 for d in (self.plan[-1] - poses[-1]).tolist())
         )
         self.plan = poses
         if not same_goal:
@@ -201,24 +203,15 @@ class TrajectoryPlanner(LocalPlanner):
     def _plan_in_window(self, x: float, y: float) -> np.ndarray:
         m = self.costmap
         thr = max(m.size_x * m.resolution / 2.0, m.size_y * m.resolution / 2.0) ** 2
-        d2 = ((self.plan[:, :2] - [x, y]) ** 2).sum(axis=1)
-        near = d2 <= thr
-        if not near.any():
-            return self.plan[:0]
-        i = int(np.argmax(near))
-        rest = near[i:]
-        j = i + (int(np.argmin(rest)) if not rest.all() else rest.shape[0])
+        i, j = _window_of(self.plan, x, y, thr)
         return self.plan[i:j]
 
     def _pruned(self, local: np.ndarray, x: float, y: float) -> np.ndarray:
         """Drop points until the first within 1 m of the robot (base_local_planner prunePlan)."""
-        d2 = ((local[:, :2] - [x, y]) ** 2).sum(axis=1)
-        close = d2 < 1.0
-        if not close.any():
+        k, cut = _prune_of(local, self.plan, x, y)
+        if k < 0:
             return local
-        k = int(np.argmax(close))
-        d2g = ((self.plan[:, :2] - local[k, :2]) ** 2).sum(axis=1)
-        self.plan = self.plan[int(np.argmin(d2g)) :]
+        self.plan = self.plan[cut:]
         return local[k:]
 
     def _update_maps(
@@ -364,3 +357,42 @@ def _obstacle_in_box(polygon, ox, oy, res, costs):
             if costs[y, x] >= 253:
                 return True
     return False
+
+
+@njit(cache=True)
+def _window_of(plan, x, y, thr):
+    """`TrajectoryPlanner._plan_in_window`'s bounds, compiled (every control cycle of every
+    robot; the NumPy version's whole-plan temporaries cost ~25 us): the plan's slice
+    ``[i, j)`` from its first point within ``sqrt(thr)`` m of (x, y) while points stay so;
+    ``(0, 0)`` when none is."""
+    n = plan.shape[0]
+    i = 0
+    while i < n and not (plan[i, 0] - x) ** 2 + (plan[i, 1] - y) ** 2 <= thr:
+        i += 1
+    if i == n:
+        return 0, 0
+    j = i
+    while j < n and (plan[j, 0] - x) ** 2 + (plan[j, 1] - y) ** 2 <= thr:
+        j += 1
+    return i, j
+
+
+@njit(cache=True)
+def _prune_of(local, plan, x, y):
+    """`TrajectoryPlanner._pruned`'s indices, compiled: the first point ``k`` of ``local``
+    within 1 m of (x, y) (-1: none) and the first point of ``plan`` nearest to it (where the
+    pruned plan starts)."""
+    k = -1
+    for i in range(local.shape[0]):
+        if (local[i, 0] - x) ** 2 + (local[i, 1] - y) ** 2 < 1.0:
+            k = i
+            break
+    if k < 0:
+        return -1, 0
+    px, py = local[k, 0], local[k, 1]
+    best, cut = np.inf, 0
+    for i in range(plan.shape[0]):
+        d = (plan[i, 0] - px) ** 2 + (plan[i, 1] - py) ** 2
+        if d < best:
+            best, cut = d, i
+    return k, cut

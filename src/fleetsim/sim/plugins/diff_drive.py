@@ -16,6 +16,7 @@ import math
 from dataclasses import dataclass
 
 import mujoco
+import numba
 import numpy as np
 
 from fleetsim.errors import SimulationError
@@ -262,31 +263,38 @@ def true_odometries(model, data, roots: np.ndarray) -> tuple[np.ndarray, ...]:
     pos : (B, 3) m, world; quat : (B, 4) x, y, z, w, world;
     lin : (B, 3) m/s and ang : (B, 3) rad/s, in each body's frame.
     """
-    pos = data.xpos[roots]
-    quat = data.xquat[roots][:, [1, 2, 3, 0]]
-    cvel = data.cvel[roots]
-    w0, w1, w2 = cvel[:, 0], cvel[:, 1], cvel[:, 2]
-    dif = pos - data.subtree_com[model.body_rootid[roots]]
-    d0, d1, d2 = dif[:, 0], dif[:, 1], dif[:, 2]
-    # linear velocity at the body's origin: v - dif x w
-    v0 = cvel[:, 3] - (d1 * w2 - d2 * w1)
-    v1 = cvel[:, 4] - (d2 * w0 - d0 * w2)
-    v2 = cvel[:, 5] - (d0 * w1 - d1 * w0)
-    r = data.xmat[roots]  # (B, 9) row-major body-to-world; R^T v in the body frame
-    lin = np.stack(
-        [
-            r[:, 0] * v0 + r[:, 3] * v1 + r[:, 6] * v2,
-            r[:, 1] * v0 + r[:, 4] * v1 + r[:, 7] * v2,
-            r[:, 2] * v0 + r[:, 5] * v1 + r[:, 8] * v2,
-        ],
-        axis=1,
+    out = _true_odometries(
+        data.xpos, data.xquat, data.xmat, data.cvel, data.subtree_com, model.body_rootid, roots
     )
-    ang = np.stack(
-        [
-            r[:, 0] * w0 + r[:, 3] * w1 + r[:, 6] * w2,
-            r[:, 1] * w0 + r[:, 4] * w1 + r[:, 7] * w2,
-            r[:, 2] * w0 + r[:, 5] * w1 + r[:, 8] * w2,
-        ],
-        axis=1,
-    )
-    return pos, quat, lin, ang
+    return out[:, 0:3], out[:, 3:7], out[:, 7:10], out[:, 10:13]
+
+
+@numba.njit(cache=True)
+def _true_odometries(xpos, xquat, xmat, cvel, subtree_com, rootid, roots):
+    """`true_odometries` as one (B, 13) array (pos, quat x y z w, lin, ang), compiled: drive
+    odometry runs at 100 Hz per robot and the NumPy batch's two dozen small-array calls cost
+    ~40 us each time."""
+    n = roots.shape[0]
+    out = np.empty((n, 13))
+    for i in range(n):
+        k = roots[i]
+        c = rootid[k]
+        w0, w1, w2 = cvel[k, 0], cvel[k, 1], cvel[k, 2]
+        d0 = xpos[k, 0] - subtree_com[c, 0]
+        d1 = xpos[k, 1] - subtree_com[c, 1]
+        d2 = xpos[k, 2] - subtree_com[c, 2]
+        # linear velocity at the body's origin: v - dif x w
+        v0 = cvel[k, 3] - (d1 * w2 - d2 * w1)
+        v1 = cvel[k, 4] - (d2 * w0 - d0 * w2)
+        v2 = cvel[k, 5] - (d0 * w1 - d1 * w0)
+        r = xmat[k]  # row-major body-to-world; R^T v in the body frame
+        out[i, 0], out[i, 1], out[i, 2] = xpos[k, 0], xpos[k, 1], xpos[k, 2]
+        out[i, 3], out[i, 4] = xquat[k, 1], xquat[k, 2]
+        out[i, 5], out[i, 6] = xquat[k, 3], xquat[k, 0]
+        out[i, 7] = r[0] * v0 + r[3] * v1 + r[6] * v2
+        out[i, 8] = r[1] * v0 + r[4] * v1 + r[7] * v2
+        out[i, 9] = r[2] * v0 + r[5] * v1 + r[8] * v2
+        out[i, 10] = r[0] * w0 + r[3] * w1 + r[6] * w2
+        out[i, 11] = r[1] * w0 + r[4] * w1 + r[7] * w2
+        out[i, 12] = r[2] * w0 + r[5] * w1 + r[8] * w2
+    return out

@@ -11,6 +11,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import mujoco
+import numba
 import numpy as np
 
 from fleetsim.errors import SimulationError
@@ -145,19 +146,13 @@ class P3dPlugin(SensorPlugin):
         """Readings of world-frame p3d plugins, vectorised over the plugins."""
         d = engine.data
         b, root, offsets, off_q, sigma, noisy = cls._layout(engine, plugins)
-        pos = d.xpos[b] + offsets
-        cvel = d.cvel[b]
-        ang = cvel[:, :3]
-        lever = d.xpos[b] - d.subtree_com[root]
-        lin = cvel[:, 3:] + cross_products(ang, lever)
-        quat = quats_multiplied(off_q, d.xquat[b])
-        xyzw = quat[:, [1, 2, 3, 0]]
+        st = world_states(d.xpos, d.xquat, d.cvel, d.subtree_com, b, root, offsets, off_q)
+        pos, xyzw, lin, ang = st[:, 0:3], st[:, 3:7], st[:, 7:10], st[:, 10:13]
         if len(noisy):
             z = engine.rng.standard_normal(9 * len(noisy)).reshape(-1, 3, 3)
             s = sigma[noisy, None]
             pos[noisy] = pos[noisy] + s * z[:, 0]
             lin[noisy] = lin[noisy] + s * z[:, 1]
-            ang = ang.copy()
             ang[noisy] = ang[noisy] + s * z[:, 2]
         return [
             OdometryReading(
@@ -177,24 +172,36 @@ class P3dPlugin(SensorPlugin):
         ]
 
 
-def cross_products(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Row-wise cross products ``a x b`` of (N, 3) arrays (as ``np.cross``, without its
-    overhead)."""
-    a0, a1, a2 = a[:, 0], a[:, 1], a[:, 2]
-    b0, b1, b2 = b[:, 0], b[:, 1], b[:, 2]
-    return np.stack([a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0], axis=1)
+@numba.njit(cache=True)
+def world_states(xpos, xquat, cvel, subtree_com, b, root, offsets, off_q):
+    """Pose and twist of bodies ``b`` for world-frame p3d plugins, (B, 13): position + offset
+    (3), orientation ``off_q * xquat`` as x, y, z, w (4), linear velocity at the body's origin
+    (``v + w x (xpos - subtree_com[root])``, 3) and angular velocity (3), all in the world.
 
-
-def quats_multiplied(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Hamilton products ``a * b`` of (N, 4) quaternion arrays (w, x, y, z)."""
-    aw, ax, ay, az = a.T
-    bw, bx, by, bz = b.T
-    return np.stack(
-        [
-            aw * bw - ax * bx - ay * by - az * bz,
-            aw * bx + ax * bw + ay * bz - az * by,
-            aw * by - ax * bz + ay * bw + az * bx,
-            aw * bz + ax * by - ay * bx + az * bw,
-        ],
-        axis=1,
-    )
+    The NumPy batch it replaces did the same operations in the same order (row-wise cross
+    product, Hamilton product); compiled, as at 100 Hz per robot that batch's two dozen
+    small-array calls cost ~40 us each time."""
+    n = b.shape[0]
+    out = np.empty((n, 13))
+    for i in range(n):
+        k, r = b[i], root[i]
+        w0, w1, w2 = cvel[k, 0], cvel[k, 1], cvel[k, 2]
+        l0 = xpos[k, 0] - subtree_com[r, 0]
+        l1 = xpos[k, 1] - subtree_com[r, 1]
+        l2 = xpos[k, 2] - subtree_com[r, 2]
+        out[i, 0] = xpos[k, 0] + offsets[i, 0]
+        out[i, 1] = xpos[k, 1] + offsets[i, 1]
+        out[i, 2] = xpos[k, 2] + offsets[i, 2]
+        aw, ax, ay, az = off_q[i, 0], off_q[i, 1], off_q[i, 2], off_q[i, 3]
+        bw, bx, by, bz = xquat[k, 0], xquat[k, 1], xquat[k, 2], xquat[k, 3]
+        out[i, 6] = aw * bw - ax * bx - ay * by - az * bz
+        out[i, 3] = aw * bx + ax * bw + ay * bz - az * by
+        out[i, 4] = aw * by - ax * bz + ay * bw + az * bx
+        out[i, 5] = aw * bz + ax * by - ay * bx + az * bw
+        out[i, 7] = cvel[k, 3] + (w1 * l2 - w2 * l1)
+        out[i, 8] = cvel[k, 4] + (w2 * l0 - w0 * l2)
+        out[i, 9] = cvel[k, 5] + (w0 * l1 - w1 * l0)
+        out[i, 10] = w0
+        out[i, 11] = w1
+        out[i, 12] = w2
+    return out

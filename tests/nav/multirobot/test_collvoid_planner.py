@@ -61,6 +61,7 @@ class Fleet:
         self.min_gap = math.inf
         self.min_wall = math.inf
         self.paths = np.zeros(len(starts))
+        self.backed = np.zeros(len(starts))  # m driven backwards
 
     def share(self):
         for i, (x, y, yaw) in enumerate(self.state):
@@ -91,6 +92,7 @@ class Fleet:
                 [x + v * np.cos(yaw) * dt, y + v * np.sin(yaw) * dt, yaw + w * dt], 1
             )
             self.paths += np.abs(v) * dt
+            self.backed += np.maximum(-v, 0.0) * dt
             xy = self.state[:, :2]
             d = np.linalg.norm(xy[:, None] - xy[None], axis=-1)
             d[np.diag_indices(len(xy))] = np.inf
@@ -124,9 +126,11 @@ def test_corridor_swap_keeps_off_the_walls():
 
 
 def test_in_a_corridor_too_narrow_to_pass_the_lower_priority_robot_backs_off():
-    """0.9 m between the walls: the lizis cannot pass, ORCA stalls them nose to nose. Without
-    the rule they stay put; with it robot2 (lower priority) backs away along its plan and robot1
-    advances (test_yielding.py: the whole swap, with wide ends to back out into)."""
+    """0.9 m between the walls: the lizis cannot pass, ORCA slows them to a standstill nose
+    to nose. Without the rule they stay put; with it robot2 (lower priority) backs away along
+    its plan once they have faced each other across the narrow passage for
+    ``narrow_deadlock_time`` (from ~3 m apart), and robot1 advances (test_yielding.py: the
+    whole swap, with wide ends to back out into)."""
     walls = [(-8, 0.45, 8, 0.65), (-8, -0.65, 8, -0.45)]
     swap = ([(-3, 0, 0), (3, 0, math.pi)], [(3, 0, 0), (-3, 0, math.pi)])
 
@@ -138,14 +142,14 @@ def test_in_a_corridor_too_narrow_to_pass_the_lower_priority_robot_backs_off():
             narrow_deadlock_time=deadlock_time,
             yield_time=4.0,
         )
-        f.run(16.0)  # nose to nose by ~10 s; no progress for 8 s
+        f.run(10.0)  # facing each other within 3 m from ~1 s, nearly stopped by 10 s
         before = f.state[:, 0].copy()
         f.run(6.0)
         assert f.min_gap > 0.0
         return f, f.state[:, 0] - before
 
     stalled, moved = standoff(1000.0)
-    assert np.all(np.abs(moved) < 0.1)
+    assert np.all(np.abs(moved) < 0.25)  # a creep towards each other, ~0.03 m/s
     f, moved = standoff(8.0)
     assert moved[1] > 0.5 and moved[0] > 0.3  # robot2 retreats east, robot1 follows
     assert f.planners[1].deadlock.yields >= 1 and f.planners[0].deadlock.yields == 0
@@ -242,3 +246,25 @@ def test_bad_parameters_are_refused_by_name(params, words):
 
 def test_move_base_knows_the_plugin_by_its_ros_name():
     assert LOCAL_PLANNERS["collvoid_local_planner/CollvoidLocalPlanner"] == "CollvoidLocalPlanner"
+
+
+def test_a_narrow_meeting_is_stuck_after_narrow_deadlock_time_progress_or_not():
+    """Facing each other across a passage too narrow for two, ORCA slows the pair to a creep
+    that still makes progress; the meeting itself starts the clock, and a robot met there
+    counts beyond deadlock_radius."""
+    rule = DeadlockRule("lizi2", deadlock_time=10.0, deadlock_radius=2.0, narrow_time=1.0)
+    assert rule.update(0.0, 6.0, {"lizi1": 2.8}, narrow=["lizi1"]) is None
+    # 0.3 m of progress (a creep), still facing across the passage: stuck after 1 s
+    assert rule.update(0.6, 5.7, {"lizi1": 2.4}, narrow=["lizi1"]) is None
+    assert rule.update(1.1, 5.4, {"lizi1": 2.1}, narrow=["lizi1"]) == "lizi1"
+    # not a narrow meeting: progress resets the clock, and 2.1 m is beyond deadlock_radius
+    plain = DeadlockRule("lizi2", deadlock_time=10.0, deadlock_radius=2.0, narrow_time=1.0)
+    plain.update(0.0, 6.0, {"lizi1": 2.8})
+    assert plain.update(1.1, 5.4, {"lizi1": 2.1}) is None
+    assert plain.update(11.5, 5.4, {"lizi1": 2.1}) is None  # too far to take part
+    assert plain.update(11.6, 5.4, {"lizi1": 1.9}) == "lizi1"
+    # the meeting over, its clock is forgotten
+    top = DeadlockRule("lizi3", deadlock_time=10.0, narrow_time=1.0)
+    top.update(0.0, 6.0, {"lizi1": 2.8}, narrow=["lizi1"])
+    top.update(0.5, 5.7, {"lizi1": 2.8})
+    assert top.update(1.2, 5.7, {"lizi1": 2.8}, narrow=["lizi1"]) is None

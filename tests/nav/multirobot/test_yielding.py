@@ -13,6 +13,7 @@ from fleetsim.nav.multirobot.yielding import (
     Retreat,
     clear_distance,
     has_passed,
+    narrow_between,
     passage_width,
     refuge,
     retreat_velocity,
@@ -76,6 +77,32 @@ def test_refuge_is_the_first_wide_place_back_along_the_plan_aside_to_the_right()
     assert wide and point[0] == pytest.approx(plan[20, 0])
 
 
+def test_refuge_set_back_stays_in_the_wide_place_and_waits_for_the_window():
+    cm = costmap(narrow_corridor_walls())
+    plan = np.c_[np.linspace(5.0, -5.0, 201), np.zeros(201)]
+    here = int(np.argmin(np.abs(plan[:, 0] - 0.5)))
+    point, wide = refuge(plan[:, :2], here, *args(cm), 0.31, 0.25, setback=0.8)
+    assert wide and point[0] == pytest.approx(3.8, abs=0.1) and point[1] > 0.3
+    # the bay ends 2 m on (x = 5): the setback stops where the plan stops being wide
+    point, wide = refuge(plan[:, :2], here, *args(cm), 0.31, 0.25, setback=5.0)
+    assert wide and 4.0 < point[0] < 5.0
+    # a window ending 0.3 m into the bay: the refuge is not final until the setback is seen
+    window = costmap(narrow_corridor_walls(), size=(66, 80), origin=(0.0, -2.0))
+    point, wide = refuge(plan[:, :2], here, *args(window), 0.31, 0.25, setback=0.8)
+    assert not wide and point[0] <= 3.3 + 1e-9
+
+
+def test_narrow_between_two_robots_facing_each_other():
+    cm = costmap(narrow_corridor_walls())
+    # both in the bays, the narrow part between them
+    assert narrow_between(*args(cm), np.array([-4.0, 0.0]), np.array([4.0, 0.0]), 0.31, 0.25)
+    # both in one bay, or in the open
+    assert not narrow_between(*args(cm), np.array([3.5, 0.0]), np.array([5.5, 0.0]), 0.31, 0.25)
+    assert not narrow_between(
+        *args(costmap([])), np.array([-4.0, 0.0]), np.array([4.0, 0.0]), 0.31, 0.25
+    )
+
+
 def test_refuge_beyond_the_rolling_window_is_the_farthest_plan_point_inside_it():
     # a 4 x 4 m window at (-2..2, -2..2) over the narrow part: no wide place in view
     cm = costmap(narrow_corridor_walls(), size=(80, 80), origin=(-2.0, -2.0))
@@ -110,6 +137,10 @@ def test_swap_through_a_passage_too_narrow_for_two():
     assert f.min_gap > 0.0
     assert f.planners[1].deadlock.yields == 1 and f.planners[0].deadlock.yields == 0
     assert np.all(np.abs(f.state[:, 1]) < 1.0 - 0.25)
+    # robot2 backs out (no half-turns on the spot), robot1 never drives backwards
+    assert f.backed[1] > 2.0 and f.backed[0] == 0.0
+    turned = Fleet(*swap, walls=walls, deadlock_time=1000.0, max_vel_x_backwards=0.0)
+    assert turned.run(60.0) and turned.backed[1] == 0.0 and turned.min_gap > 0.0
 
 
 def test_a_wall_marked_as_a_dotted_line_still_bounds_the_passage():
@@ -133,7 +164,8 @@ def test_retreat_keeps_the_way_it_came_and_cuts_the_retreat_off_after_a_yield():
     assert np.all((steps >= 0.1) & (steps < 0.13)) and r.trail[0] == (-5.0, 0.0)
     v = r.velocity(cm, np.array([0.0, 0.0]), 0.31, 0.25, 0.5, 0.6)
     assert v[0] < 0  # back west, into the narrow part's wide end
-    assert r.refuge_final and -3.3 < r.refuge[0] < -3.0 and r.refuge[1] < -0.3
+    # REFUGE_SETBACK (0.6 m) past the bay's mouth at x = -3, aside (south: robot1 faces east)
+    assert r.refuge_final and -3.9 < r.refuge[0] < -3.5 and r.refuge[1] < -0.3
     r.extend(np.array([-2.0, 0.0]))  # the yield is over where the robot now stands
     assert r.refuge is None and r.trail[-1] == pytest.approx((-2.0, 0.0), abs=0.06)
     r.reset()

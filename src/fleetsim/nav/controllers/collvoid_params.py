@@ -91,7 +91,16 @@ class CollvoidParams:
         10.0, unit="s", range=(0.0, None), help="no progress this long near a robot: stuck"
     )
     narrow_deadlock_time: float = param(
-        3.0, unit="s", range=(0.0, None), help="the same in a passage too narrow for two"
+        1.0,
+        unit="s",
+        range=(0.0, None),
+        help="a robot facing this one across a passage too narrow for two this long: stuck",
+    )
+    max_vel_x_backwards: float = param(
+        0.5,
+        unit="m/s",
+        range=(0.0, None),
+        help="backing out while yielding, at most max_vel_x (0: turn round, drive forwards)",
     )
     deadlock_progress: float = param(
         0.2, unit="m", range=(0.0, None), help="progress that resets the deadlock clock"

@@ -11,8 +11,10 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    the goal; while another robot ahead, nearer than the goal, is closing in, it is turned by
    ``left_pref`` rad (negative: keep right), which breaks the symmetry of head-on meetings that
    plain ORCA cannot;
-3. the `DeadlockRule` may make the robot yield: back off to the right, away from a robot with
-   priority, taking full responsibility for avoiding it;
+3. the `DeadlockRule` may make the robot yield (at once when a robot faces it across a
+   passage too narrow for two): it backs out along the way it came (``max_vel_x_backwards``)
+   to a place wide enough, aside to the right, taking full responsibility for avoiding the
+   robot with priority, and waits there without turning until that robot is level with it;
 4. ORCA half-planes (`fleetsim.nav.multirobot.orca`): one per robot on ``/position_share``
    within ``neighbor_dist`` (at most ``max_neighbors``, horizon ``time_horizon``, half the
    responsibility, all of it for a robot that is not ``controlled``, stands still or is yielded
@@ -53,12 +55,13 @@ from fleetsim.nav.multirobot.holonomic import (
     preferred_velocity,
     rotated,
     speed_along_heading,
+    speed_nearest_still,
     tracking_command,
 )
 from fleetsim.nav.multirobot.orca import orca_halfplanes, orca_velocity
 from fleetsim.nav.multirobot.position_share import PositionShare
 from fleetsim.nav.multirobot.uncertainty import uncertainty_radius
-from fleetsim.nav.multirobot.yielding import Retreat, has_passed, too_narrow
+from fleetsim.nav.multirobot.yielding import Retreat, has_passed, narrow_meetings
 from fleetsim.runtime import load_params
 
 _log = logging.getLogger("fleetsim.nav.collvoid")
@@ -130,6 +133,7 @@ class CollvoidLocalPlanner(LocalPlanner):
         self.last_w = 0.0
         self.last_holo = np.zeros(2)
         self.yielding_to: str | None = None
+        self.waiting = False  # yielding, in the refuge: stands still while ORCA lets it
         self.plan_index = 0
         self.retreat = Retreat()  # the way back and the refuge of a yield
         self.lines = (np.zeros((0, 2)), np.zeros((0, 2)), 0)  # this cycle's half-planes
@@ -215,6 +219,7 @@ class CollvoidLocalPlanner(LocalPlanner):
         resp = np.zeros(0)
         ids: list[str] = []
         controlled = np.zeros(0, dtype=bool)
+        yaws = np.zeros(0)
         speed = float(np.hypot(*vel))
         map_xy = xy
         if tx is not None:
@@ -231,29 +236,34 @@ class CollvoidLocalPlanner(LocalPlanner):
             still = np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED
             resp = np.where(~near.controlled | still, 1.0, 0.5)
             controlled = near.controlled
+            yaws = np.array([r.yaw for r in near.robots]) + tyaw
         own_r = self.own_radius(speed, map_xy)
         dist = np.hypot(pos[:, 0] - xy[0], pos[:, 1] - xy[1])
         active = {k: d for k, d, c in zip(ids, dist.tolist(), controlled) if c}
-        narrow = False
+        narrow: list[str] = []
         if active and self.yielding_to is None:
-            heading = carrot - xy
-            n = float(np.hypot(*heading))
             cm = self.costmap
-            narrow = n > 1e-6 and too_narrow(
-                cm.costs,
-                (cm.origin_x, cm.origin_y),
-                cm.resolution,
+            meet = narrow_meetings(
+                (cm.costs, (cm.origin_x, cm.origin_y), cm.resolution),
                 xy,
-                heading / n,
+                carrot - xy,
+                pos - xy,
+                nvel,
+                yaws,
+                radii,
+                controlled,
                 own_r,
-                float(radii[controlled].max()),
             )
+            narrow = [ids[k] for k in meet]
         self.yielding_to = self.deadlock.update(now, remaining, active, narrow)
+        self.waiting = False
         if self.yielding_to is not None:
             k = ids.index(self.yielding_to)
-            pref = self._yield_velocity(xy, carrot - xy, pos[k], own_r, radii[k], remaining, pref)
+            along = carrot - self.plan[self.plan_index, :2]  # the plan's way here
+            pref = self._yield_velocity(xy, along, pos[k], own_r, radii[k], remaining, pref)
             if self.yielding_to is not None:
                 resp[k] = 1.0
+                self.waiting = not pref.any()
         if self.yielding_to is None and ids:
             near_goal = remaining < KEEP_RIGHT_UNTIL
             if not near_goal and self._oncoming(pos - xy, nvel, vel, pref, dist, remaining).any():
@@ -304,9 +314,10 @@ class CollvoidLocalPlanner(LocalPlanner):
 
     def _yield_velocity(self, xy, to_goal, other, own_r, other_r, remaining, pref):
         """Yielding (`fleetsim.nav.multirobot.yielding`): to the refuge back along the plan,
-        then wait there; the yield ends (``pref`` again) once the other robot has gone by."""
+        then wait there; the yield ends (``pref`` again) as soon as the other robot is level
+        with us (beside us in the refuge, out of the passage; ORCA keeps us apart from there)."""
         p, now = self.params, self.node.now()
-        if has_passed(other - xy, to_goal, own_r + other_r):
+        if has_passed(other - xy, to_goal, 0.0):
             self.deadlock.release(now, remaining)
             self.yielding_to = None
             return pref
@@ -338,13 +349,30 @@ class CollvoidLocalPlanner(LocalPlanner):
 
     def _track(self, holo: np.ndarray, pose, velocity) -> VelocityCommand:
         p, yaw = self.params, pose[2]
-        if p.holonomic_robot:
+        nudge = None
+        if self.waiting and not p.holonomic_robot:
+            # in the refuge: ORCA's nudge away from the robot going by is not worth a turn on
+            # the spot (turning back when the yield ends takes a lizi seconds)
+            back = min(p.max_vel_x, p.max_vel_x_backwards)
+            nudge = speed_nearest_still(*self.lines[:2], yaw, p.max_vel_x, back)
+        if nudge is not None:
+            cmd = (nudge, 0.0, 0.0)
+        elif p.holonomic_robot:
             body = rotated(holo, -yaw)
             cmd = (float(body[0]), float(body[1]), 0.0)
         else:
-            v, w = tracking_command(holo, yaw, p.time_to_holo, p.max_vel_x, p.max_vel_theta)
-            v = speed_along_heading(*self.lines, yaw, v, p.max_vel_x)
-            cmd = (v, 0.0, _clamp(w, p.min_vel_theta, p.max_vel_theta))
+            # a yielding robot backs out (its way back is behind it, and two half-turns on the
+            # spot cost a skid-steer lizi ~6 s each)
+            back = (
+                self.yielding_to is not None
+                and p.max_vel_x_backwards > 0.0
+                and holo[0] * math.cos(yaw) + holo[1] * math.sin(yaw) < 0.0
+            )
+            top = min(p.max_vel_x, p.max_vel_x_backwards) if back else p.max_vel_x
+            heading = yaw + math.pi if back else yaw
+            v, w = tracking_command(holo, heading, p.time_to_holo, top, p.max_vel_theta)
+            v = speed_along_heading(*self.lines, heading, v, top)
+            cmd = (-v if back else v, 0.0, _clamp(w, p.min_vel_theta, p.max_vel_theta))
         v0, vy0 = float(velocity[0]), float(velocity[1])
         dv, dw = p.acc_lim_x * self.dt, p.acc_lim_theta * self.dt
         dvy = p.acc_lim_y * self.dt

@@ -7,9 +7,10 @@ measurement with RVO2: exact head-on pairs and 0.6 m corridors never finish). Ea
 
 1. progress is the remaining distance to the goal; when it has not shrunk by
    ``deadlock_progress`` m for ``deadlock_time`` s while another robot is within
-   ``deadlock_radius`` m, the robot is *stuck*; in a passage too narrow for two (the planner
-   measures it) after ``narrow_time`` s already: no reciprocal method resolves that, waiting
-   longer only loses time;
+   ``deadlock_radius`` m, the robot is *stuck*; when a robot faces it across a passage too
+   narrow for two (the planner measures it: a *narrow meeting*) after ``narrow_time`` s of
+   that meeting already, progress or not: no reciprocal method resolves it (ORCA only slows
+   the pair to a creep), waiting longer only loses time;
 2. a stuck robot looks at the robots around it that are navigating (``controlled`` on
    /position_share; a robot parked at its goal will not move, waiting for it is pointless):
    priority goes by robot id (natural order, so ``lizi2`` before ``lizi10``); every robot sees
@@ -28,6 +29,7 @@ robot that keeps going.
 from __future__ import annotations
 
 import re
+from collections.abc import Collection
 from dataclasses import dataclass
 
 
@@ -57,36 +59,53 @@ class DeadlockRule:
         self.yield_to: str | None = None
         self.yield_until = -float("inf")
         self.yields = 0
+        self.narrow_since: float | None = None
 
     def release(self, now: float, remaining: float) -> None:
         """The robot yielded to has gone by: the yield ends, the progress clock restarts."""
         self.yield_to = None
         self.yield_until = -float("inf")
         self.best, self.best_time = remaining, now
+        self.narrow_since = None
 
     def update(
-        self, now: float, remaining: float, nearby: dict[str, float], narrow: bool = False
+        self,
+        now: float,
+        remaining: float,
+        nearby: dict[str, float],
+        narrow: Collection[str] = (),
     ) -> str | None:
         """The robot to yield to this cycle, or None.
 
         remaining : m to the goal; nearby : robot id -> distance (m) of the navigating robots
-        around; narrow : the robot stands in a passage too narrow for two.
+        around; narrow : the robots of a narrow meeting (each faces this one across a passage
+        too narrow for two; they take part at any distance, not only within deadlock_radius).
         """
         if remaining < self.best - self.deadlock_progress:
             self.best, self.best_time = remaining, now
+        if not narrow:
+            self.narrow_since = None
+        elif self.narrow_since is None:
+            self.narrow_since = now
         if self.yield_to is not None:
             if now < self.yield_until and self.yield_to in nearby:
                 return self.yield_to
             self.yield_to = None
             self.best, self.best_time = remaining, now
-        close = {k: d for k, d in nearby.items() if d <= self.deadlock_radius}
-        patience = min(self.narrow_time, self.deadlock_time) if narrow else self.deadlock_time
-        if not close or now - self.best_time < patience:
+            self.narrow_since = now if narrow else None
+        close = {k: d for k, d in nearby.items() if d <= self.deadlock_radius or k in narrow}
+        waited = now - self.best_time
+        patience = self.deadlock_time
+        if self.narrow_since is not None:
+            waited = max(waited, now - self.narrow_since)
+            patience = min(self.narrow_time, self.deadlock_time)
+        if not close or waited < patience:
             return None
         mine = priority_key(self.robot_id)
         higher = [k for k in close if priority_key(k) < mine]
         if not higher:
             self.best, self.best_time = remaining, now  # we keep the right of way
+            self.narrow_since = now if narrow else None
             return None
         self.yield_to = min(higher, key=lambda k: close[k])
         self.yield_until = now + self.yield_time

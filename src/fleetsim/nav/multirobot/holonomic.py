@@ -11,7 +11,9 @@
 * `speed_along_heading`: the forward speed nearest the tracking one that the ORCA half-planes
   admit for motion along the robot's heading (a 1-D linear program). While the base turns
   towards the holonomic velocity it moves along its heading, not along that velocity; without
-  this check the arc can lead into a wall or a neighbour that the holonomic velocity avoided.
+  this check the arc can lead into a wall or a neighbour that the holonomic velocity avoided;
+* `speed_nearest_still`: the same along the heading, forwards or backwards, nearest standing
+  still: a robot waiting for another to go by moves only as ORCA requires, without turning.
 """
 
 from __future__ import annotations
@@ -225,3 +227,23 @@ def speed_along_heading(
         if lo <= hi:
             return min(max(wanted, lo), hi)
     return 0.0
+
+
+def speed_nearest_still(
+    points: np.ndarray,
+    directions: np.ndarray,
+    yaw: float,
+    max_forward: float,
+    max_backward: float,
+) -> float | None:
+    """The speed along ``yaw`` (m/s, negative: backwards) nearest 0 that every half-plane
+    admits, or None when no speed along that line does."""
+    u = np.array([math.cos(yaw), math.sin(yaw)])
+    options = []
+    lo, hi = speed_interval(points, directions, u, max_forward)
+    if lo <= hi:
+        options.append(lo)
+    lo, hi = speed_interval(points, directions, -u, max_backward)
+    if lo <= hi:
+        options.append(-lo)
+    return min(options, key=abs) if options else None

@@ -10,7 +10,11 @@ robot has gone by:
 
 * `passage_width`: the free width across a direction at a point, from the costmap's lethal cells
   (the clear distance to each side, each capped);
-* `too_narrow`: two robots cannot pass each other here (the deadlock rule stops waiting);
+* `too_narrow`: two robots cannot pass each other here;
+* `narrow_meetings` / `narrow_between`: somewhere between two robots facing each other the
+  passage is too narrow for both (the deadlock rule decides at once who yields, instead of
+  waiting for no progress: ORCA slows a pair in such a passage to a creep that keeps making a
+  little progress, and every second of it is one more the yielder has to back out);
 * `refuge`: walking back along the plan from the robot's place, the first plan point where the
   width allows both robots, moved aside to its right as far as the walls allow; while no such
   point lies inside the (rolling) local costmap, the farthest plan point back that does, so the
@@ -34,6 +38,12 @@ TRAIL_STEP = 0.1
 TRAIL_POINTS = 400
 #: m between the probes of `passage_width`
 PROBE_STEP = 0.025
+#: m/s: a robot drawing away from us faster than this is not met head-on
+RECEDING_SPEED = 0.05
+#: m a yielding robot waits farther back than the first place wide enough (`refuge`)
+REFUGE_SETBACK = 0.6
+#: m from the refuge that count as there (closer, a skid steer only turns on the spot)
+REFUGE_TOLERANCE = 0.15
 #: cells around a probe that count: a wall a laser marks at a grazing angle is a dotted line,
 #: and a probe would pass between the dots
 PROBE_CELLS = 2
@@ -106,6 +116,62 @@ def too_narrow(
     return sum(passage_width(costs, origin, resolution, point, heading, need)) < need
 
 
+def narrow_between(
+    costs: np.ndarray,
+    origin: tuple[float, float],
+    resolution: float,
+    point: np.ndarray,
+    other: np.ndarray,
+    own_radius: float,
+    other_radius: float,
+    step: float = 0.25,
+) -> bool:
+    """The passage is too narrow for two robots somewhere on the straight way from ``point``
+    to ``other`` (both (2,), m; ``step`` m between the probes), measured across that way."""
+    way = np.asarray(other, dtype=np.float64) - point
+    n = float(np.hypot(*way))
+    if n < 1e-9:
+        return False
+    heading = way / n
+    for s in np.arange(0.0, n + 1e-9, step):
+        if too_narrow(
+            costs, origin, resolution, point + s * heading, heading, own_radius, other_radius
+        ):
+            return True
+    return False
+
+
+def narrow_meetings(
+    grid: tuple[np.ndarray, tuple[float, float], float],
+    xy: np.ndarray,
+    way: np.ndarray,
+    rel: np.ndarray,
+    velocities: np.ndarray,
+    yaws: np.ndarray,
+    radii: np.ndarray,
+    navigating: np.ndarray,
+    own_radius: float,
+) -> list[int]:
+    """The robots we meet across a passage too narrow for two: navigating, ahead of us (along
+    ``way``), facing us and not drawing away, with `narrow_between` us.
+
+    grid : (costs (H, W) uint8, origin (2,) m, resolution m); xy : (2,) us; way : (2,) our
+    direction of travel; rel : (N, 2) their positions relative to us, m; velocities : (N, 2)
+    m/s; yaws : (N,) rad; radii : (N,) m; navigating : (N,) bool. Returns indices into rel.
+    """
+    if float(np.hypot(*way)) < 1e-6 or rel.shape[0] == 0:
+        return []
+    d = np.maximum(np.hypot(rel[:, 0], rel[:, 1]), 1e-9)
+    facing = -(np.cos(yaws) * rel[:, 0] + np.sin(yaws) * rel[:, 1]) > 0.0
+    receding = np.einsum("ij,ij->i", rel, velocities) / d > RECEDING_SPEED
+    ahead = rel @ way > 0.0
+    return [
+        int(k)
+        for k in np.flatnonzero(navigating & ahead & facing & ~receding)
+        if narrow_between(*grid, xy, xy + rel[k], own_radius, float(radii[k]))
+    ]
+
+
 def refuge(
     plan_xy: np.ndarray,
     index: int,
@@ -115,36 +181,61 @@ def refuge(
     own_radius: float,
     other_radius: float,
     margin: float = 0.1,
+    setback: float = 0.0,
 ) -> tuple[np.ndarray, bool]:
     """Where a robot at plan point ``index`` waits for another to pass (see the module doc).
 
     plan_xy : (N, 2) the robot's plan (to its goal), costmap frame, m; own_radius,
-    other_radius : m, the two robots' safety radii; margin : m of clearance between them.
+    other_radius : m, the two robots' safety radii; margin : m of clearance between them;
+    setback : m farther back along the plan than the first wide place, while the plan stays
+    wide (a robot backing out reaches a point aside on a shallower slant: the skid steer slows
+    to turn for a heading error above ~25 degrees).
     Returns (the point (2,), m; True when it is the wide place, False when it is only the
     farthest plan point back inside the costmap).
     """
     h, w = costs.shape
     need = width_needed(own_radius, other_radius, margin)
-    reach = need
-    last_inside = plan_xy[index]
-    for i in range(index, 0, -1):
+
+    def widths(i: int) -> tuple[np.ndarray, float, float] | None:
+        """(heading, left, right) at plan point i, None outside the costmap or degenerate."""
         p = plan_xy[i]
         c = (p[0] - origin[0]) / resolution
         r = (p[1] - origin[1]) / resolution
         if not (0 <= c < w and 0 <= r < h):
-            break
-        last_inside = p
+            return None
         ahead = plan_xy[i] - plan_xy[i - 1]
         norm = float(np.hypot(*ahead))
         if norm < 1e-9:
-            continue
+            return np.zeros(2), 0.0, 0.0
         heading = ahead / norm
-        left, right = passage_width(costs, origin, resolution, p, heading, reach)
-        if left + right >= need:
-            # aside to the right (the robot faces its goal) as far as the wall allows, at most
-            # half the width needed; the other robot passes on its left, where the rest is
-            aside = max(0.0, min(right - own_radius - 0.5 * margin, need / 2.0))
-            return p + np.array([heading[1], -heading[0]]) * aside, True
+        return heading, *passage_width(costs, origin, resolution, p, heading, need)
+
+    last_inside = plan_xy[index]
+    for i in range(index, 0, -1):
+        got = widths(i)
+        if got is None:
+            break
+        last_inside = plan_xy[i]
+        heading, left, right = got
+        if left + right < need:
+            continue
+        back, seen = 0.0, True
+        for k in range(i - 1, 0, -1):
+            back += float(np.hypot(*(plan_xy[k + 1] - plan_xy[k])))
+            if back > setback:
+                break
+            further = widths(k)
+            if further is None:  # the setback runs out of the rolling window: not yet final
+                seen = False
+                break
+            if sum(further[1:]) < need:
+                break
+            if float(np.hypot(*further[0])) > 0.0:
+                i, (heading, left, right) = k, further
+        # aside to the right (the robot faces its goal) as far as the wall allows, at most
+        # half the width needed; the other robot passes on its left, where the rest is
+        aside = max(0.0, min(right - own_radius - 0.5 * margin, need / 2.0))
+        return plan_xy[i] + np.array([heading[1], -heading[0]]) * aside, seen
     return np.asarray(last_inside, dtype=np.float64).copy(), False
 
 
@@ -164,7 +255,7 @@ def retreat_velocity(
     m/s^2)."""
     to = np.asarray(target, dtype=np.float64) - xy
     d = float(np.hypot(*to))
-    if d < 0.05:
+    if d < REFUGE_TOLERANCE:
         return np.zeros(2)
     return to / d * min(max_speed, math.sqrt(2.0 * deceleration * d))
 
@@ -217,5 +308,6 @@ class Retreat:
                 costmap.resolution,
                 own_radius,
                 other_radius,
+                setback=REFUGE_SETBACK,
             )
         return retreat_velocity(xy, self.refuge, max_speed, deceleration)

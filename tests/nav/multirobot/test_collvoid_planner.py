@@ -17,6 +17,7 @@ from fleetsim.nav.move_base_plugins import LOCAL_PLANNERS
 from fleetsim.nav.multirobot.deadlock import DeadlockRule, priority_key
 from fleetsim.nav.multirobot.holonomic import (
     detour_velocity,
+    gaps_closed,
     obstacle_points,
     tracking_command,
 )
@@ -268,3 +269,32 @@ def test_a_narrow_meeting_is_stuck_after_narrow_deadlock_time_progress_or_not():
     top.update(0.0, 6.0, {"lizi1": 2.8}, narrow=["lizi1"])
     top.update(0.5, 5.7, {"lizi1": 2.8})
     assert top.update(1.2, 5.7, {"lizi1": 2.8}, narrow=["lizi1"]) is None
+
+
+def test_the_way_round_a_parked_robot_takes_the_side_a_wall_leaves_room_on():
+    """A 2 m corridor, a robot parked 0.16 m off its middle (as lizi3 on its goal in the
+    held-out corridor of 4): the way past it on the narrow side is closed by the wall, so the
+    detour takes the wide side even where the narrow side's tangent is nearer."""
+    cm = empty_map([(-8, 1.0, 8, 1.2), (-8, -1.2, 8, -1.0)])
+    grid = (cm.costs, (cm.origin_x, cm.origin_y), cm.resolution)
+    me = np.array([-1.0, 0.45])
+    parked = np.array([[1.0, -0.29]])  # at (0, 0.16), relative to us
+    closed = gaps_closed(grid, me, parked, np.array([0.65]), BODY + 0.035)
+    assert closed.tolist() == [[False, True]]  # its right (south) open, its left shut
+    pref = np.array([0.5, 0.0])  # the left tangent is the nearer turn
+    v, _ = detour_velocity(pref, parked, np.array([0.65]), 1.5)
+    assert v[1] > 0
+    v, k = detour_velocity(pref, parked, np.array([0.65]), 1.5, closed)
+    assert k == 0 and v[1] < 0
+    # in the open both ways are open
+    assert not gaps_closed(
+        (empty_map().costs, grid[1], grid[2]), me, parked, np.array([0.65]), BODY + 0.035
+    ).any()
+
+
+def test_a_robot_passes_one_parked_off_the_middle_of_a_corridor():
+    walls = [(-8, 1.0, 8, 1.2), (-8, -1.2, 8, -1.0)]
+    parked = (0.0, 0.16, 0.0)
+    f = Fleet([(-3, 0.4, 0), parked], [(3, 0.0, 0), parked], walls=walls)
+    assert f.run(40.0)
+    assert f.min_gap > 0.0 and np.all(np.abs(f.state[:, 1]) < 1.0 - BODY)

@@ -50,6 +50,7 @@ from fleetsim.nav.costmap.footprint import footprint_radii
 from fleetsim.nav.multirobot.deadlock import DeadlockRule
 from fleetsim.nav.multirobot.holonomic import (
     detour_velocity,
+    gaps_closed,
     obstacle_points,
     plan_carrot,
     preferred_velocity,
@@ -325,8 +326,9 @@ class CollvoidLocalPlanner(LocalPlanner):
         return self.retreat.velocity(self.costmap, xy, own_r, other_r, p.max_vel_x, decel)
 
     def _around_still(self, pref, xy, rel, nvel, radii, controlled) -> np.ndarray:
-        """``pref`` turned round the nearest robot standing in its way (`detour_velocity`),
-        unless that robot stands on the goal (then ORCA stops us short of it)."""
+        """``pref`` turned round the nearest robot standing in its way (`detour_velocity`) on a
+        side a wall leaves room on (`gaps_closed`), unless that robot stands on the goal (then
+        ORCA stops us short of it)."""
         still = (np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED) | ~controlled
         if not still.any():
             return pref
@@ -334,7 +336,11 @@ class CollvoidLocalPlanner(LocalPlanner):
         to_goal = self.plan[-1, :2] - xy
         free = np.hypot(*(rel[still] - to_goal).T) > r
         idx = np.flatnonzero(still)[free]
-        out, _ = detour_velocity(pref, rel[idx], radii[idx] + DETOUR_MARGIN, DETOUR_REACH)
+        r = radii[idx] + DETOUR_MARGIN
+        cm = self.costmap
+        grid = (cm.costs, (cm.origin_x, cm.origin_y), cm.resolution)
+        closed = gaps_closed(grid, xy, rel[idx], r, self.body_radius + cm.resolution * 0.71)
+        out, _ = detour_velocity(pref, rel[idx], r, DETOUR_REACH, closed)
         return out
 
     @staticmethod

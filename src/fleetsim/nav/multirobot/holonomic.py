@@ -23,6 +23,7 @@ import math
 import numpy as np
 
 from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
+from fleetsim.nav.multirobot.yielding import clear_distance
 
 
 def plan_carrot(
@@ -73,7 +74,11 @@ def rays_blocked(
 
 
 def detour_velocity(
-    pref: np.ndarray, rel_pos: np.ndarray, radii: np.ndarray, reach: float
+    pref: np.ndarray,
+    rel_pos: np.ndarray,
+    radii: np.ndarray,
+    reach: float,
+    closed: np.ndarray | None = None,
 ) -> tuple[np.ndarray, int]:
     """``pref`` turned to the nearest heading whose ray is clear of every disc within ``reach``.
 
@@ -85,8 +90,10 @@ def detour_velocity(
     oncoming traffic keeps to).
 
     pref : (2,) m/s; rel_pos : (N, 2) disc centres relative to the robot, m; radii : (N,) m
-    (combined: own + theirs + margin). Returns (the velocity (2,) m/s, same speed; the index of
-    the disc whose tangent it follows, or -1 when ``pref`` is clear or no heading is).
+    (combined: own + theirs + margin); closed : (N, 2) bool or None, the way past each disc on
+    its right, on its left (as seen from the robot) shut by a wall (`gaps_closed`): that
+    tangent is no candidate. Returns (the velocity (2,) m/s, same speed; the index of the disc
+    whose tangent it follows, or -1 when ``pref`` is clear or no heading is).
     """
     speed = float(np.hypot(*pref))
     if speed < 1e-9 or rel_pos.shape[0] == 0:
@@ -102,10 +109,40 @@ def detour_velocity(
     order = np.argsort(np.abs(turn) + 1e-6 * (turn > 0), kind="stable")
     dirs = np.stack([np.cos(heading[order]), np.sin(heading[order])], axis=1)
     free = ~rays_blocked(dirs, rel_pos, radii, reach)
+    if closed is not None:
+        shut = np.concatenate([closed[:, 0], closed[:, 1]])  # right tangents, then left
+        free &= ~shut[order]
     if not free.any():
         return pref, -1
     first = int(np.argmax(free))
     return speed * dirs[first], int(order[first] % rel_pos.shape[0])
+
+
+def gaps_closed(
+    grid: tuple[np.ndarray, tuple[float, float], float],
+    xy: np.ndarray,
+    rel_pos: np.ndarray,
+    radii: np.ndarray,
+    wall_clearance: float,
+) -> np.ndarray:
+    """(N, 2) bool: whether the way past each disc on its right, on its left (seen from the
+    robot at ``xy``) is too narrow between the disc and a wall: the lethal cells across our
+    bearing to the disc are nearer its centre than ``radii`` (combined, m) + ``wall_clearance``
+    (m, the robot's body to a wall). A robot parked off the middle of a corridor leaves room on
+    one side only; going round it on the other wedges the robot between it and the wall.
+
+    grid : (costs (H, W) uint8, origin (2,) m, resolution m); rel_pos : (N, 2) m.
+    """
+    out = np.zeros((rel_pos.shape[0], 2), dtype=bool)
+    for k, (rel, r) in enumerate(zip(rel_pos, radii)):
+        d = float(np.hypot(*rel))
+        if d < 1e-9:
+            continue
+        u = rel / d
+        need = float(r) + wall_clearance
+        for side, normal in enumerate((np.array([u[1], -u[0]]), np.array([-u[1], u[0]]))):
+            out[k, side] = clear_distance(*grid, xy + rel, normal, need) < need
+    return out
 
 
 def rotated(v: np.ndarray, angle: float) -> np.ndarray:

@@ -99,8 +99,17 @@ def footprint_cost_bounds_near(costs, offsets, cx: int, cy: int, radius: int):
     robot, a fraction of the local map; a bound of 255 only sends a pose to the exact footprint
     check, so the costs are the same whatever ``radius`` is, and this costs the window's share.
     """
+    return _bounds_near(costs, offsets, cx, cy, radius)
+
+
+@njit(cache=True)
+def _bounds_near(costs, offsets, cx, cy, radius):
+    """`footprint_cost_bounds_near`, compiled whole (it runs every control cycle of every
+    robot; its NumPy wrapper's few array calls cost as much as the block's kernel)."""
     h, w = costs.shape
-    k = int(np.abs(offsets).max()) if offsets.shape[0] else 0
+    k = 0
+    for i in range(offsets.shape[0]):
+        k = max(k, abs(offsets[i, 0]), abs(offsets[i, 1]))
     r0, r1 = max(cy - radius - k, 0), min(cy + radius + k + 1, h)
     c0, c1 = max(cx - radius - k, 0), min(cx + radius + k + 1, w)
     out = np.full((h, w), 255, dtype=np.uint8)

@@ -373,3 +373,25 @@ def test_a_callback_may_wait_again_from_inside_its_call():
     for k in range(3):
         buf.add_message(TFMessage(transforms=[msg("odom", "base_link", k + 1.0, (0, 0, 0))]))
     assert calls == [0, 1]
+
+
+def test_a_callback_waiting_on_frames_ignores_other_robots_transforms():
+    """A message filter waiting on robot 1's odom -> base_link edge is not woken by robot 2's
+    transforms (N robots' amcl x N robots' /tf), but is by its own and by a tree change."""
+    from fleetsim.msgs.tf2_msgs import TFMessage
+
+    buf = Buffer()
+    for r in ("r1", "r2"):
+        buf.add_message(TFMessage(transforms=[msg(f"{r}/odom", f"{r}/base_link", 1.0, (0, 0, 0))]))
+    edges = buf.edges_between("r1/odom", "r1/base_link")
+    assert edges == frozenset({"r1/base_link"})
+    calls = []
+    buf.call_after_next_message(lambda: calls.append("r1"), edges)
+    buf.add_message(TFMessage(transforms=[msg("r2/odom", "r2/base_link", 2.0, (0, 0, 0))]))
+    assert calls == []
+    buf.add_message(TFMessage(transforms=[msg("r1/odom", "r1/base_link", 2.0, (0, 0, 0))]))
+    assert calls == ["r1"]
+    buf.call_after_next_message(lambda: calls.append("tree"), edges)
+    buf.add_message(TFMessage(transforms=[msg("map", "r2/odom", 2.0, (0, 0, 0))]))  # new edge
+    assert calls == ["r1", "tree"]
+    assert buf.edges_between("r1/odom", "nowhere") is None  # unknown frame: wait on anything

@@ -66,7 +66,8 @@ class Buffer(TreeIntrospection):
         self._version = 0  # bumped whenever an edge of the tree appears, moves or disappears
         self._paths: dict[tuple[str, str], tuple[int, list[FrameCache], list[FrameCache]]] = {}
         self._rejected: set[tuple[str, str]] = set()  # (child, authority) already warned about
-        self._waiting: list[Callable[[], Any]] = []  # see call_after_next_message
+        # see call_after_next_message: (callback, the child frames it waits on or None: any)
+        self._waiting: list[tuple[Callable[[], Any], frozenset[str] | None]] = []
 
     # ------------------------------------------------------------------ writing
     def add_message(self, msg: Any, authority: str = "", is_static: bool = False) -> int:
@@ -74,30 +75,55 @@ class Buffer(TreeIntrospection):
         (NaN, self parent, a loop, an empty frame) is logged, naming its frame and publisher,
         and skipped; the others still go in. Returns how many were added."""
         added = 0
+        touched: set[str] = set()
+        version = self._version
         for t in msg.transforms:
             try:
                 self.set_transform(t, authority=authority, is_static=is_static)
                 added += 1
+                if self._waiting:
+                    touched.add(normalize_frame(t.child_frame_id))
             except (TransformError, InvalidName) as exc:
                 key = (str(t.child_frame_id), authority)
                 if key not in self._rejected:  # once per frame and publisher, not per message
                     self._rejected.add(key)
                     _log.error("ignoring transform for %r: %s", t.child_frame_id, exc)
         if added and self._waiting:
-            waiting, self._waiting = self._waiting, []
-            for callback in waiting:
-                callback()
+            moved = self._version != version  # the tree changed: every chain may have
+            due = [
+                w for w in self._waiting if moved or w[1] is None or not w[1].isdisjoint(touched)
+            ]
+            if due:
+                self._waiting = [w for w in self._waiting if w not in due]
+                for callback, _ in due:
+                    callback()
         return added
 
-    def call_after_next_message(self, callback: Callable[[], Any]) -> None:
-        """Call ``callback()`` once, after the next message that adds a transform.
+    def call_after_next_message(
+        self, callback: Callable[[], Any], frames: frozenset[str] | None = None
+    ) -> None:
+        """Call ``callback()`` once, after the next message that adds a transform (with
+        ``frames``: a transform to one of those child frames, see `edges_between`).
 
-        What tf2's message filters wait on (``BufferCore::addTransformableCallback``): a node
-        holding data whose transform has not arrived retries when tf changes, without each such
-        node receiving every ``/tf`` message itself (N robots' nodes x N robots' transforms).
+        What tf2's message filters wait on (``BufferCore::addTransformableCallback``, which
+        waits on its request's frames): a node holding data whose transform has not arrived
+        retries when tf changes, without each such node receiving every ``/tf`` message itself
+        (N robots' nodes x N robots' transforms); with ``frames``, without retrying on the
+        other robots' transforms either.
         """
-        if callback not in self._waiting:
-            self._waiting.append(callback)
+        if all(cb != callback for cb, _ in self._waiting):
+            self._waiting.append((callback, frames))
+
+    def edges_between(self, target_frame: str, source_frame: str) -> frozenset[str] | None:
+        """The child frames of the dynamic tf edges between two frames: the transforms a
+        lookup between them waits on. None when they are not connected yet or only static
+        edges join them (then any new transform may be the one that matters)."""
+        try:
+            down, up = self._chain(target_frame, source_frame)
+        except (TransformError, InvalidName):
+            return None
+        edges = frozenset(f.name for f in (*down, *up) if not f.is_static)
+        return edges or None
 
     def set_transform(self, transform: Any, authority: str = "", is_static: bool = False) -> bool:
         """Add one ``geometry_msgs/TransformStamped`` to the buffer.

@@ -18,15 +18,24 @@ class MessageFilter:
     """A bounded queue of messages, each handed to ``process`` once tf can answer for it.
 
     ``process(msg)`` returns False when tf cannot answer for ``msg`` yet (the message stays at
-    the head and is retried after the next tf message), True when it is done with it (used or
-    dropped). ``queue_size`` bounds the queue; the oldest message goes first, as in tf2.
+    the head and is retried after the next tf message; with ``frames(msg)`` giving the
+    (target, source) frames it needs, after the next one that moves an edge between them),
+    True when it is done with it (used or dropped). ``queue_size`` bounds the queue; the
+    oldest message goes first, as in tf2.
     """
 
-    __slots__ = ("_buffer", "_process", "queue")
+    __slots__ = ("_buffer", "_frames", "_process", "queue")
 
-    def __init__(self, buffer: Any, process: Callable[[Any], bool], queue_size: int) -> None:
+    def __init__(
+        self,
+        buffer: Any,
+        process: Callable[[Any], bool],
+        queue_size: int,
+        frames: Callable[[Any], tuple[str, str]] | None = None,
+    ) -> None:
         self._buffer = buffer
         self._process = process
+        self._frames = frames  # (target, source) a message needs: wait only on their edges
         self.queue: deque = deque(maxlen=queue_size)
 
     def __len__(self) -> int:
@@ -42,6 +51,8 @@ class MessageFilter:
         queue = self.queue
         while queue:
             if not self._process(queue[0]):
-                self._buffer.call_after_next_message(self.drain)
+                buf = self._buffer
+                edges = buf.edges_between(*self._frames(queue[0])) if self._frames else None
+                buf.call_after_next_message(self.drain, edges)
                 return
             queue.popleft()

@@ -84,7 +84,12 @@ class Amcl(Node):
         )
         self.tf_pub = TransformBroadcaster(self) if p.tf_broadcast else None
         _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now, not at the first scan
-        self._pending_scans = MessageFilter(self.tf_buffer, self._process_scan, SCAN_QUEUE_SIZE)
+        self._pending_scans = MessageFilter(
+            self.tf_buffer,
+            self._process_scan,
+            SCAN_QUEUE_SIZE,
+            frames=lambda scan: (self.odom_frame, self.base_frame),
+        )
         self.create_subscription(sensor_msgs.LaserScan, "scan", self.on_scan, queue_size=1)
         self.create_subscription(
             geometry_msgs.PoseWithCovarianceStamped, "initialpose", self.on_initial_pose, 2

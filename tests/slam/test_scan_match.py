@@ -53,9 +53,10 @@ def scan_from(pose, n=180):
     return np.minimum(tx, ty), angles
 
 
-def reference_score(maps, p, pose, ranges, angles, kernel=1, sigma=0.05, lsigma=0.075):
+def reference_score(maps, p, pose, ranges, angles, kernel=1, sigma=0.05, lsigma=0.075, reach=0.0):
     """gmapping's ``score`` and ``likelihoodAndScore``, beam by beam, cell by cell, as it runs:
-    the nearest cell with a hit in the kernel (see fleetsim.slam.scan_match on the free cell)."""
+    the nearest cell with a hit in the kernel (see fleetsim.slam.scan_match on the free cell);
+    ``reach`` > 0: the continuous score (each beam's distance capped at reach, found or not)."""
     ox, oy, delta = maps.geom
     dense = np.zeros((*maps.shape_cells, 3))
     for ty in range(maps.table.shape[1]):
@@ -81,15 +82,23 @@ def reference_score(maps, p, pose, ranges, angles, kernel=1, sigma=0.05, lsigma=
                 mu = (hx - mx, hy - my)
                 d2 = mu[0] ** 2 + mu[1] ** 2
                 best = d2 if best is None else min(best, d2)
-        if best is not None:
+        if reach > 0:
+            score += math.exp(-min(reach**2 if best is None else best, reach**2) / sigma)
+        elif best is not None:
             score += math.exp(-best / sigma)
         like += -best / lsigma if best is not None else -0.5 / lsigma
     return score, like
 
 
 @settings(max_examples=20, deadline=None, phases=[Phase.explicit, Phase.generate])
-@given(st.floats(-0.3, 0.3), st.floats(-0.3, 0.3), st.floats(-0.2, 0.2), st.floats(-0.1, 0.1))
-def test_likelihood_at_the_matched_pose_agrees_with_gmapping_score(x, y, yaw, err):
+@given(
+    st.floats(-0.3, 0.3),
+    st.floats(-0.3, 0.3),
+    st.floats(-0.2, 0.2),
+    st.floats(-0.1, 0.1),
+    st.sampled_from([0.0, 0.05]),
+)
+def test_likelihood_at_the_matched_pose_agrees_with_gmapping_score(x, y, yaw, err, reach):
     maps = room_maps()
     true = np.array([x, y, yaw])
     ranges, angles = scan_from(true)
@@ -97,11 +106,11 @@ def test_likelihood_at_the_matched_pose_agrees_with_gmapping_score(x, y, yaw, er
     # no steps and a huge minimum score: the pose stays, only score and likelihood are computed
     out, scores, likes = matched_poses(
         maps.pool, maps.table, start, LASER, ranges, angles, maps.geom, 1, 0.05, 0.075, 0,
-        0.0, 0.0, 0, 1e9,
+        0.0, 0.0, 0, 1e9, reach,
     )  # fmt: skip
     assert np.array_equal(out, start)
     for p in range(2):
-        ref_score, ref_like = reference_score(maps, p, start[p], ranges, angles)
+        ref_score, ref_like = reference_score(maps, p, start[p], ranges, angles, reach=reach)
         assert scores[p] == pytest.approx(ref_score, rel=1e-6, abs=1e-6)
         assert likes[p] == pytest.approx(ref_like, rel=1e-6, abs=1e-6)
 
@@ -132,3 +141,28 @@ def test_lskip_uses_every_nth_beam():
     _, s0, _ = matched_poses(*args, 0.05, 0.075, 0, 0.0, 0.0, 0, 1e9)
     _, s2, _ = matched_poses(*args, 0.05, 0.075, 2, 0.0, 0.0, 0, 1e9)
     assert s2[0] == pytest.approx(s0[0] / 3, rel=0.05)
+
+
+def test_the_continuous_score_has_no_jumps_where_gmappings_has():
+    # isolated hits (posts, 60 beams' endpoints) and the pose slid along x in 0.5 mm steps:
+    # gmapping's score drops by a found beam's worth (0.82-0.95) wherever a window loses its
+    # hit; the continuous one changes by no more than its slope
+    rng = np.random.default_rng(0)
+    r, a = rng.uniform(1.0, 3.0, 60), rng.uniform(-np.pi, np.pi, 60)
+    xs = np.arange(0.0, 0.08, 0.0005)
+    maps = CowTiles(len(xs), *GEOM_ARGS)
+    cells, hits = endpoint_cells(np.zeros((1, 3)), np.zeros(3), r, a, maps.geom)
+    maps.write(add_hits, np.repeat(cells, len(xs), 0), np.repeat(hits, len(xs), 0))
+    poses = np.c_[xs, np.zeros_like(xs), np.zeros_like(xs)]
+    steps, scores = {}, {}
+    for reach in (0.0, 0.05):
+        _, scores[reach], _ = matched_poses(
+            maps.pool, maps.table, poses, np.zeros(3), r, a, maps.geom, 1, 0.05, 0.075, 0,
+            0.0, 0.0, 0, 1e9, reach,
+        )  # fmt: skip
+        steps[reach] = np.abs(np.diff(scores[reach])).max()
+    assert scores[0.0][0] == pytest.approx(60.0) and scores[0.0][-1] < 30.0  # hits lost
+    assert steps[0.0] > 0.8
+    # no more than the slope allows: 60 beams x d/dd exp(-d^2/sigma) <= 2 reach/sigma, x step
+    assert steps[0.05] <= 60 * 2 * 0.05 / 0.05 * 0.0005
+    assert np.all(np.diff(scores[0.05]) <= 1e-9)  # and it falls steadily away from the hits

@@ -80,6 +80,8 @@ class GmappingFilter:
         self.last_update_time = -math.inf
         self.updates = 0
         self.neff = float(n)
+        # the continuous score's cap: the distance the kernel's window always covers
+        self.reach = p.kernelSize * p.delta if p.continuous_score else 0.0
 
     # ----- per scan -----
     def process(self, odom: np.ndarray, stamp: float, beams: Beams) -> UpdateResult:
@@ -110,7 +112,7 @@ class GmappingFilter:
             self.poses, _, likes = matched_poses(
                 self.maps.pool, self.maps.table, self.poses, self.laser, ranges, angles,
                 self.maps.geom, p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep,
-                p.iterations, p.minimumScore,
+                p.iterations, p.minimumScore, self.reach,
             )  # fmt: skip
             self.weights += likes
             self.weight_sums += likes

@@ -80,6 +80,12 @@ class GmappingParams:
     )
     ogain: float = param(3.0, range=(1e-9, None), help="smoothing of the weights")
     lskip: int = param(0, range=(0, None), help="use every (lskip+1)-th beam")
+    continuous_score: bool = param(
+        True,
+        help="fleetsim addition: a beam scores its distance to the nearest hit capped at "
+        "kernelSize*delta, so the score is continuous in the pose (false: gmapping's score, "
+        "0 for a beam with no hit in its window; see fleetsim.slam.scan_match)",
+    )
     # --- motion model ---
     srr: float = param(0.1, range=(0.0, None), help="translation noise from translation")
     srt: float = param(0.2, range=(0.0, None), help="rotation noise from translation")

@@ -104,7 +104,10 @@ def fleet(n: int, seed: int, goals_per_robot: int = 4) -> tuple[list, list]:
 
 
 def launch_xml(layer: str, starts: list, goals: list) -> str:
-    """A launch file for ``layer`` (robots, fake or amcl) with one lizi per start pose."""
+    """A launch file for ``layer`` (robots, fake or amcl; ``fake:collvoid`` or
+    ``amcl:collvoid`` with collvoid's local planner and position sharing in place of
+    TrajectoryPlannerROS) with one lizi per start pose."""
+    layer, _, planner = layer.partition(":")
     out = ["<launch>", '  <param name="/use_sim_time" value="true"/>']
     out.append(
         '  <include file="$(find gazebo_ros)/launch/empty_world.launch">'
@@ -137,7 +140,9 @@ def launch_xml(layer: str, starts: list, goals: list) -> str:
                 f'<param name="amcl/initial_pose_y" value="{y}"/>'
                 '<include file="$(find fleetsim_launch)/include/one_robot.launch">'
                 f'<arg name="init_pose" value="{pose}"/><arg name="robot_name" value="{ns}"/>'
-                f'<arg name="localization" value="{layer}"/></include>'
+                f'<arg name="localization" value="{layer}"/>'
+                + (f'<arg name="local_planner" value="{planner}"/>' if planner else "")
+                + "</include>"
             )
         out.append("  </group>")
     if layer != "robots":
@@ -380,10 +385,14 @@ def table(sizes: list[int], layers: list[str], duration: float, seed: int, repea
     )
 
 
-def soak(minutes: float, localization: str, seed: int) -> None:
+def soak(minutes: float, localization: str, seed: int, planner: str = "trajectory") -> None:
     chunks = max(2, round(minutes / 10))
-    print(f"soak: 10 lizis, {localization}, random goals, {minutes:g} sim min in {chunks} parts")
-    r = run_layer(localization, 10, minutes * 60.0, seed, chunks)
+    print(
+        f"soak: 10 lizis, {localization}, {planner} local planner, random goals, {minutes:g} "
+        f"sim min in {chunks} parts"
+    )
+    layer = localization if planner == "trajectory" else f"{localization}:{planner}"
+    r = run_layer(layer, 10, minutes * 60.0, seed, chunks)
     if "error" in r:
         print("failed:", r["error"])
         return
@@ -414,6 +423,13 @@ def main() -> None:
     ap.add_argument("--soak", action="store_true", help="the one-hour soak run instead")
     ap.add_argument("--soak-minutes", type=float, default=60.0)
     ap.add_argument("--soak-localization", choices=("fake", "amcl"), default="fake")
+    ap.add_argument(
+        "--soak-planner",
+        choices=("trajectory", "collvoid"),
+        default="trajectory",
+        help="the soak's local planner: TrajectoryPlannerROS (lizis do not see each other: "
+        "their lasers sweep above the other bodies) or collvoid (position sharing and ORCA)",
+    )
     ap.add_argument("--worker", nargs=5, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.cpu:
@@ -423,7 +439,7 @@ def main() -> None:
         print(json.dumps(worker(layer, int(n), float(duration), int(seed), int(chunks))))
         return
     if args.soak:
-        soak(args.soak_minutes, args.soak_localization, args.seed)
+        soak(args.soak_minutes, args.soak_localization, args.seed, args.soak_planner)
         return
     layers = [x for x in args.layers.split(",") if x]
     unknown = sorted(set(layers) - set(LAYERS))

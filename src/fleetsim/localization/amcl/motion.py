@@ -15,6 +15,8 @@ Backward and forward motion get the same noise (amcl's ``delta_rot*_noise``).
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from fleetsim.errors import ParameterError
@@ -29,15 +31,16 @@ def wrapped_angles(a: np.ndarray | float) -> np.ndarray | float:
 
 def angle_diff(a: float, b: float) -> float:
     """Smallest signed difference ``a - b`` in rad, in [-pi, pi] (amcl's ``angle_diff``)."""
-    d = float(wrapped_angles(a - b))
-    return d
+    # Python floats: the same floor-modulo as NumPy's remainder, without a 0-d array per call
+    # (every scan of every robot asks whether it moved enough)
+    return (float(a) - float(b) + math.pi) % (2.0 * math.pi) - math.pi
 
 
 def odometry_delta(old_pose: np.ndarray, new_pose: np.ndarray) -> np.ndarray:
     """(3,) ``(dx, dy, dyaw)`` from ``old_pose`` to ``new_pose`` in the odom frame (m, m, rad)."""
-    old = np.asarray(old_pose, dtype=float)
-    new = np.asarray(new_pose, dtype=float)
-    return np.array([new[0] - old[0], new[1] - old[1], angle_diff(new[2], old[2])])
+    ox, oy, oth = (float(v) for v in old_pose)
+    nx, ny, nth = (float(v) for v in new_pose)
+    return np.array([nx - ox, ny - oy, angle_diff(nth, oth)])
 
 
 def particles_after_odometry(

@@ -134,6 +134,24 @@ def test_hill_climbing_recovers_an_offset_pose():
     assert np.array_equal(out2, start)
 
 
+def test_the_continuous_climber_ends_between_its_last_steps():
+    # the manual's 3 halvings of astep 0.05 leave gmapping on a 6 mrad grid round its start;
+    # the continuous score's parabola through the last round's scores gets well within it
+    maps = room_maps(particles=3)
+    true = np.array([0.2, -0.1, 0.05])
+    ranges, angles = scan_from(true)
+    start = true + np.array([[0.08, -0.06, 0.04], [-0.1, 0.05, -0.03], [0.0, 0.0, 0.0]])
+    err = {}
+    for reach in (0.0, 0.05):
+        out, *_ = matched_poses(
+            maps.pool, maps.table, start, LASER, ranges, angles, maps.geom, 1, 0.05, 0.075, 0,
+            0.05, 0.05, 3, 0.0, reach,
+        )  # fmt: skip
+        err[reach] = np.abs(out - true).max(axis=0)
+    assert err[0.0][2] > 0.002  # on gmapping's grid: 2.5 mrad off
+    assert err[0.05][2] < 0.0005 and err[0.05][:2].max() < 0.0015
+
+
 def test_lskip_uses_every_nth_beam():
     maps = room_maps(particles=1)
     ranges, angles = scan_from(np.zeros(3))

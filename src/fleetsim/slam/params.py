@@ -83,8 +83,9 @@ class GmappingParams:
     continuous_score: bool = param(
         True,
         help="fleetsim addition: a beam scores its distance to the nearest hit capped at "
-        "kernelSize*delta, so the score is continuous in the pose (false: gmapping's score, "
-        "0 for a beam with no hit in its window; see fleetsim.slam.scan_match)",
+        "kernelSize*delta, so the score is continuous in the pose, and the hill climber's "
+        "pose is refined below its last step (false: gmapping's score, 0 for a beam with no "
+        "hit in its window, and its climber; see fleetsim.slam.scan_match)",
     )
     # --- motion model ---
     srr: float = param(0.1, range=(0.0, None), help="translation noise from translation")

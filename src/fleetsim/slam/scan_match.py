@@ -30,8 +30,14 @@ up along a corridor (Willow replay, noise-free motion model: 0.83 m at worst, th
 twice). With the distance capped at ``kernelSize * delta`` (the distance the window always
 covers, whatever the endpoint's place in its cell) a beam without a hit within that distance
 scores what one at the cap does: the score is continuous in the pose (a truncated least
-squares), and the same replay stays within 1.5 cm. The likelihood (the particles' weights)
-is gmapping's: beams without a hit still cost ``nullLikelihood``.
+squares), and the same replay stays within 1.5 cm. With the continuous score the climber's
+pose is also refined below its last step: its last round scored both neighbours on each axis
+lower, and the pose moves to the top of the parabola through the three scores (at most half a
+step). gmapping stops on the grid of its last step (``astep / 2^iterations``, 0.004 rad with
+the manual's parameters, 4 cm at 10 m), and those errors add up too (Willow replay with the
+manual's noise: ATE 0.06 / 0.04 / 0.03 m without the refinement, 0.01 / 0.05 / 0.03 m with,
+precision 0.91-0.96 -> 0.97-0.99, seeds 1-3). The likelihood (the particles' weights) is
+gmapping's: beams without a hit still cost ``nullLikelihood``.
 
 Geometry arguments shared by the kernels:
 ``geom = (origin_x, origin_y, delta)`` (m, m, m/cell) of cell (0, 0)'s corner;
@@ -126,6 +132,17 @@ def _match(pool, table, p, pose, laser, ex, ey, geom, kernel, sigma, lsigma, ski
     return score, like
 
 
+@numba.njit(cache=True, inline="always")
+def _vertex(below, centre, above, step):
+    """Offset (in step's unit) of the top of the parabola through the scores ``below``,
+    ``centre``, ``above`` at -step, 0, +step; within half a step when centre is the highest,
+    0 when the three are flat."""
+    curve = below - 2.0 * centre + above
+    if curve >= 0.0:
+        return 0.0
+    return 0.5 * step * (below - above) / curve
+
+
 @numba.njit(cache=True)
 def matched_poses(
     pool, table, poses, laser, ranges, angles, geom, kernel, sigma, lsigma, skip,
@@ -139,8 +156,9 @@ def matched_poses(
     pool : (T, TILE, TILE, 3) float32, the shared tiles; table : (P, TY, TX) int32.
     poses : (P, 3) float64, the particles' sampled base poses in the map frame (m, m, rad).
     reach : m; > 0 scores with the continuous score (a beam's distance to its nearest hit
-        capped at ``reach``), 0 with gmapping's (a beam without a hit in its window scores 0).
-        The likelihood is gmapping's either way.
+        capped at ``reach``) and refines the climber's last pose by a parabola through the last
+        round's scores; 0: gmapping's score and climber (a beam without a hit in its window
+        scores 0). The likelihood is gmapping's either way.
 
     Returns
     -------
@@ -152,6 +170,7 @@ def matched_poses(
     scores = np.zeros(n)
     likes = np.zeros(n)
     cand = np.empty(3)
+    move_scores = np.empty(6)  # the round's score of each move (+x, -x, -y, +y, +yaw, -yaw)
     ex, ey = ranges * np.cos(angles), ranges * np.sin(angles)
     for p in range(n):
         cur = poses[p].copy()
@@ -175,6 +194,7 @@ def matched_poses(
         ld, ad = lstep, astep
         refinement = 0
         back = -1  # the move leading back to the last round's pose (no better: not scored)
+        back_score = -1.0
         while True:
             if best_score >= cur_score:
                 refinement += 1
@@ -185,6 +205,7 @@ def matched_poses(
             taken = -1
             for move in range(6):
                 if move == back:
+                    move_scores[move] = back_score
                     continue
                 cand[0], cand[1], cand[2] = cur[0], cur[1], cur[2]
                 if move == 0:
@@ -203,16 +224,25 @@ def matched_poses(
                     pool, table, p, cand, laser, ex, ey, geom, kernel, sigma,
                     lsigma, skip, reach, False,
                 )  # fmt: skip
+                move_scores[move] = sc
                 if sc > cur_score:
                     cur_score = sc
                     best_local[:] = cand
                     taken = move
             cur[:] = best_local
+            if taken >= 0:
+                back_score = best_score  # the pose left behind
             back = taken ^ 1 if taken >= 0 else -1  # moves come in opposite pairs
             if not (cur_score > best_score or refinement < iterations):
                 break
         if best_score > minimum_score:
             out[p] = cur
+            if reach > 0.0:
+                # the last round scored every neighbour lower: the top of the parabola through
+                # each axis' three scores (within half a step of the climber's pose)
+                out[p, 0] += _vertex(move_scores[1], best_score, move_scores[0], ld)
+                out[p, 1] += _vertex(move_scores[2], best_score, move_scores[3], ld)
+                out[p, 2] += _vertex(move_scores[5], best_score, move_scores[4], ad)
         scores[p] = best_score
         _, likes[p] = _match(
             pool,

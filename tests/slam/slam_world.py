@@ -88,7 +88,11 @@ def drive(waypoints, rng, speed=0.5, turn=1.0, dt=0.1, odom_noise=0.02, odom_bia
 class FakeRobot(Node):
     """Drives ``route``; odometry tf, a static laser tf and scans at 10 Hz."""
 
-    def __init__(self, rt, ns="/", route=ROUTE, seed=0, beams=360, laser_rpy=(0.0, 0.0, 0.0)):
+    def __init__(
+        self, rt, ns="/", route=ROUTE, seed=0, beams=360, laser_rpy=(0.0, 0.0, 0.0),
+        laser_tf_at=0.0,
+    ):  # fmt: skip
+        """``laser_tf_at``: sim time (s) the static laser transform is sent at (None: never)."""
         super().__init__(rt, "fake_robot", ns)
         self.rng = np.random.default_rng(seed)
         self.steps = drive(np.asarray(route, float), self.rng)
@@ -98,9 +102,21 @@ class FakeRobot(Node):
         self.tf = TransformBroadcaster(self)
         r, p, y = laser_rpy
         q = _quat(r, p, y)
-        StaticTransformBroadcaster(self).send_transform(
-            make_transform_stamped(self.frame("base_link"), self.frame("laser"), 0.0, LASER, q)
+        laser_tf = make_transform_stamped(
+            self.frame("base_link"), self.frame("laser"), 0.0, LASER, q
         )
+        if laser_tf_at == 0.0:
+            StaticTransformBroadcaster(self).send_transform(laser_tf)
+        elif laser_tf_at is not None:
+            static = StaticTransformBroadcaster(self)
+
+            def send_laser_tf():
+                if self.now() >= laser_tf_at and not self._laser_sent:
+                    static.send_transform(laser_tf)
+                    self._laser_sent = True
+
+            self._laser_sent = False
+            self.create_timer(0.05, send_laser_tf)
         self.flip = r != 0.0
         self.scan_pub = self.create_publisher(sensor_msgs.LaserScan, "scan", queue_size=1)
         self.create_timer(0.1, self.tick, priority=-50)

@@ -149,6 +149,28 @@ def test_missing_odometry_tf_is_reported_naming_the_frames(caplog):
     assert "no odometry for the scans on /scan: cannot look up odom -> base_link" in caplog.text
 
 
+def test_scans_wait_for_a_late_laser_transform_and_a_missing_one_is_reported(caplog):
+    # a static laser transform sent after the first scans (a static_transform_publisher that
+    # starts later): the scans wait for it, quietly, as gmapping's tf::MessageFilter does
+    rt = Runtime(seed=0)
+    FakeRobot(rt, laser_tf_at=0.3)
+    slam = SlamGmapping(rt)
+    with caplog.at_level(logging.WARNING):
+        rt.run(duration=2.0)
+    assert slam.filter is not None and slam.filter.updates >= 1
+    assert not caplog.records, [r.getMessage() for r in caplog.records]
+    # one that never comes is reported after a second, naming the topic and both frames
+    rt = Runtime(seed=0)
+    FakeRobot(rt, laser_tf_at=None)
+    slam = SlamGmapping(rt)
+    with caplog.at_level(logging.WARNING):
+        rt.run(duration=2.0)
+    assert slam.filter is None
+    assert "cannot place the laser of /scan: no transform from base_link to its frame 'laser'" in (
+        caplog.text
+    )
+
+
 def test_dynamic_map_before_any_scan_is_a_clear_error():
     rt = Runtime(seed=0)
     SlamGmapping(rt)

@@ -44,7 +44,7 @@ from .filter import Beams, GmappingFilter
 from .params import GmappingParams, gmapping_params
 
 SCAN_QUEUE_SIZE = 5  # gmapping's tf::MessageFilter queue
-TF_GRACE = 1.0  # s of sim time before missing odometry tf is reported
+TF_GRACE = 1.0  # s of sim time before missing odometry or laser tf is reported
 DEFAULT_SIM_PERIOD = 0.01  # s: the simulator's publish period when no simulator node is found
 
 
@@ -140,6 +140,11 @@ class SlamGmapping(Node):
             if self.filter is None:
                 self._start(scan)
             beams = self._beams(scan)
+        except _NoLaserTransform as err:
+            if self.now() < TF_GRACE:  # the laser's (static) transform is on its way: wait
+                return False
+            self._warn_once(f"scan:{err}", str(err))
+            return True
         except SlamError as err:
             self._warn_once(f"scan:{err}", str(err))
             return True
@@ -161,7 +166,7 @@ class SlamGmapping(Node):
         try:
             tf = self.tf_buffer.lookup_transform(self.base_frame, frame, 0.0).transform
         except FleetsimError as err:
-            raise SlamError(
+            raise _NoLaserTransform(
                 f"cannot place the laser of {self.scan_topic}: no transform from "
                 f"{self.base_frame} to its frame '{frame}' ({err})"
             ) from None
@@ -244,3 +249,7 @@ class SlamGmapping(Node):
                 f"{self.full_name}: no map yet (no scan processed on {self.scan_topic})"
             )
         return nav_msgs.GetMap.Response(map=self.grid_msg)
+
+
+class _NoLaserTransform(SlamError):
+    """The laser's frame is not (yet) in tf: scans wait for it for TF_GRACE of sim time."""

@@ -156,6 +156,26 @@ def test_me_publisher_rejects_a_bad_footprint_parameter():
         MePublisher(rt, "me_publisher", "/lizi1", params={"footprint": [[0, 0]]})
 
 
+def test_me_publisher_takes_the_named_costmaps_footprint():
+    rt = Runtime()
+    cm = "/lizi1/move_base_node/local_costmap"
+    rt.params.set(f"{cm}/footprint", [[-0.19, -0.16], [-0.19, 0.16], [0.19, 0.16], [0.19, -0.16]])
+    rt.params.set(f"{cm}/footprint_padding", 0.01)
+    me = MePublisher(
+        rt, "me_publisher", "/lizi1", params={"costmap": "move_base_node/local_costmap"}
+    )
+    assert me.footprint.max(axis=0) == pytest.approx((0.2, 0.17))
+    rt.params.set("/lizi2/move_base_node/local_costmap/robot_radius", 0.15)
+    me2 = MePublisher(
+        rt, "me_publisher", "/lizi2", params={"costmap": "move_base_node/local_costmap"}
+    )
+    assert me2.robot_radius == pytest.approx(0.15, abs=0.01)
+    with pytest.raises(Exception, match="lizi3/move_base_node/local_costmap has neither"):
+        MePublisher(
+            rt, "me_publisher", "/lizi3", params={"costmap": "move_base_node/local_costmap"}
+        )
+
+
 def test_me_publisher_is_controlled_only_while_move_base_has_a_goal():
     from fleetsim.msgs import actionlib_msgs
 

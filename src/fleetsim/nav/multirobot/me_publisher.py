@@ -4,8 +4,9 @@ Every ``1 / publish_me_frequency`` s the node looks up its base in ``global_fram
 and publishes a `collvoid_msgs.PoseTwistWithCovariance`:
 
 * ``robot_id``: ``~name``, else the robot's ``tf_prefix``, else its namespace without slashes;
-* ``footprint``: ``~footprint`` (``[[x, y], ...]``, robot frame; else a ``~robot_radius`` circle)
-  padded by the localization uncertainty, ``radius`` its circumscribed radius;
+* ``footprint``: ``~footprint`` (``[[x, y], ...]``, robot frame; else the footprint of the
+  costmap ``~costmap`` names, a fleetsim addition; else a ``~robot_radius`` circle) padded by
+  the localization uncertainty, ``radius`` its circumscribed radius;
 * the uncertainty: from the latest ``particlecloud`` (amcl's PoseArray, relative name, so it is
   ``/lizi1/particlecloud``): the distance from the estimate within which ``1 - eps`` of the
   particles lie, capped at twice the robot radius (`uncertainty_radius`). fake_localization's
@@ -25,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from fleetsim.errors import TransformError
+from fleetsim.errors import ParameterError, TransformError
 from fleetsim.msgs import actionlib_msgs, collvoid_msgs, geometry_msgs, nav_msgs
 from fleetsim.nav.costmap.footprint import (
     footprint_from_param,
@@ -63,6 +64,12 @@ class MePublisherParams:
     robot_radius: float = param(
         0.2, unit="m", range=(0.0, None), help="circular robot when no footprint is given"
     )
+    costmap: str = param(
+        "",
+        help="a costmap's namespace (e.g. move_base_node/local_costmap) whose footprint, "
+        "footprint_padding or robot_radius is shared when ~footprint is not given (fleetsim "
+        "addition: collvoid's planner-side agent takes its local costmap's footprint)",
+    )
 
 
 class MePublisher(Node):
@@ -73,11 +80,7 @@ class MePublisher(Node):
     def __init__(self, runtime, name: str = "me_publisher", namespace: str = "/", **kw: Any):
         super().__init__(runtime, name, namespace, **kw)
         p: MePublisherParams = self.params
-        fp_value = p.footprint
-        if isinstance(fp_value, str) and fp_value.strip() in ("", "[]"):
-            self.footprint = footprint_from_radius(p.robot_radius)
-        else:
-            self.footprint = footprint_from_param(fp_value, f"{self.full_name}/footprint")
+        self.footprint = self._footprint(p)
         self.robot_radius = footprint_radii(self.footprint)[1]
         self.robot_id = p.name or self.tf_prefix or self.namespace.strip("/").replace("/", "_")
         self.base_frame = resolve_frame_once(self.tf_prefix, p.base_frame)
@@ -94,6 +97,28 @@ class MePublisher(Node):
         )
         _ = self.tf_buffer
         self.create_timer(1.0 / p.publish_me_frequency, self.publish_me)
+
+    def _footprint(self, p: MePublisherParams) -> np.ndarray:
+        """``~footprint``; else the footprint of the costmap ``~costmap`` names (its
+        ``footprint`` padded by ``footprint_padding``, or its ``robot_radius``); else a
+        ``~robot_radius`` circle."""
+        if not (isinstance(p.footprint, str) and p.footprint.strip() in ("", "[]")):
+            return footprint_from_param(p.footprint, f"{self.full_name}/footprint")
+        if p.costmap:
+            ns = p.costmap.rstrip("/")
+            value = self.get_param(f"{ns}/footprint")
+            if value is not None and not (isinstance(value, str) and value.strip() in ("", "[]")):
+                where = f"{self.resolve_name(ns)}/footprint (~costmap)"
+                padding = float(self.get_param(f"{ns}/footprint_padding", 0.0))
+                return padded_footprint(footprint_from_param(value, where), padding)
+            radius = self.get_param(f"{ns}/robot_radius")
+            if radius is None:
+                raise ParameterError(
+                    f"{self.full_name}: ~costmap is {p.costmap!r}, but "
+                    f"{self.resolve_name(ns)} has neither a footprint nor a robot_radius"
+                )
+            return footprint_from_radius(float(radius))
+        return footprint_from_radius(p.robot_radius)
 
     def on_cloud(self, msg: Any) -> None:
         self._particles = np.array(

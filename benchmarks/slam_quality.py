@@ -111,14 +111,18 @@ def report(name, slam, truth, est, true, times, wall, sim_s, route_range=None) -
           f" ms ({len(ut)} updates, 20 particles, 720 beams; CPU time)")  # fmt: skip
 
 
-def sample(s, est, true, model: str = "robocluedo_robot", base: str = "base_link") -> None:
+def sample(
+    s, est, true, model: str = "robocluedo_robot", base: str = "base_link", frame: str = "map"
+) -> None:
     pos, _ = s.monitor.sim.engine.model_pose(model)
-    est.append(s.runtime.tf_buffer.lookup_pose2d("map", base, 0.0)[:2])
+    est.append(s.runtime.tf_buffer.lookup_pose2d(frame, base, 0.0)[:2])
     true.append((float(pos[0]), float(pos[1])))
 
 
-def office(max_time: float, seed: int, robots: int = 1) -> float:
-    """Explore the office with ``robots`` hunters (slam_explore robots:=N); the sim time it took."""
+def office(max_time: float, seed: int, robots: int = 1, robot: str = "hunter") -> float:
+    """Explore the office with ``robots`` robots (slam_explore robots:=N robot:=...); the sim
+    time it took. One hunter is the manual's hunter_run (no namespace), any other robot runs in
+    namespaces ``<robot>1``, ``<robot>2``."""
     import fleetsim
     from fleetsim.cli.launch import resolve_launch_file
     from fleetsim.launch.runner import LaunchSession, load_plan
@@ -126,25 +130,30 @@ def office(max_time: float, seed: int, robots: int = 1) -> float:
 
     truth = load_map(Path(fleetsim.__file__).parent / "assets" / "maps" / "office.yaml")
     t0 = time.perf_counter()
-    plan = load_plan(resolve_launch_file("slam_explore"), {"robots": str(robots)})
-    names = [""] if robots == 1 else [f"hunter{i + 1}" for i in range(robots)]
+    plan = load_plan(resolve_launch_file("slam_explore"), {"robots": str(robots), "robot": robot})
+    alone = robots == 1 and robot == "hunter"
+    names = [""] if alone else [f"{robot}{i + 1}" for i in range(robots)]
     with update_timer() as times, LaunchSession(plan, seed=seed) as s:
         explorers = [s.nodes[f"/{n}/explore".replace("//", "/")] for n in names]
         est, true = [[] for _ in names], [[] for _ in names]
         while not all(ex.finished for ex in explorers) and s.runtime.now() < max_time:
             s.runtime.run(duration=1.0)
             for i, n in enumerate(names):
-                if n:
-                    sample(s, est[i], true[i], n, f"{n}/base_link")
+                if n:  # alone, the robot's own map frame; two: the merged map's
+                    frame = f"{n}/map" if robots == 1 else "map"
+                    sample(s, est[i], true[i], n, f"{n}/base_link", frame)
                 else:
                     sample(s, est[i], true[i])
         explored_at = s.runtime.now()
-        slam = s.nodes["/slam_gmapping"].grid_msg if robots == 1 else s.nodes["/map_merge"].merged
+        if robots == 1:
+            slam = s.nodes[f"/{names[0]}/slam_gmapping".replace("//", "/")].grid_msg
+        else:
+            slam = s.nodes["/map_merge"].merged
     state = ", ".join(
-        f"{n or 'hunter'}: finished={ex.finished} blacklisted={len(ex.blacklist)}"
+        f"{n or robot}: finished={ex.finished} blacklisted={len(ex.blacklist)}"
         for n, ex in zip(names, explorers)
     )
-    print(f"office ({robots} hunter(s) explore, seed {seed}): {state}")
+    print(f"office ({robots} {robot}(s) explore, seed {seed}): {state}")
     if robots > 1:
         from fleetsim.slam.quality import ate
 
@@ -319,6 +328,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--max-time", type=float, default=1500.0)
     ap.add_argument("--seeds", default="1", help="comma-separated runtime seeds, run in turn")
+    ap.add_argument("--robot", default="hunter", help="office1: the robot (hunter or lizi)")
     ap.add_argument(
         "--only", choices=["update", "office", "office1", "office2", "willow"], default=None
     )
@@ -328,7 +338,7 @@ def main() -> None:
         update_30x360()
     for seed in seeds:
         if a.only in (None, "office", "office1", "office2"):
-            one = office(a.max_time, seed) if a.only != "office2" else None
+            one = office(a.max_time, seed, robot=a.robot) if a.only != "office2" else None
             two = office(a.max_time, seed, robots=2) if a.only != "office1" else None
             if one is not None and two is not None:
                 print(f"two hunters explored the office in {two / one:.0%} of one hunter's time")

@@ -118,6 +118,34 @@ def test_slam_explore_two_hunters_explore_through_the_merged_map(caplog, tmp_pat
     assert not Path("MUJOCO_LOG.TXT").exists()
 
 
+@pytest.mark.scenario
+def test_slam_explore_with_a_lizi_maps_in_its_own_frame(caplog, tmp_path):
+    # robot:=lizi alone: in namespace lizi1, its gmapping on base_scan (a 270-degree laser 1 m
+    # up, published by a static transform that may come after the first scan), its global
+    # costmap in lizi1/map (the lizi's file names the shared /map of its amcl scenarios)
+    out = tmp_path / "lizi_slam"
+    plan = load_plan(resolve_launch_file("slam_explore"), {"robot": "lizi", "map_out": str(out)})
+    with caplog.at_level(logging.WARNING), LaunchSession(plan, seed=1) as s:
+        s.runtime.run(duration=20.0)
+        ex = s.nodes["/lizi1/explore"]
+        slam = s.nodes["/lizi1/slam_gmapping"]
+        grid = slam.grid_msg
+        costmap = s.nodes["/lizi1/move_base"].global_costmap
+        pos = s.monitor.sim.engine.model_pose("lizi1")[0]
+        est = s.runtime.tf_buffer.lookup_pose2d("lizi1/map", "lizi1/base_link", 0.0)
+    assert grid.header.frame_id == "lizi1/map" and costmap.global_frame == "lizi1/map"
+    assert slam.filter.updates > 5 and ex.goals_sent >= 2 and not ex.finished
+    assert math.hypot(pos[0] - 4.0, pos[1] - 10.0) > 3.0  # it drove off
+    # the map frame starts on the odometry's, i.e. the world's: the estimate is the true pose
+    assert math.hypot(est[0] - pos[0], est[1] - pos[1]) < 0.15
+    known = np.count_nonzero(np.asarray(grid.data) >= 0) * grid.info.resolution**2
+    assert known > 100.0  # m^2 mapped
+    saved = load_map(out.with_suffix(".yaml"))  # map_saver reads lizi1/map
+    assert saved.data.shape == (grid.info.height, grid.info.width)
+    assert not caplog.records, [r.getMessage() for r in caplog.records]
+    assert not Path("MUJOCO_LOG.TXT").exists()
+
+
 class GoalSink(Node):
     """A move_base that accepts every goal and never finishes one."""
 

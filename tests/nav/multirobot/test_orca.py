@@ -143,3 +143,14 @@ def test_static_neighbour_is_walked_around():
     final, gap, path = simulate([(-3, 0.0)], [(3, 0.0)], static=[(0.0, 0.05)])
     assert np.allclose(final, [(3, 0)], atol=0.05)
     assert gap >= -1e-3 and path[0] > 6.0
+
+
+def test_lines_differing_by_rounding_alone_stay_feasible():
+    """Two neighbours 1e-14 m apart (hypothesis found it): their half-planes are parallel and
+    one lies beyond the other by rounding only; the program must not call that infeasible."""
+    v = np.array([0.1, 0.0])
+    rel = np.array([[1.0, 1.0424538626254102e-14], [1.0, 0.0]])
+    rel_vel = v - np.array([[0.0, 0.0], [0.0, 1.0424538626254102e-14]])
+    pts, dirs = orca_halfplanes(rel, rel_vel, np.full(2, 0.5), v, 2.0, 0.1, 0.5)
+    got, feasible = orca_velocity(pts, dirs, 1.5, np.array([2.0, 2.0]))
+    assert feasible and inside(pts, dirs, got, 1e-6)

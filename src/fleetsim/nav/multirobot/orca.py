@@ -24,6 +24,8 @@ import numba
 import numpy as np
 
 RVO_EPSILON = 1e-5
+#: m/s a (nearly) parallel line may lie on the wrong side of another by rounding alone
+PARALLEL_SLACK = 1e-9
 
 
 def orca_halfplanes(
@@ -108,7 +110,10 @@ def _lp1(P, D, n, radius, opt, direction_opt, result):
         den = _det(D[n, 0], D[n, 1], D[i, 0], D[i, 1])
         num = _det(D[i, 0], D[i, 1], P[n, 0] - P[i, 0], P[n, 1] - P[i, 1])
         if abs(den) <= RVO_EPSILON:
-            if num < 0.0:
+            # (nearly) parallel: line n lies on the wrong side of line i. RVO2 tests num < 0;
+            # two neighbours 1e-14 m apart give lines that differ by rounding only, and that
+            # made a feasible program infeasible (found by the grid-search property test)
+            if num < -PARALLEL_SLACK:
                 return False
             continue
         t = num / den

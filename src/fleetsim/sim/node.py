@@ -27,6 +27,7 @@ from fleetsim.sim.plugins.base import (
     ScanReading,
 )
 from fleetsim.sim.plugins.camera import CameraPlugin
+from fleetsim.sim.plugins.laser import LaserPlugin
 from fleetsim.sim.plugins.ros_control import start_controller_managers
 from fleetsim.sim.services import WorldServices
 from fleetsim.sim.world import WALL_HEIGHT
@@ -144,6 +145,10 @@ class Simulator(Node):
                     p.depth_wanted = lambda topics=depth: self._has_subscribers(topics)
                 topics = [self.topic(entry, p.topic(n)) for n in names] + depth
                 p.wanted = lambda topics=topics: self._has_subscribers(topics)
+            elif isinstance(p, LaserPlugin):
+                # as gazebo_ros_laser: cast only while someone subscribes to the scans
+                scan = self._publisher(self.topic(entry, p.params.topicName), sensor_msgs.LaserScan)
+                p.wanted = lambda topic=scan.topic: bool(topic.subscriptions)
         # gazebo_ros_control: the robot's controller_manager, destroyed with the model
         subs.extend(start_controller_managers(self, entry))
         self._subs[entry.name] = subs

@@ -141,10 +141,18 @@ class SensorSchedule:
             for r, p in zip(readings, group):
                 r.namespace = p.ctx.namespace
                 out.append(r)
-        lasers = self.lasers[due[self.lasers]]
-        if len(lasers):
-            group = [plugins[i] for i in lasers.tolist()]
+        # lasers nobody listens to cast nothing (their due times still advance, as an inactive
+        # Gazebo sensor's update clock does)
+        due_lasers = self.lasers[due[self.lasers]].tolist()
+        group = [plugins[i] for i in due_lasers if _wanted(plugins[i])]
+        if group:
             for r, p in zip(engine.lasers.measure(engine, group, t), group):
                 r.namespace = p.ctx.namespace
                 out.append(r)
         return out
+
+
+def _wanted(plugin: Any) -> bool:
+    """Whether a sensor's output has a reader (``plugin.wanted``: None means always)."""
+    wanted = getattr(plugin, "wanted", None)
+    return wanted is None or wanted()

@@ -4,7 +4,8 @@ Beam geometry comes from the enclosing ``<sensor type="ray">``: ``scan/horizonta
 min_angle, max_angle; ``range`` min, max; ``noise`` gaussian mean, stddev; ``update_rate``.
 Rays are cast in the horizontal plane at the sensor's height, along its heading; the casting (and
 the noise) is batched over all lasers by ``fleetsim.sim.lasers.LaserBatch``. No hit within
-range: ``inf``.
+range: ``inf``. Under the simulator node a laser casts only while its topic has a subscriber,
+as gazebo_ros_laser activates its sensor on the first connection.
 """
 
 from __future__ import annotations
@@ -49,6 +50,10 @@ def _num(d: dict, path: str, default: float, where: str) -> float:
 class LaserPlugin(SensorPlugin):
     Params = LaserParams
     is_laser = True
+    #: set by the simulator node: True while the scan topic has a subscriber (None: always
+    #: cast). As gazebo_ros_laser ("sensor generation off by default", on while connected),
+    #: a laser nobody listens to casts no rays and draws no noise.
+    wanted = None
 
     def __init__(self, ctx, spec, sensor=None) -> None:
         super().__init__(ctx, spec, sensor)

@@ -7,19 +7,23 @@ For each fleet size N (default 1, 3, 10, 30, 100) one row per layer, side by sid
 - ``robots``: the robots alone through a launch file (simulator node, spawn_model,
   joint_state_publisher, robot_state_publisher, the laser's static transform: plugins and their
   messages, no navigation nodes);
+- ``scans``: the robots alone with a reader of every lizi's ``base_scan`` in the benchmark's
+  process (the simulator casts a laser only while its scan topic has a subscriber, as
+  gazebo_ros_laser; the stacks' costmaps and amcl subscribe, so this is the robots' share of a
+  stack);
 - ``fake``: the whole stack with fake_localization (move_base + fake_localization per robot,
   map_server, send_goals looping over random reachable goals);
 - ``amcl``: the same with amcl instead of fake_localization;
 
-with each one's ratio to ``robots`` (measured in the same invocation: this shared 2-core
-machine's speed swings by up to 2x from one minute to the next, so ratios within one run are the
-figure to compare), memory per robot (resident set growth over the run, from before the launch
-to its end; per added robot over the smallest fleet measured, so that the modules and kernels
-loaded once do not count, and for the smallest fleet the whole growth divided by N) and, when
-``ir-sim`` is installed (``pip install fleetsim[bench]``),
-IR-SIM's real-time factor for comparable robots (diff drive, 360-beam 2D lidar at every step)
-on the same map. Every run is a fresh subprocess, so that memory and caches do not leak from
-one row into the next. WARNING lines logged by a run are counted and the first one is shown.
+with each one's ratio to ``robots`` and the stacks' to ``scans`` (measured in the same
+invocation: this shared 2-core machine's speed swings by up to 2x from one minute to the next,
+so ratios within one run are the figure to compare), memory per robot (resident set growth over
+the run, from before the launch to its end; per added robot over the smallest fleet measured, so
+that the modules and kernels loaded once do not count, and for the smallest fleet the whole
+growth divided by N) and, when ``ir-sim`` is installed (``pip install fleetsim[bench]``), IR-
+SIM's real-time factor for comparable robots (diff drive, 360-beam 2D lidar at every step) on
+the same map. Every run is a fresh subprocess, so that memory and caches do not leak from one
+row into the next. WARNING lines logged by a run are counted and the first one is shown.
 
 Targets (issue 14) at N = 10: robots >= 10x real time, fake >= 0.6 of robots, amcl >= 0.4;
 at N = 100 both whole stacks >= 1x.
@@ -53,7 +57,7 @@ from scipy import ndimage
 
 ROOT = Path(__file__).resolve().parent.parent
 WILLOW = ROOT.parent / "shared" / "data" / "maps" / "willow-full.yaml"
-LAYERS = ("engine", "robots", "fake", "amcl", "irsim")
+LAYERS = ("engine", "robots", "scans", "fake", "amcl", "irsim")
 #: free-space clearance of start poses and goals, m (the lizi's radius is about 0.2 m)
 CLEARANCE = 0.6
 #: sim seconds IR-SIM runs at most (100 of its robots take minutes per sim second)
@@ -108,6 +112,7 @@ def launch_xml(layer: str, starts: list, goals: list) -> str:
     ``amcl:collvoid`` with collvoid's local planner and position sharing in place of
     TrajectoryPlannerROS) with one lizi per start pose."""
     layer, _, planner = layer.partition(":")
+    layer = "robots" if layer == "scans" else layer
     out = ["<launch>", '  <param name="/use_sim_time" value="true"/>']
     out.append(
         '  <include file="$(find gazebo_ros)/launch/empty_world.launch">'
@@ -221,6 +226,16 @@ def measure_launch(layer: str, n: int, duration: float, seed: int, chunks: int =
         path = Path(tmp) / f"fleet_{layer}_{n}.launch"
         path.write_text(launch_xml(layer, starts, goals))
         with LaunchSession(load_plan(path), seed=seed) as s:
+            if layer == "scans":
+                from fleetsim.msgs import sensor_msgs
+
+                got = [0]
+
+                def count(_msg) -> None:
+                    got[0] += 1
+
+                for i in range(n):
+                    s.runtime.graph.subscribe(f"/lizi{i}/base_scan", sensor_msgs.LaserScan, count)
             s.run(duration=WARMUP)
             per_chunk = []
             for _ in range(chunks):
@@ -343,6 +358,8 @@ def table(sizes: list[int], layers: list[str], duration: float, seed: int, repea
     )
     head = f"{'N':>4}" + "".join(f"{name:>9}" for name in layers)
     head += "  " + "".join(f"{name + '/rob':>10}" for name in layers if name != "robots")
+    if "scans" in layers:
+        head += "".join(f"{name + '/scans':>11}" for name in layers if name in ("fake", "amcl"))
     head += "   MB per robot (" + ", ".join(layers) + ")"
     print(head)
     notes: list[str] = []
@@ -362,12 +379,17 @@ def table(sizes: list[int], layers: list[str], duration: float, seed: int, repea
                     f"N={n} {layer}: {r['warnings']} warnings, first: {r['first_warnings'][0]}"
                 )
         base = res.get("robots", {}).get("rtf")
+        scans = res.get("scans", {}).get("rtf")
         row += "  "
         for layer in layers:
             if layer == "robots":
                 continue
             rtf = res[layer].get("rtf")
             row += f"{rtf / base:>10.2f}" if rtf and base else f"{'-':>10}"
+        for layer in layers:
+            if layer in ("fake", "amcl") and "scans" in layers:
+                rtf = res[layer].get("rtf")
+                row += f"{rtf / scans:>11.2f}" if rtf and scans else f"{'-':>11}"
         mem = []
         for layer in layers:
             mb = res[layer].get("mb")

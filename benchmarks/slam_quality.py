@@ -26,7 +26,9 @@ ground truth along a path that keeps 0.3 m from the walls (move_base is left out
 get the hunter along the west corridor, and this measures SLAM); the same figures, the recall
 over the true walls a 360-degree laser of the hunter's range (9.99 m) sees from the route.
 
-The Willow drive is not deterministic from run to run (the scripted driver's commands).
+Every part is deterministic: the same seed gives the same figures (the Willow driver reads
+the simulator's pose every 0.1 sim s; two runs of seed 1 gave the same map and trajectory; an
+earlier note here said otherwise, measured across code changes).
 
 Usage: python benchmarks/slam_quality.py [--max-time 1500] [--seeds 1,2,3]
        [--only update|office|office1|office2|willow]

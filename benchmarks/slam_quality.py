@@ -27,8 +27,8 @@ get the hunter along the west corridor, and this measures SLAM); the same figure
 over the true walls a 360-degree laser of the hunter's range (9.99 m) sees from the route.
 
 Every part is deterministic: the same seed gives the same figures (the Willow driver reads
-the simulator's pose every 0.1 sim s; two runs of seed 1 gave the same map and trajectory; an
-earlier note here said otherwise, measured across code changes).
+the simulator's pose every 0.1 sim s; two runs of seed 1 gave the same figures; an earlier
+note here said the drive was not deterministic, which the current code does not show).
 
 Usage: python benchmarks/slam_quality.py [--max-time 1500] [--seeds 1,2,3]
        [--only update|office|office1|office2|willow]

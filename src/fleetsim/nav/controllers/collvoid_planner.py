@@ -20,12 +20,17 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    responsibility, all of it for a robot that is not ``controlled``, stands still or is yielded
    to), and one per static obstacle point of the local costmap (the nearest lethal cell per
    bearing sector, horizon ``time_horizon_obst``, full responsibility, kept hard when the
-   program is infeasible);
+   program is infeasible; the robot's circumscribed disc, or its inscribed one where the
+   walls leave that disc no way on);
 5. the linear program gives the holonomic velocity nearest the preferred one; a differential
    drive tracks it (`tracking_command`, ``time_to_holo``) within ``acc_lim_x``/``acc_lim_theta``,
    its forward speed cut to what the same half-planes admit along its heading
    (`speed_along_heading`), so that turning towards a safe velocity never drives it somewhere
-   unsafe;
+   unsafe; a differential drive's command is then rolled out for ``time_horizon_obst`` with
+   the real footprint on the local costmap and, if that touches a lethal cell, replaced by
+   the clear command that best follows the holonomic velocity
+   (`fleetsim.nav.multirobot.footprint_check`: collvoid checks static obstacles with the
+   footprint, base_local_planner-style, and keeps its velocity obstacles for the robots);
 6. within ``xy_goal_tolerance`` the robot stops and turns in place to the goal yaw, as
    base_local_planner does.
 
@@ -46,8 +51,9 @@ from fleetsim.errors import ParameterError, TransformError
 from fleetsim.msgs import geometry_msgs
 from fleetsim.nav.controllers.base import EmptyPlan, LocalPlanner, VelocityCommand
 from fleetsim.nav.controllers.collvoid_params import CollvoidParams
-from fleetsim.nav.costmap.footprint import footprint_radii
+from fleetsim.nav.costmap.footprint import footprint_radii, outline_points
 from fleetsim.nav.multirobot.deadlock import DeadlockRule
+from fleetsim.nav.multirobot.footprint_check import footprint_safe_command
 from fleetsim.nav.multirobot.holonomic import (
     detour_velocity,
     gaps_closed,
@@ -56,6 +62,7 @@ from fleetsim.nav.multirobot.holonomic import (
     preferred_velocity,
     rotated,
     speed_along_heading,
+    speed_interval,
     speed_nearest_still,
     tracking_command,
 )
@@ -80,6 +87,9 @@ DETOUR_REACH = 1.0
 #: m: closer to the goal than this, no more keeping right (it only pushed arriving robots off
 #: their goal, to come back to it from the side and turn there)
 KEEP_RIGHT_UNTIL = 1.5
+#: share of the preferred speed under which the walls block the circumscribed disc (then the
+#: inscribed disc steers and the footprint keeps off the walls, `_wall_halfplanes`)
+WALLS_BLOCK = 0.25
 #: no truncation: the velocity obstacle's horizon, s
 UNTRUNCATED = 1e3
 
@@ -108,7 +118,17 @@ class CollvoidLocalPlanner(LocalPlanner):
         self.costmap = costmap_ros.costmap
         self.frame = costmap_ros.global_frame
         self.robot_id = p.robot_id or node.tf_prefix or node.namespace.strip("/")
-        self.body_radius = p.footprint_radius or footprint_radii(costmap_ros.footprint)[1]
+        inscribed, circumscribed = footprint_radii(costmap_ros.footprint)
+        self.body_radius = p.footprint_radius or circumscribed
+        # walls: a differential drive's footprint is checked on its command's rollout
+        # (`footprint_check`); where the walls block its circumscribed disc, ORCA's static
+        # half-planes steer with the inscribed one (`_wall_halfplanes`)
+        self.wall_radius = p.footprint_radius or inscribed
+        if p.holonomic_robot:
+            self.wall_radius = self.body_radius
+        self.outline = outline_points(costmap_ros.footprint, self.costmap.resolution)
+        self.replaced = False  # this cycle's command was replaced by a footprint-clear one
+        self.walls_blocked = False  # this cycle the walls left the circumscribed disc no way
         self.share = PositionShare(node)
         self.deadlock = DeadlockRule(
             self.robot_id,
@@ -279,17 +299,8 @@ class CollvoidLocalPlanner(LocalPlanner):
             self.body_radius + p.max_vel_x * self.horizon_obst + 0.3,
             OBSTACLE_SECTORS,
         )
-        cell_r = self.costmap.resolution * 0.71
         if obst.shape[0]:
-            lp, ld = orca_halfplanes(
-                obst - xy,
-                np.broadcast_to(vel, obst.shape),
-                np.full(obst.shape[0], self.body_radius + cell_r),
-                vel,
-                self.horizon_obst,
-                self.dt,
-                1.0,
-            )
+            lp, ld = self._wall_halfplanes(obst - xy, vel, pref)
             lines_p.append(lp)
             lines_d.append(ld)
         if ids:
@@ -312,6 +323,34 @@ class CollvoidLocalPlanner(LocalPlanner):
         )
         self.last_holo = holo
         return holo
+
+    def _wall_halfplanes(self, rel, vel, pref) -> tuple[np.ndarray, np.ndarray]:
+        """ORCA half-planes of the static obstacle points ``rel`` (M, 2), m from the robot.
+
+        The robot is its circumscribed disc (``body_radius``) unless the walls leave that disc
+        no way on (their program infeasible, or its velocity under `WALLS_BLOCK` of the
+        preferred speed): then, for a differential drive, its inscribed disc, and the real
+        footprint's rollout (`_footprint_clear`) keeps it off the walls. A lizi's disc (0.25 m)
+        does not pass a 0.45 m gap between clutter that its body (0.32 m wide) drives through;
+        in open corridors the disc keeps its distance from walls as before, so two lizis
+        meeting in a corridor still find it too narrow to pass."""
+        cell_r = self.costmap.resolution * 0.71
+        n, p = rel.shape[0], self.params
+        lines = orca_halfplanes(
+            rel, np.broadcast_to(vel, rel.shape), np.full(n, self.body_radius + cell_r),
+            vel, self.horizon_obst, self.dt, 1.0,
+        )  # fmt: skip
+        self.walls_blocked = False
+        if self.wall_radius >= self.body_radius:
+            return lines
+        v, ok = orca_velocity(*lines, p.max_vel_x, pref, n)
+        if ok and float(np.hypot(*v)) >= WALLS_BLOCK * float(np.hypot(*pref)):
+            return lines
+        self.walls_blocked = True
+        return orca_halfplanes(
+            rel, np.broadcast_to(vel, rel.shape), np.full(n, self.wall_radius + cell_r),
+            vel, self.horizon_obst, self.dt, 1.0,
+        )  # fmt: skip
 
     def _yield_velocity(self, xy, to_goal, other, own_r, other_r, remaining, pref):
         """Yielding (`fleetsim.nav.multirobot.yielding`): to the refuge back along the plan,
@@ -379,6 +418,9 @@ class CollvoidLocalPlanner(LocalPlanner):
             v, w = tracking_command(holo, heading, p.time_to_holo, top, p.max_vel_theta)
             v = speed_along_heading(*self.lines, heading, v, top)
             cmd = (-v if back else v, 0.0, _clamp(w, p.min_vel_theta, p.max_vel_theta))
+        self.replaced = False
+        if not p.holonomic_robot:
+            cmd = self._footprint_clear(cmd, pose, velocity)
         v0, vy0 = float(velocity[0]), float(velocity[1])
         dv, dw = p.acc_lim_x * self.dt, p.acc_lim_theta * self.dt
         dvy = p.acc_lim_y * self.dt
@@ -388,6 +430,30 @@ class CollvoidLocalPlanner(LocalPlanner):
         self.last_w = w
         self.local_plan = self._rollout(pose, vx, vy, w)
         return VelocityCommand(vx, vy, w)
+
+    def _footprint_clear(self, cmd, pose, velocity) -> tuple[float, float, float]:
+        """``cmd``, or the command nearest it whose footprint rollout over ``time_horizon_obst``
+        is clear of the local costmap's obstacles (`footprint_safe_command`), at speeds the
+        robots' half-planes admit along the heading (any, when they admit none there)."""
+        p, yaw = self.params, pose[2]
+        points, dirs, n_obst = self.lines
+        u = np.array([math.cos(yaw), math.sin(yaw)])
+        caps = []
+        for sign, top in ((1.0, p.max_vel_x), (-1.0, min(p.max_vel_x, p.max_vel_x_backwards))):
+            lo, hi = speed_interval(points[n_obst:], dirs[n_obst:], sign * u, top)
+            caps.append(hi if lo <= hi else top)  # none admitted: as speed_along_heading
+        cm = self.costmap
+        v, w, self.replaced = footprint_safe_command(
+            (cmd[0], cmd[2]),
+            self.last_holo,
+            tuple(float(a) for a in pose),
+            (float(velocity[0]), float(velocity[2])),
+            (cm.costs, (cm.origin_x, cm.origin_y), cm.resolution),
+            self.outline,
+            (-caps[1], caps[0], p.min_vel_theta, p.max_vel_theta, p.acc_lim_x, p.acc_lim_theta),
+            self.horizon_obst if self.horizon_obst < UNTRUNCATED else p.time_horizon_obst,
+        )
+        return v, 0.0, w
 
     @staticmethod
     def _rollout(pose, vx: float, vy: float, w: float, steps: int = 10) -> np.ndarray:

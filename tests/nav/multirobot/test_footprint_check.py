@@ -1,0 +1,95 @@
+"""Static obstacles against the real footprint (`fleetsim.nav.multirobot.footprint_check`): a
+lizi with collvoid drives through a gap its body fits and its circumscribed disc does not
+(issue 14's soak: lizis stopped for good between Willow's clutter), the rollout kernel agrees
+with the footprint placed pose by pose, and a command into a wall is replaced."""
+
+import math
+
+import numpy as np
+import pytest
+from test_collvoid_planner import BODY, LIZI, Fleet, empty_map
+
+from fleetsim.nav.costmap.footprint import footprint_costs, outline_points
+from fleetsim.nav.multirobot.footprint_check import (
+    STEPS,
+    first_collisions,
+    footprint_safe_command,
+)
+
+OUTLINE = outline_points(LIZI, 0.05)
+
+
+def grid_of(cm):
+    return cm.costs, (cm.origin_x, cm.origin_y), cm.resolution
+
+
+@pytest.mark.parametrize("width", [0.46, 0.5])
+def test_a_lizi_drives_through_a_gap_its_body_fits_and_its_disc_does_not(width):
+    """Two blocks 0.3 m deep leave a ``width`` gap on the straight plan: narrower than the
+    lizi's circumscribed disc (2 x 0.25 m + a cell), wider than its body (0.32 m). The lizi
+    starts turned 0.3 rad off the plan; it reaches the goal and its footprint never touches
+    a lethal cell on the way."""
+    half = width / 2
+    walls = [(-0.15, half, 0.15, 2.0), (-0.15, -2.0, 0.15, -half)]
+    assert 2 * (BODY + 0.05 * 0.71) > width > 0.32
+    f = Fleet([(-2.5, 0.0, 0.3)], [(2.5, 0.0, 0.0)], walls=walls)
+    cm = f.cm
+    reached = False
+    for _ in range(300):
+        reached = f.run(0.1)
+        cost = footprint_costs(
+            cm.costs, cm.origin_x, cm.origin_y, cm.resolution, OUTLINE, f.state.copy()
+        )
+        assert cost[0] >= 0.0, f"footprint on a wall at {f.state[0]}"
+        if reached:
+            break
+    assert reached, f"stopped at {f.state[0]}, goal (2.5, 0)"
+    assert f.state[0, 0] > 2.2
+
+
+def test_first_collisions_agree_with_the_footprint_pose_by_pose():
+    cm = empty_map([(0.5, -1.0, 0.7, 1.0)])
+    rng = np.random.default_rng(3)
+    cmds = np.c_[rng.uniform(-0.5, 0.5, 40), rng.uniform(-1.0, 1.0, 40)]
+    pose = np.array([0.0, 0.1, 0.2])
+    vel = np.array([0.2, 0.0])
+    acc = np.array([2.5, 3.2])
+    ends = np.empty((40, 2))
+    got = first_collisions(cmds, pose, vel, acc, 1.0, STEPS, cm.costs,
+                           np.array(grid_of(cm)[1]), 0.05, OUTLINE, ends)  # fmt: skip
+    dt = 1.0 / STEPS
+    for (cv, cw), k, end in zip(cmds, got, ends):
+        x, y, th = pose
+        v, w = vel
+        poses = []
+        for _ in range(STEPS):
+            v = min(cv, v + 2.5 * dt) if cv >= v else max(cv, v - 2.5 * dt)
+            w = min(cw, w + 3.2 * dt) if cw >= w else max(cw, w - 3.2 * dt)
+            x, y, th = x + v * math.cos(th) * dt, y + v * math.sin(th) * dt, th + w * dt
+            poses.append((x, y, th))
+        cost = footprint_costs(cm.costs, -10.0, -10.0, 0.05, OUTLINE, np.array(poses))
+        bad = np.flatnonzero(cost < 0)
+        assert k == (bad[0] + 1 if bad.size else STEPS + 1)
+        last_clear = poses[bad[0] - 1] if bad.size and bad[0] > 0 else poses[-1]
+        if bad.size and bad[0] == 0:
+            last_clear = pose
+        assert end == pytest.approx(np.asarray(last_clear)[:2])
+    assert (got <= STEPS).any() and (got > STEPS).any()
+
+
+def test_a_command_into_a_wall_is_replaced_by_the_nearest_clear_one():
+    cm = empty_map([(0.45, -1.0, 0.65, 1.0)])  # 0.26 m ahead of the lizi's nose
+    limits = (-0.5, 0.5, -1.0, 1.0, 2.5, 3.2)
+    pose, vel = (0.0, 0.0, 0.0), (0.0, 0.0)
+    ahead = np.array([0.5, 0.0])
+    v, w, replaced = footprint_safe_command((0.5, 0.0), ahead, pose, vel, grid_of(cm), OUTLINE,
+                                            limits, 1.0)  # fmt: skip
+    assert replaced and 0.0 <= v < 0.5 and w == pytest.approx(0.0)
+    # its own rollout is clear
+    k = first_collisions(np.array([[v, w]]), np.array(pose), np.array(vel), np.array([2.5, 3.2]),
+                         1.0, STEPS, cm.costs, np.array(grid_of(cm)[1]), 0.05, OUTLINE,
+                         np.empty((1, 2)))  # fmt: skip
+    assert k[0] == STEPS + 1
+    # away from the wall nothing is replaced
+    assert footprint_safe_command((0.5, 0.2), ahead, (-2.0, 0.0, 0.0), vel, grid_of(cm),
+                                  OUTLINE, limits, 1.0) == (0.5, 0.2, False)  # fmt: skip

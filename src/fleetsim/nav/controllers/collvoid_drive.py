@@ -1,0 +1,136 @@
+"""The base side of ``collvoid_local_planner/CollvoidLocalPlanner``: from the cycle's
+holonomic ORCA velocity to the command a base can follow.
+
+* a holonomic base takes the velocity as it is (in its own frame);
+* a differential drive tracks it (`tracking_command`, ``time_to_holo``), its forward speed cut
+  to what the cycle's half-planes admit along its heading (`speed_along_heading`); a yielding
+  robot backs out, one waiting in its refuge only moves as ORCA requires
+  (`speed_nearest_still`); then the command's rollout over ``time_horizon_obst`` is checked
+  with the real footprint on the local costmap and, if it touches an obstacle, replaced by the
+  clear command that best follows the holonomic velocity (`footprint_safe_command`);
+* every command within ``acc_lim_x``/``acc_lim_y``/``acc_lim_theta`` of the last;
+* within the goal's xy tolerance, the turn in place to the goal yaw (base_local_planner's).
+
+`CollvoidDrive` is mixed into the planner, which owns the state it reads (``params``,
+``lines``, ``last_holo``, ``yielding_to``, ``waiting``, ``outline``, ``costmap``, ``dt``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from fleetsim.nav.controllers.base import VelocityCommand
+from fleetsim.nav.multirobot.footprint_check import footprint_safe_command
+from fleetsim.nav.multirobot.holonomic import (
+    rotated,
+    speed_along_heading,
+    speed_interval,
+    speed_nearest_still,
+    tracking_command,
+)
+
+#: no truncation: the velocity obstacle's horizon, s
+UNTRUNCATED = 1e3
+
+
+def _clamp(v: float, lo: float, hi: float) -> float:
+    return max(lo, min(hi, v))
+
+
+class CollvoidDrive:
+    """The command side of the collvoid planner (see the module doc)."""
+
+    def _track(self, holo: np.ndarray, pose, velocity) -> VelocityCommand:
+        p, yaw = self.params, pose[2]
+        nudge = None
+        if self.waiting and not p.holonomic_robot:
+            # in the refuge: ORCA's nudge away from the robot going by is not worth a turn on
+            # the spot (turning back when the yield ends takes a lizi seconds)
+            back = min(p.max_vel_x, p.max_vel_x_backwards)
+            nudge = speed_nearest_still(*self.lines[:2], yaw, p.max_vel_x, back)
+        if nudge is not None:
+            cmd = (nudge, 0.0, 0.0)
+        elif p.holonomic_robot:
+            body = rotated(holo, -yaw)
+            cmd = (float(body[0]), float(body[1]), 0.0)
+        else:
+            # a yielding robot backs out (its way back is behind it, and two half-turns on the
+            # spot cost a skid-steer lizi ~6 s each)
+            back = (
+                self.yielding_to is not None
+                and p.max_vel_x_backwards > 0.0
+                and holo[0] * math.cos(yaw) + holo[1] * math.sin(yaw) < 0.0
+            )
+            top = min(p.max_vel_x, p.max_vel_x_backwards) if back else p.max_vel_x
+            heading = yaw + math.pi if back else yaw
+            v, w = tracking_command(holo, heading, p.time_to_holo, top, p.max_vel_theta)
+            v = speed_along_heading(*self.lines, heading, v, top)
+            cmd = (-v if back else v, 0.0, _clamp(w, p.min_vel_theta, p.max_vel_theta))
+        self.replaced = False
+        if not p.holonomic_robot:
+            cmd = self._footprint_clear(cmd, pose, velocity)
+        v0, vy0 = float(velocity[0]), float(velocity[1])
+        dv, dw = p.acc_lim_x * self.dt, p.acc_lim_theta * self.dt
+        dvy = p.acc_lim_y * self.dt
+        vx = _clamp(cmd[0], v0 - dv, v0 + dv)
+        vy = _clamp(cmd[1], vy0 - dvy, vy0 + dvy)
+        w = _clamp(cmd[2], self.last_w - dw, self.last_w + dw)
+        self.last_w = w
+        self.local_plan = self._rollout(pose, vx, vy, w)
+        return VelocityCommand(vx, vy, w)
+
+    def _footprint_clear(self, cmd, pose, velocity) -> tuple[float, float, float]:
+        """``cmd``, or the command nearest it whose footprint rollout over ``time_horizon_obst``
+        is clear of the local costmap's obstacles (`footprint_safe_command`), at speeds the
+        robots' half-planes admit along the heading (any, when they admit none there)."""
+        p, yaw = self.params, pose[2]
+        points, dirs, n_obst = self.lines
+        u = np.array([math.cos(yaw), math.sin(yaw)])
+        caps = []
+        for sign, top in ((1.0, p.max_vel_x), (-1.0, min(p.max_vel_x, p.max_vel_x_backwards))):
+            lo, hi = speed_interval(points[n_obst:], dirs[n_obst:], sign * u, top)
+            caps.append(hi if lo <= hi else top)  # none admitted: as speed_along_heading
+        cm = self.costmap
+        v, w, self.replaced = footprint_safe_command(
+            (cmd[0], cmd[2]),
+            self.last_holo,
+            tuple(float(a) for a in pose),
+            (float(velocity[0]), float(velocity[2])),
+            (cm.costs, (cm.origin_x, cm.origin_y), cm.resolution),
+            self.outline,
+            (-caps[1], caps[0], p.min_vel_theta, p.max_vel_theta, p.acc_lim_x, p.acc_lim_theta),
+            self.horizon_obst if self.horizon_obst < UNTRUNCATED else p.time_horizon_obst,
+        )
+        return v, 0.0, w
+
+    @staticmethod
+    def _rollout(pose, vx: float, vy: float, w: float, steps: int = 10) -> np.ndarray:
+        """The command held for one second, (steps, 3) poses in the local frame (local_plan)."""
+        dt = 1.0 / (steps - 1)
+        out = np.empty((steps, 3))
+        x, y, th = pose
+        for k in range(steps):
+            out[k] = x, y, th
+            c, s = math.cos(th), math.sin(th)
+            x, y, th = x + (c * vx - s * vy) * dt, y + (s * vx + c * vy) * dt, th + w * dt
+        return out
+
+    def _at_goal(self, yaw: float, goal_yaw: float) -> VelocityCommand:
+        p = self.params
+        ang = math.remainder(goal_yaw - yaw, 2 * math.pi)
+        if abs(ang) <= p.yaw_goal_tolerance:
+            self.rotating_to_goal = False
+            self.xy_tolerance_latch = False
+            self.reached_goal = True
+            self.local_plan = np.zeros((0, 3))
+            self.last_w = 0.0
+            return VelocityCommand()
+        self.rotating_to_goal = True
+        v = _clamp(abs(ang), p.min_in_place_vel_theta, p.max_vel_theta)
+        ramp = max(0.0, self.last_w if ang > 0 else -self.last_w) + p.acc_lim_theta * self.dt
+        v = min(v, math.sqrt(2 * p.acc_lim_theta * abs(ang)), ramp)
+        v = max(v, p.min_in_place_vel_theta)
+        self.last_w = math.copysign(v, ang)
+        return VelocityCommand(0.0, 0.0, self.last_w)

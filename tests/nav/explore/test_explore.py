@@ -186,3 +186,38 @@ def test_a_frontier_a_peer_explorer_heads_for_is_left_to_it():
     peer.publish(geometry_msgs.PointStamped(point=geometry_msgs.Point(x=math.nan, y=math.nan)))
     rt.run(duration=1.0)
     assert sink.goals[-1] == big_goal
+
+
+def test_a_frontier_nearer_to_a_peer_robot_is_left_to_it():
+    data = np.full((20, 30), -1, dtype=np.int8)
+    data[:, :10] = 0  # the big frontier along x = 1 m, nearer to the peer at x = 1.5 m
+    data[:4, :6] = -1  # the small one at the south-west, nearer to this robot
+    big, small = frontiers_from_grid(data, 0.1, (0.0, 0.0), (0.35, 1.05))
+    big_goal, small_goal = (tuple(round(v, 2) for v in f.centroid) for f in (big, small))
+    rt = Runtime(seed=0)
+    rt.params.set("/explore/peer_frames", ["peer/base_link"])
+    FakeWorld(rt, data)
+    sink = GoalSink(rt)
+    peer_tf = StaticTransformBroadcaster(Node(rt, "peer"))
+    peer_tf.send_transform(make_transform_stamped("map", "peer/base_link", 0.0, (1.5, 1.0, 0.0)))
+    Explore(rt)
+    rt.run(duration=1.5)
+    assert sink.goals == [small_goal]
+    # the peer drives far off: this robot is the nearer one to both, the big one is best
+    peer_tf.send_transform(make_transform_stamped("map", "peer/base_link", 0.0, (9.0, 9.0, 0.0)))
+    rt.run(duration=1.0)
+    assert sink.goals[-1] == big_goal
+
+
+def test_a_peer_frame_tf_does_not_know_is_warned_about_and_ignored(caplog):
+    data = np.full((20, 30), -1, dtype=np.int8)
+    data[:, :10] = 0
+    rt = Runtime(seed=0)
+    rt.params.set("/explore/peer_frames", ["nobody/base_link"])
+    FakeWorld(rt, data)
+    sink = GoalSink(rt)
+    Explore(rt)
+    with caplog.at_level(logging.WARNING):
+        rt.run(duration=1.5)
+    assert "cannot find the peer nobody/base_link in map" in caplog.text
+    assert len(sink.goals) == 1

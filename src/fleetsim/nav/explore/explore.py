@@ -16,7 +16,12 @@ world).
 
 Explorers sharing one map (slam_explore ``robots:=2``) would all head for the same best
 frontier; fleetsim adds ``peer_goals``: each explorer announces its goal on ``~goal`` and leaves
-frontiers within ``peer_radius`` of a peer's goal to that peer, unless every frontier is.
+frontiers within ``peer_radius`` of a peer's goal to that peer, unless every frontier is; with
+``peer_frames`` (the peers' base frames, found in the shared map through tf) it also leaves to
+a peer every frontier whose nearest cell is nearer to that peer than to itself, so that each
+robot takes the frontiers on its side instead of both heading for the same region (the pair of
+hunters crossed the office's corridor to each other's end). The preference falls back step by
+step: frontiers nearer to it that no peer heads for, then any no peer heads for, then any.
 
 ``costmap_updates_topic`` is accepted but fleetsim's costmaps publish whole grids only (see
 `fleetsim.nav.costmap.costmap_ros`), so it is not subscribed. ``orientation_scale`` is accepted
@@ -68,6 +73,9 @@ class ExploreParams:
     peer_goals: list = param([], help="other explorers' ~goal topics (geometry_msgs/PointStamped)")
     peer_radius: float = param(
         3.0, unit="m", range=(0.0, None), help="frontiers this close to a peer's goal are its"
+    )
+    peer_frames: list = param(
+        [], help="other explorers' base frames: frontiers nearer to one of them are its"
     )
 
 
@@ -139,6 +147,18 @@ class Explore(Node):
             return None
         return x, y
 
+    def _peer_positions(self, frame: str) -> list[tuple[float, float]]:
+        """Where the peers in ``peer_frames`` are in ``frame`` (those tf knows)."""
+        out = []
+        for peer in self.params.peer_frames:
+            try:
+                x, y, _ = self.tf_buffer.lookup_pose2d(frame, str(peer).lstrip("/"), 0.0)
+            except FleetsimError as err:
+                self._warn_once(f"peer {peer}", f"cannot find the peer {peer} in {frame}: {err}")
+                continue
+            out.append((x, y))
+        return out
+
     def make_plan(self) -> None:
         """explore_lite's makePlan: pick the best frontier, watch progress, send the goal."""
         if self.finished or self.grid is None:
@@ -172,10 +192,13 @@ class Explore(Node):
             self.stop("all frontiers traversed/tried out, stopping")
             return
         taken = [g for g in self.peers.values() if g is not None]
-        mine = [
+        free = [
             f for f in candidates if all(math.dist(f.centroid, g) >= p.peer_radius for g in taken)
         ]
-        candidates = mine or candidates  # all taken by peers: help with the best one
+        others = self._peer_positions(frame)
+        nearer = [f for f in free if _nearest_to_me(f, others)]
+        # all taken by peers: help with the best one
+        candidates = nearer or free or candidates
         target = candidates[0].centroid
         same = self.goal is not None and math.dist(target, self.goal) < 1e-6
         # progress as explore_lite measures it: towards the frontier's nearest cell (its
@@ -247,3 +270,14 @@ class Explore(Node):
                 )
             )
         self.marker_pub.publish(visualization_msgs.MarkerArray(markers=markers))
+
+
+def _nearest_to_me(frontier: Frontier, others: list[tuple[float, float]]) -> bool:
+    """Whether no other robot (positions, m) is nearer to the frontier's nearest cell to it
+    than this robot is (``frontier.min_distance``); ties stay with this robot."""
+    for x, y in others:
+        if np.hypot(frontier.points[:, 0] - x, frontier.points[:, 1] - y).min() < (
+            frontier.min_distance
+        ):
+            return False
+    return True

@@ -3,6 +3,7 @@ lizi with collvoid drives through a gap its body fits and its circumscribed disc
 (issue 14's soak: lizis stopped for good between Willow's clutter), the rollout kernel agrees
 with the footprint placed pose by pose, and a command into a wall is replaced."""
 
+import itertools
 import math
 
 import numpy as np
@@ -93,3 +94,32 @@ def test_a_command_into_a_wall_is_replaced_by_the_nearest_clear_one():
     # away from the wall nothing is replaced
     assert footprint_safe_command((0.5, 0.2), ahead, (-2.0, 0.0, 0.0), vel, grid_of(cm),
                                   OUTLINE, limits, 1.0) == (0.5, 0.2, False)  # fmt: skip
+
+
+@pytest.mark.parametrize("escape", [True, False])
+def test_a_lizi_wedged_nose_first_backs_out_and_goes_through(escape, monkeypatch):
+    """Issue 14's lizi7 at (24.84, 44.70): a block 3.5 cm ahead of the lizi's right front
+    corner, a wall 0.2 m above its left side, the plan through the 0.4 m gap between them.
+    No arc is clear and a turn on the spot hits the block, so the clear command nearest the
+    holonomic velocity is to stand: it stood until move_base gave up. Backing out straight
+    0.15 m (base_local_planner's escape) leaves room for an arc into the gap."""
+    if not escape:
+        monkeypatch.setattr("fleetsim.nav.controllers.collvoid_drive.ESCAPE_SPEED", 0.0)
+    walls = [(0.225, -1.0, 0.5, -0.025), (0.15, 0.375, 0.6, 1.5), (-0.05, 0.3, 0.05, 1.5)]
+    f = Fleet([(0.0, 0.0, 0.0)], [(3.0, 0.17, 0.0)], walls=walls)
+    corners = np.array([[0, 0, 0], [0.3, 0.12, 0], [0.6, 0.17, 0], [3, 0.17, 0]], float)
+    f.planners[0].set_plan(
+        np.concatenate([np.linspace(a, b, 20) for a, b in itertools.pairwise(corners)])
+    )
+    cm = f.cm
+    reached = False
+    for _ in range(150):
+        reached = f.run(0.2)
+        cost = footprint_costs(
+            cm.costs, cm.origin_x, cm.origin_y, cm.resolution, OUTLINE, f.state.copy()
+        )
+        assert cost[0] >= 0.0, f"footprint on a wall at {f.state[0]}"
+        if reached:
+            break
+    assert reached is escape
+    assert (f.planners[0].escapes >= 1) is escape

@@ -7,12 +7,14 @@ holonomic ORCA velocity to the command a base can follow.
   robot backs out, one waiting in its refuge only moves as ORCA requires
   (`speed_nearest_still`); then the command's rollout over ``time_horizon_obst`` is checked
   with the real footprint on the local costmap and, if it touches an obstacle, replaced by the
-  clear command that best follows the holonomic velocity (`footprint_safe_command`);
+  clear command that best follows the holonomic velocity (`footprint_safe_command`); a robot
+  wedged nose first (the best clear command is to stand) backs out straight a little;
 * every command within ``acc_lim_x``/``acc_lim_y``/``acc_lim_theta`` of the last;
 * within the goal's xy tolerance, the turn in place to the goal yaw (base_local_planner's).
 
 `CollvoidDrive` is mixed into the planner, which owns the state it reads (``params``,
-``lines``, ``last_holo``, ``yielding_to``, ``waiting``, ``outline``, ``costmap``, ``dt``).
+``lines``, ``last_holo``, ``yielding_to``, ``waiting``, ``outline``, ``costmap``, ``dt``,
+``escape_from``, ``escapes``).
 """
 
 from __future__ import annotations
@@ -31,6 +33,12 @@ from fleetsim.nav.multirobot.holonomic import (
     tracking_command,
 )
 
+#: m/s and m: the escape of a robot wedged nose first (base_local_planner's escape_vel and
+#: escape_reset_dist, 0.1 and 0.1; a little farther here, the room an arc needs to turn off)
+ESCAPE_SPEED = 0.1
+ESCAPE_DISTANCE = 0.15
+#: m/s: a holonomic velocity slower than this is content to stand still (no escape)
+STILL_HOLO = 0.02
 #: no truncation: the velocity obstacle's horizon, s
 UNTRUNCATED = 1e3
 
@@ -84,25 +92,53 @@ class CollvoidDrive:
     def _footprint_clear(self, cmd, pose, velocity) -> tuple[float, float, float]:
         """``cmd``, or the command nearest it whose footprint rollout over ``time_horizon_obst``
         is clear of the local costmap's obstacles (`footprint_safe_command`), at speeds the
-        robots' half-planes admit along the heading (any, when they admit none there)."""
+        robots' half-planes admit along the heading (any, when they admit none there).
+
+        When the clear command nearest the holonomic velocity is to stand still while that
+        velocity is not (wedged nose first where no arc is clear and a turn on the spot hits a
+        corner), the robot escapes as base_local_planner does: straight back at `ESCAPE_SPEED`
+        until `ESCAPE_DISTANCE` from where it stuck, while that stays clear."""
         p, yaw = self.params, pose[2]
         points, dirs, n_obst = self.lines
         u = np.array([math.cos(yaw), math.sin(yaw)])
+        back_top = min(p.max_vel_x, p.max_vel_x_backwards)
         caps = []
-        for sign, top in ((1.0, p.max_vel_x), (-1.0, min(p.max_vel_x, p.max_vel_x_backwards))):
+        for sign, top in ((1.0, p.max_vel_x), (-1.0, back_top)):
             lo, hi = speed_interval(points[n_obst:], dirs[n_obst:], sign * u, top)
             caps.append(hi if lo <= hi else top)  # none admitted: as speed_along_heading
         cm = self.costmap
-        v, w, self.replaced = footprint_safe_command(
-            (cmd[0], cmd[2]),
-            self.last_holo,
-            tuple(float(a) for a in pose),
-            (float(velocity[0]), float(velocity[2])),
-            (cm.costs, (cm.origin_x, cm.origin_y), cm.resolution),
-            self.outline,
-            (-caps[1], caps[0], p.min_vel_theta, p.max_vel_theta, p.acc_lim_x, p.acc_lim_theta),
-            self.horizon_obst if self.horizon_obst < UNTRUNCATED else p.time_horizon_obst,
-        )
+        horizon = self.horizon_obst if self.horizon_obst < UNTRUNCATED else p.time_horizon_obst
+
+        def clear(wanted, holo):
+            return footprint_safe_command(
+                wanted,
+                holo,
+                tuple(float(a) for a in pose),
+                (float(velocity[0]), float(velocity[2])),
+                (cm.costs, (cm.origin_x, cm.origin_y), cm.resolution),
+                self.outline,
+                (-caps[1], caps[0], p.min_vel_theta, p.max_vel_theta, p.acc_lim_x, p.acc_lim_theta),
+                horizon,
+            )
+
+        xy = np.array(pose[:2], dtype=np.float64)
+        escape = min(ESCAPE_SPEED, back_top)
+        if self.escape_from is not None:
+            if float(np.hypot(*(xy - self.escape_from))) < ESCAPE_DISTANCE and escape > 0.0:
+                _, _, blocked = clear((-escape, 0.0), -escape * u)
+                if not blocked:
+                    self.replaced = True
+                    return -escape, 0.0, 0.0
+            self.escape_from = None
+        v, w, self.replaced = clear((cmd[0], cmd[2]), self.last_holo)
+        still = abs(v) < 1e-3 and abs(w) < 1e-3
+        wants = float(np.hypot(*self.last_holo)) > STILL_HOLO
+        if self.replaced and still and wants and not self.waiting and escape > 0.0:
+            _, _, blocked = clear((-escape, 0.0), -escape * u)
+            if not blocked:
+                self.escape_from = xy
+                self.escapes += 1
+                return -escape, 0.0, 0.0
         return v, 0.0, w
 
     @staticmethod

@@ -119,6 +119,8 @@ class CollvoidLocalPlanner(CollvoidDrive, LocalPlanner):
         self.outline = outline_points(costmap_ros.footprint, self.costmap.resolution)
         self.replaced = False  # this cycle's command was replaced by a footprint-clear one
         self.walls_blocked = False  # this cycle the walls left the circumscribed disc no way
+        self.escape_from: np.ndarray | None = None  # where a wedged robot began backing out
+        self.escapes = 0  # how often it did
         self.share = PositionShare(node)
         self.deadlock = DeadlockRule(
             self.robot_id,
@@ -173,6 +175,7 @@ class CollvoidLocalPlanner(CollvoidDrive, LocalPlanner):
             self.xy_tolerance_latch = False
             self.deadlock.reset(self.node.now())
             self.retreat.reset()
+            self.escape_from = None
 
     def is_goal_reached(self) -> bool:
         return self.reached_goal

@@ -123,7 +123,9 @@ def _bounds_near(costs, offsets, cx, cy, radius):
 
 
 @njit(cache=True, inline="always")
-def _new_velocity(vg, vi, a_max, dt):
+def new_velocity(vg, vi, a_max, dt):
+    """``vi`` moved toward ``vg`` by at most ``a_max * dt`` (base_local_planner's
+    computeNewVelocity)."""
     if vg - vi >= 0:
         return min(vg, vi + a_max * dt)
     return max(vg, vi - a_max * dt)
@@ -301,9 +303,9 @@ def trajectory_costs(
             poses_out[s, i, 0] = x
             poses_out[s, i, 1] = y
             poses_out[s, i, 2] = th
-            vx = _new_velocity(samples[s, 0], vx, acc[0], dt)
-            vy = _new_velocity(samples[s, 1], vy, acc[1], dt)
-            vth = _new_velocity(samples[s, 2], vth, acc[2], dt)
+            vx = new_velocity(samples[s, 0], vx, acc[0], dt)
+            vy = new_velocity(samples[s, 1], vy, acc[1], dt)
+            vth = new_velocity(samples[s, 2], vth, acc[2], dt)
             if vy != 0.0:
                 x = x + (vx * math.cos(th) + vy * math.cos(math.pi / 2.0 + th)) * dt
                 y = y + (vx * math.sin(th) + vy * math.sin(math.pi / 2.0 + th)) * dt

@@ -30,6 +30,7 @@ import math
 import numpy as np
 from numba import njit
 
+from fleetsim.nav.controllers.rollout import new_velocity
 from fleetsim.nav.costmap.footprint import footprint_cost_at
 
 #: m: weight of a rad/s of turn-rate difference against a m/s of speed difference when
@@ -41,13 +42,6 @@ SPEED_SAMPLES = 11
 TURN_SAMPLES = 21
 #: rollout steps over the horizon (0.05 m apart at 0.5 m/s over 1 s: below a cell's width)
 STEPS = 10
-
-
-@njit(cache=True, inline="always")
-def _ramp(target, current, acc, dt):
-    if target >= current:
-        return min(target, current + acc * dt)
-    return max(target, current - acc * dt)
 
 
 @njit(cache=True)
@@ -80,8 +74,8 @@ def first_collisions(
         ends[s, 0] = x
         ends[s, 1] = y
         for i in range(1, steps + 1):
-            v = _ramp(commands[s, 0], v, acc[0], dt)
-            w = _ramp(commands[s, 1], w, acc[1], dt)
+            v = new_velocity(commands[s, 0], v, acc[0], dt)
+            w = new_velocity(commands[s, 1], w, acc[1], dt)
             x += v * math.cos(th) * dt
             y += v * math.sin(th) * dt
             th += w * dt

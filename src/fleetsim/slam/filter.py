@@ -112,7 +112,7 @@ class GmappingFilter:
             self.poses, _, likes = matched_poses(
                 self.maps.pool, self.maps.table, self.poses, self.laser, ranges, angles,
                 self.maps.geom, p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep,
-                p.iterations, p.minimumScore, self.reach,
+                p.iterations, p.minimumScore, self.reach, p.climb_skip,
             )  # fmt: skip
             self.weights += likes
             self.weight_sums += likes

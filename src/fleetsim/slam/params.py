@@ -87,6 +87,14 @@ class GmappingParams:
         "pose is refined below its last step (false: gmapping's score, 0 for a beam with no "
         "hit in its window, and its climber; see fleetsim.slam.scan_match)",
     )
+    climb_skip: int = param(
+        3,
+        range=(0, None),
+        help="fleetsim addition, with continuous_score: the hill climber scores every "
+        "(climb_skip+1)-th of the beams lskip leaves, then the pose is refined on all of them by "
+        "Gauss-Newton steps on the continuous score (about 2.5x faster; 0: every beam, as "
+        "gmapping; see fleetsim.slam.scan_align)",
+    )
     # --- motion model ---
     srr: float = param(0.1, range=(0.0, None), help="translation noise from translation")
     srt: float = param(0.2, range=(0.0, None), help="rotation noise from translation")

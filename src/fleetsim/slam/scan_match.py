@@ -52,6 +52,7 @@ import math
 import numba
 import numpy as np
 
+from .scan_align import refined_pose
 from .tiles import FAR, writable_tile
 from .tiles import MASK as _MASK
 from .tiles import SHIFT as _SHIFT
@@ -146,7 +147,7 @@ def _vertex(below, centre, above, step):
 @numba.njit(cache=True)
 def matched_poses(
     pool, table, poses, laser, ranges, angles, geom, kernel, sigma, lsigma, skip,
-    lstep, astep, iterations, minimum_score, reach=0.0,
+    lstep, astep, iterations, minimum_score, reach=0.0, climb_skip=0,
 ):  # fmt: skip
     """Hill-climbed poses, scores and log-likelihoods of every particle (``ScanMatcher::optimize``
     then ``likelihoodAndScore``).
@@ -159,6 +160,10 @@ def matched_poses(
         capped at ``reach``) and refines the climber's last pose by a parabola through the last
         round's scores; 0: gmapping's score and climber (a beam without a hit in its window
         scores 0). The likelihood is gmapping's either way.
+    climb_skip : with ``reach > 0`` and ``climb_skip > 0`` (the fast matcher) the climber
+        scores every ``(climb_skip + 1)``-th of the beams ``skip`` leaves, and its pose is then
+        refined on all of those by Gauss-Newton steps (`fleetsim.slam.scan_align`) instead of
+        the parabola; the score is then the continuous score at the refined pose.
 
     Returns
     -------
@@ -172,23 +177,14 @@ def matched_poses(
     cand = np.empty(3)
     move_scores = np.empty(6)  # the round's score of each move (+x, -x, -y, +y, +yaw, -yaw)
     ex, ey = ranges * np.cos(angles), ranges * np.sin(angles)
+    fast = reach > 0.0 and climb_skip > 0
+    # the climber's beams: every (skip+1)-th, or in the fast matcher a (climb_skip+1)-th of those
+    climb = (skip + 1) * (climb_skip + 1) - 1 if fast else skip
+    used_x, used_y = ex[:: skip + 1].copy(), ey[:: skip + 1].copy()  # what the refinement fits
     for p in range(n):
         cur = poses[p].copy()
         cur_score, _ = _match(
-            pool,
-            table,
-            p,
-            cur,
-            laser,
-            ex,
-            ey,
-            geom,
-            kernel,
-            sigma,
-            lsigma,
-            skip,
-            reach,
-            False,
+            pool, table, p, cur, laser, ex, ey, geom, kernel, sigma, lsigma, climb, reach, False
         )
         best_score = -1.0
         ld, ad = lstep, astep
@@ -222,7 +218,7 @@ def matched_poses(
                     cand[2] -= ad
                 sc, _ = _match(
                     pool, table, p, cand, laser, ex, ey, geom, kernel, sigma,
-                    lsigma, skip, reach, False,
+                    lsigma, climb, reach, False,
                 )  # fmt: skip
                 move_scores[move] = sc
                 if sc > cur_score:
@@ -235,7 +231,19 @@ def matched_poses(
             back = taken ^ 1 if taken >= 0 else -1  # moves come in opposite pairs
             if not (cur_score > best_score or refinement < iterations):
                 break
-        if best_score > minimum_score:
+        if fast:
+            cur = refined_pose(
+                pool, table, p, cur, laser, used_x, used_y, geom, kernel, sigma, reach
+            )
+            # score and likelihood of every used beam in one pass
+            best_score, like = _match(
+                pool, table, p, cur, laser, ex, ey, geom, kernel, sigma, lsigma, skip, reach, True
+            )
+            if best_score > minimum_score:
+                out[p] = cur
+                scores[p], likes[p] = best_score, like
+                continue
+        elif best_score > minimum_score:
             out[p] = cur
             if reach > 0.0:
                 # the last round scored every neighbour lower: the top of the parabola through

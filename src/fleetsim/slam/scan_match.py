@@ -233,8 +233,9 @@ def matched_poses(
                 break
         if fast:
             cur = refined_pose(
-                pool, table, p, cur, laser, used_x, used_y, geom, kernel, sigma, reach
-            )
+                pool, table, p, cur, laser, used_x, used_y, geom, kernel, sigma, reach, lstep,
+                astep,
+            )  # fmt: skip
             # score and likelihood of every used beam in one pass
             best_score, like = _match(
                 pool, table, p, cur, laser, ex, ey, geom, kernel, sigma, lsigma, skip, reach, True

@@ -8,15 +8,17 @@ import logging
 
 import numpy as np
 import pytest
-from slam_world import FakeRobot, true_occupied
+from slam_world import LASER, FakeRobot, exact_ranges, true_occupied
 
 from fleetsim.errors import ServiceError
 from fleetsim.launch.registry import resolve_node
-from fleetsim.msgs import nav_msgs, std_msgs
+from fleetsim.msgs import nav_msgs, sensor_msgs, std_msgs
+from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.nav.map_io import load_map
 from fleetsim.nav.map_server import MapSaver
 from fleetsim.runtime import Node, Runtime
 from fleetsim.slam import SlamGmapping
+from fleetsim.tf import StaticTransformBroadcaster, TransformBroadcaster, make_transform_stamped
 
 START = np.array([1.5, 1.5, 0.0])  # the route's first pose: the map frame's origin
 FAST = {"xmin": -5.0, "ymin": -5.0, "xmax": 15.0, "ymax": 12.0, "particles": 15}
@@ -204,3 +206,49 @@ def test_frame_parameters_are_strings_next_to_the_str_noise_parameter():
     slam = SlamGmapping(rt)
     assert slam.base_frame == "base_footprint" and slam.params.str == 0.3
     assert slam.params.temporalUpdate == 3.0
+
+
+def test_a_waiting_scan_is_retried_on_its_own_robots_odometry_only():
+    # lizi1's scan waits for its odometry at its stamp; lizi2's transforms (10 Hz) do not wake
+    # it, as amcl's scans wait on their own robot's edges; its own odometry does
+    class CountingSlam(SlamGmapping):
+        tries = 0
+
+        def _process(self, scan):
+            self.tries += 1
+            return super()._process(scan)
+
+    rt = Runtime(seed=0)
+    for ns in ("lizi1", "lizi2"):
+        rt.params.set(f"/{ns}/tf_prefix", ns)
+    for key, value in FAST.items():
+        rt.params.set(f"/lizi1/slam_gmapping/{key}", value)
+    FakeRobot(rt, "/lizi2")
+    slam = CountingSlam(rt, "slam_gmapping", "/lizi1")
+    me = Node(rt, "driver", "/lizi1")
+    odom = TransformBroadcaster(me)
+    StaticTransformBroadcaster(me).send_transform(
+        make_transform_stamped("lizi1/base_link", "lizi1/laser", 0.0, LASER, (0, 0, 0, 1))
+    )
+
+    def send_odom(t):
+        odom.send_transform(
+            make_transform_stamped("lizi1/odom", "lizi1/base_link", t, START, (0, 0, 0, 1))
+        )
+
+    send_odom(0.0)
+    rt.run(duration=1.0)
+    angles = -np.pi + 2 * np.pi / 360 * np.arange(360)
+    ranges = exact_ranges(START + LASER, angles, 12.0).astype(np.float32)
+    me.create_publisher(sensor_msgs.LaserScan, "scan", 1).publish(
+        sensor_msgs.LaserScan(
+            header=std_msgs.Header(stamp=Time.from_sec(1.0), frame_id="lizi1/laser"),
+            angle_min=-np.pi, angle_max=np.pi - 2 * np.pi / 360,
+            angle_increment=2 * np.pi / 360, range_min=0.05, range_max=12.0, ranges=ranges,
+        )
+    )  # fmt: skip
+    rt.run(duration=1.0)  # lizi2's odometry only
+    assert slam.tries == 1 and slam.filter is None
+    send_odom(1.0)
+    rt.run(duration=0.05)
+    assert slam.tries == 2 and slam.filter is not None and slam.filter.updates == 1

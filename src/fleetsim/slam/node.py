@@ -76,7 +76,14 @@ class SlamGmapping(Node):
         self.create_service(nav_msgs.GetMap, "dynamic_map", self.on_dynamic_map)
         self.tf_pub = TransformBroadcaster(self)
         _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now
-        self._pending = MessageFilter(self.tf_buffer, self._process, SCAN_QUEUE_SIZE)
+        # a scan waits on its own robot's odometry edges, not on every /tf message (the laser's
+        # static transform, should it come late, is retried with the next odometry)
+        self._pending = MessageFilter(
+            self.tf_buffer,
+            self._process,
+            SCAN_QUEUE_SIZE,
+            frames=lambda scan: (self.odom_frame, self.base_frame),
+        )
         self.create_subscription(sensor_msgs.LaserScan, "scan", self.on_scan, queue_size=5)
         self.tf_period = self._tf_period(p.transform_publish_period)
         if self.tf_period > 0:

@@ -29,6 +29,7 @@ import math
 import numpy as np
 from numba import njit
 
+from fleetsim.nav.controllers.rollout import new_velocity
 from fleetsim.nav.costmap.costmap_2d import FREE_SPACE, LETHAL_OBSTACLE
 from fleetsim.nav.costmap.footprint import footprint_cost_at
 
@@ -39,13 +40,6 @@ W_FOV, W_OUT, W_FOLLOW, W_OBSTACLE, W_SMOOTH, W_FACE = range(6)
 @njit(cache=True, inline="always")
 def _wrap(a):
     return (a + math.pi) % (2.0 * math.pi) - math.pi
-
-
-@njit(cache=True, inline="always")
-def _toward(goal, current, limit, dt):
-    if goal >= current:
-        return min(goal, current + limit * dt)
-    return max(goal, current - limit * dt)
 
 
 @njit(cache=True)
@@ -107,8 +101,8 @@ def rollout_costs(
             (samples[i, 0] - previous[0]) ** 2 + 0.1 * (samples[i, 1] - previous[1]) ** 2
         )
         for k in range(steps):
-            v = _toward(samples[i, 0], v, accel[0], dt)
-            w = _toward(samples[i, 1], w, accel[1], dt)
+            v = new_velocity(samples[i, 0], v, accel[0], dt)
+            w = new_velocity(samples[i, 1], w, accel[1], dt)
             x += v * math.cos(th) * dt
             y += v * math.sin(th) * dt
             th += w * dt

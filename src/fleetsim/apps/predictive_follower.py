@@ -37,6 +37,7 @@ from fleetsim.apps.predictive_follower_params import PredictiveFollowerParams
 from fleetsim.apps.target_tracker import TargetTracker, TrackerParams
 from fleetsim.errors import TransformError
 from fleetsim.msgs import fiducial_msgs, geometry_msgs, nav_msgs, std_msgs
+from fleetsim.nav.controllers.rollout import new_velocity
 from fleetsim.nav.costmap.costmap_ros import Costmap2DROS
 from fleetsim.nav.costmap.footprint import outline_points
 from fleetsim.runtime import Node
@@ -289,8 +290,8 @@ class PredictiveFollower(Node):
             self.publish_command(0.0, 0.0)
             return
         dt = 1.0 / p.controller_frequency
-        v = _toward(self.samples[best, 0], self.velocity[0], p.acc_lim_x, dt)
-        w = _toward(self.samples[best, 1], self.velocity[1], p.acc_lim_theta, dt)
+        v = new_velocity(self.samples[best, 0], self.velocity[0], p.acc_lim_x, dt)
+        w = new_velocity(self.samples[best, 1], self.velocity[1], p.acc_lim_theta, dt)
         self.publish_command(v, w)
         self.publish_plan(poses[best])
 
@@ -337,8 +338,3 @@ class PredictiveFollower(Node):
     def destroy(self) -> None:
         self.costmap.destroy()
         super().destroy()
-
-
-def _toward(goal: float, current: float, limit: float, dt: float) -> float:
-    """``current`` moved toward ``goal`` by at most ``limit * dt``."""
-    return float(np.clip(goal, current - limit * dt, current + limit * dt))

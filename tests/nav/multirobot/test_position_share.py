@@ -195,3 +195,17 @@ def test_me_publisher_is_controlled_only_while_move_base_has_a_goal():
 
     assert say(actionlib_msgs.GoalStatus.ACTIVE)
     assert not say(actionlib_msgs.GoalStatus.SUCCEEDED)  # parked at its goal
+
+
+def test_me_publisher_takes_a_cloud_of_one_pose_as_no_uncertainty():
+    """fake_localization's cloud is one pose, the true one a moment before the tf the estimate
+    comes from: a moving robot is not padded by the distance it drove in between (issue 18:
+    zero for fake_localization, as the planner's own_radius takes it)."""
+    rt = Runtime()
+    robot = Robot(rt, 0.0, 0.0, 0.0)
+    me = MePublisher(rt, "me_publisher", "/lizi1", params={"footprint": SQUARE})
+    one = geometry_msgs.Pose(position=geometry_msgs.Point(x=0.03, y=0.0))
+    robot.cloud.publish(geometry_msgs.PoseArray(poses=[one]))
+    rt.run(duration=0.3)
+    assert me.uncertainty(0.0, 0.0) == 0.0
+    assert robot.got[-1].radius == pytest.approx(math.hypot(0.2, 0.2))

@@ -10,7 +10,8 @@ and publishes a `collvoid_msgs.PoseTwistWithCovariance`:
 * the uncertainty: from the latest ``particlecloud`` (amcl's PoseArray, relative name, so it is
   ``/lizi1/particlecloud``): the distance from the estimate within which ``1 - eps`` of the
   particles lie, capped at twice the robot radius (`uncertainty_radius`). fake_localization's
-  cloud is the one true pose, so the uncertainty is zero, as it is before any cloud arrives;
+  cloud is the one true pose: a cloud of one pose (or none) counts as zero uncertainty, as it
+  does before any cloud arrives;
 * ``pose`` (map frame, with the particle spread's x/y covariance), ``twist`` (``odom``'s
   twist, base frame) and ``holonomic_velocity`` (that velocity turned into the map frame);
 * ``controlled``: ``~controlled``, and - once ``move_base/status`` has been heard - only while
@@ -139,8 +140,11 @@ class MePublisher(Node):
         return self.params.controlled and self._navigating is not False
 
     def uncertainty(self, x: float, y: float) -> float:
-        """The localization uncertainty radius at estimate (x, y), m (0 without a cloud)."""
-        if self._particles is None:
+        """The localization uncertainty radius at estimate (x, y), m: 0 without a cloud or with
+        a cloud of one pose (fake_localization's: the true pose, published a moment apart from
+        the tf the estimate comes from, so a moving robot would be padded by the distance it
+        drove in between), as the planner's ``own_radius`` takes it."""
+        if self._particles is None or self._particles.shape[0] <= 1:
             return 0.0
         return uncertainty_radius(
             self._particles, np.array([x, y]), self.params.eps, 2.0 * self.robot_radius

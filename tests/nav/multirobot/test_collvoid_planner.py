@@ -2,6 +2,7 @@
 robots' states on /position_share): swaps and crossings without contact, walls respected,
 deadlocks broken by priority, bad parameters refused, move_base finds the plugin by name."""
 
+import dataclasses
 import math
 from types import SimpleNamespace
 
@@ -11,6 +12,7 @@ import pytest
 from fleetsim.errors import ParameterError
 from fleetsim.msgs import collvoid_msgs, geometry_msgs
 from fleetsim.msgs.builtin_interfaces import Time
+from fleetsim.nav.controllers.collvoid_params import CollvoidParams
 from fleetsim.nav.controllers.collvoid_planner import CollvoidLocalPlanner
 from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE, Costmap2D
 from fleetsim.nav.move_base_plugins import LOCAL_PLANNERS
@@ -197,14 +199,30 @@ def test_detour_velocity_takes_the_tangent_on_the_side_the_ray_leans_to():
         assert k == -1 and v is pref
 
 
+def make_rule(robot_id: str, **params) -> DeadlockRule:
+    """A deadlock rule with the planner's parameter defaults, ``params`` changed."""
+    return DeadlockRule.from_params(robot_id, dataclasses.replace(CollvoidParams(), **params))
+
+
+def test_the_deadlock_rule_takes_the_planners_defaults_declared_once():
+    p = CollvoidParams()
+    r = DeadlockRule.from_params("lizi1", p)
+    assert (r.deadlock_time, r.deadlock_progress, r.deadlock_radius, r.yield_time) == (
+        p.deadlock_time, p.deadlock_progress, p.deadlock_radius, p.yield_time,
+    )  # fmt: skip
+    assert r.narrow_time == p.narrow_deadlock_time == 1.0
+    with pytest.raises(TypeError):
+        DeadlockRule("lizi1")  # no second set of defaults
+
+
 def test_deadlock_rule_yields_to_the_lower_id_only_after_no_progress():
-    rule = DeadlockRule("lizi10", deadlock_time=5.0, deadlock_progress=0.2, yield_time=4.0)
+    rule = make_rule("lizi10", deadlock_time=5.0, deadlock_progress=0.2, yield_time=4.0)
     assert rule.update(0.0, 5.0, {"lizi2": 1.0}) is None
     assert rule.update(4.9, 4.95, {"lizi2": 1.0}) is None
     assert rule.update(5.1, 4.95, {"lizi2": 1.0, "lizi11": 0.5}) == "lizi2"
     assert rule.update(8.0, 4.95, {"lizi2": 1.0}) == "lizi2"  # still yielding
     assert rule.update(9.2, 4.95, {"lizi2": 1.0}) is None  # done; the clock restarts
-    top = DeadlockRule("lizi2")
+    top = make_rule("lizi2")
     top.update(0.0, 5.0, {"lizi10": 1.0})
     assert top.update(6.0, 5.0, {"lizi10": 1.0}) is None  # priority: never yields
     assert priority_key("lizi2") < priority_key("lizi10")
@@ -253,19 +271,19 @@ def test_a_narrow_meeting_is_stuck_after_narrow_deadlock_time_progress_or_not():
     """Facing each other across a passage too narrow for two, ORCA slows the pair to a creep
     that still makes progress; the meeting itself starts the clock, and a robot met there
     counts beyond deadlock_radius."""
-    rule = DeadlockRule("lizi2", deadlock_time=10.0, deadlock_radius=2.0, narrow_time=1.0)
+    rule = make_rule("lizi2", deadlock_time=10.0, deadlock_radius=2.0, narrow_deadlock_time=1.0)
     assert rule.update(0.0, 6.0, {"lizi1": 2.8}, narrow=["lizi1"]) is None
     # 0.3 m of progress (a creep), still facing across the passage: stuck after 1 s
     assert rule.update(0.6, 5.7, {"lizi1": 2.4}, narrow=["lizi1"]) is None
     assert rule.update(1.1, 5.4, {"lizi1": 2.1}, narrow=["lizi1"]) == "lizi1"
     # not a narrow meeting: progress resets the clock, and 2.1 m is beyond deadlock_radius
-    plain = DeadlockRule("lizi2", deadlock_time=10.0, deadlock_radius=2.0, narrow_time=1.0)
+    plain = make_rule("lizi2", deadlock_time=10.0, deadlock_radius=2.0, narrow_deadlock_time=1.0)
     plain.update(0.0, 6.0, {"lizi1": 2.8})
     assert plain.update(1.1, 5.4, {"lizi1": 2.1}) is None
     assert plain.update(11.5, 5.4, {"lizi1": 2.1}) is None  # too far to take part
     assert plain.update(11.6, 5.4, {"lizi1": 1.9}) == "lizi1"
     # the meeting over, its clock is forgotten
-    top = DeadlockRule("lizi3", deadlock_time=10.0, narrow_time=1.0)
+    top = make_rule("lizi3", deadlock_time=10.0, narrow_deadlock_time=1.0)
     top.update(0.0, 6.0, {"lizi1": 2.8}, narrow=["lizi1"])
     top.update(0.5, 5.7, {"lizi1": 2.8})
     assert top.update(1.2, 5.7, {"lizi1": 2.8}, narrow=["lizi1"]) is None

@@ -31,6 +31,7 @@ from __future__ import annotations
 import re
 from collections.abc import Collection
 from dataclasses import dataclass
+from typing import Any
 
 
 def priority_key(robot_id: str) -> tuple:
@@ -40,17 +41,35 @@ def priority_key(robot_id: str) -> tuple:
 
 @dataclass
 class DeadlockRule:
-    """One robot's deadlock state (see the module doc)."""
+    """One robot's deadlock state (see the module doc).
+
+    The times and distances have no defaults here: they are the local planner's parameters
+    (``deadlock_time``, ``deadlock_progress``, ``deadlock_radius``, ``yield_time``,
+    ``narrow_deadlock_time`` of `fleetsim.nav.controllers.collvoid_params.CollvoidParams`),
+    declared there once; `from_params` takes them from such a parameter set.
+    """
 
     robot_id: str
-    deadlock_time: float = 10.0
-    deadlock_progress: float = 0.2
-    deadlock_radius: float = 2.0
-    yield_time: float = 30.0
-    narrow_time: float = 3.0
+    deadlock_time: float
+    deadlock_progress: float
+    deadlock_radius: float
+    yield_time: float
+    narrow_time: float
 
     def __post_init__(self) -> None:
         self.reset(0.0)
+
+    @classmethod
+    def from_params(cls, robot_id: str, params: Any) -> DeadlockRule:
+        """The rule with a planner parameter set's deadlock fields (any object with them)."""
+        return cls(
+            robot_id,
+            params.deadlock_time,
+            params.deadlock_progress,
+            params.deadlock_radius,
+            params.yield_time,
+            params.narrow_deadlock_time,
+        )
 
     def reset(self, now: float, remaining: float = float("inf")) -> None:
         """A new goal: forget progress and any yielding."""

@@ -9,10 +9,15 @@ s. When no frontier is left the node stops (``finished``), as explore_lite does 
 frontiers traversed/tried out, stopping"). With ``visualize`` it publishes ``~frontiers``
 (visualization_msgs/MarkerArray).
 
-For ``fleetsim launch --until-goals`` the node is a goal sender (``sends_goals``, ``done`` once
-it has stopped): the run ends when exploration does, and succeeds when every goal it sent was
-reached (a blacklisted frontier, aborted or without progress, means it gave up on part of the
-world).
+For ``fleetsim launch --until-goals`` the node is a goal sender (`fleetsim.launch.monitor.
+GoalSender`: ``sends_goals``, ``done`` once it has stopped): the run ends when exploration
+does. Exploration *finished* (``succeeded``, exit status 0) when it stopped because the map has
+no frontier left; it *gave up* (``gave_up``, exit status 1) when it stopped with frontiers left,
+every one of them blacklisted (move_base aborted its goal, or no progress for
+``progress_timeout``). A frontier blacklisted on the way that the robot's laser later maps from
+elsewhere is no longer a frontier and does not count. explore_lite stops either way; the goal
+it cancels on stopping is listed in ``withdrawn_goals``, so that the run monitor does not count
+it as a failed goal.
 
 Explorers sharing one map (slam_explore ``robots:=2``) would all head for the same best
 frontier; fleetsim adds ``peer_goals``: each explorer announces its goal on ``~goal`` and leaves
@@ -65,7 +70,9 @@ class ExploreParams:
     potential_scale: float = param(1e-3, range=(0.0, None), help="weight of frontier distance")
     orientation_scale: float = param(0.0, range=(0.0, None), help="unused, as in explore_lite")
     gain_scale: float = param(1.0, range=(0.0, None), help="weight of frontier size")
-    transform_tolerance: float = param(0.3, unit="s", range=(0.0, None), help="tf tolerance")
+    transform_tolerance: float = param(
+        0.3, unit="s", range=(0.0, None), help="oldest robot pose (tf) used to plan"
+    )
     min_frontier_size: float = param(
         0.5, unit="m", range=(0.0, None), help="smallest frontier considered"
     )
@@ -93,6 +100,10 @@ class Explore(Node):
         self.blacklist: list[tuple[float, float]] = []
         self.goal: tuple[float, float] | None = None
         self.finished = False
+        #: stopped with frontiers left, all blacklisted (see the module docstring)
+        self.gave_up = False
+        #: ids of the goals it canceled itself on stopping (for the run monitor)
+        self.withdrawn_goals: set[str] = set()
         self.goals_sent = 0
         self._handle: Any = None
         self._best_distance = math.inf
@@ -122,6 +133,11 @@ class Explore(Node):
     def done(self) -> bool:
         return self.finished
 
+    @property
+    def succeeded(self) -> bool:
+        """Stopped with no frontier left (False while exploring, or when it gave up)."""
+        return self.finished and not self.gave_up
+
     def on_costmap(self, msg: nav_msgs.OccupancyGrid) -> None:
         self.grid = msg
 
@@ -140,11 +156,25 @@ class Explore(Node):
         )
 
     def _robot_position(self, frame: str) -> tuple[float, float] | None:
+        """The robot's newest x, y in ``frame``; None (warned) when tf does not know it, or when
+        that pose is older than ``transform_tolerance`` (explore_lite's getRobotPose: a stale
+        pose would pick frontiers, and measure progress, from where the robot was)."""
+        buf = self.tf_buffer
         try:
-            x, y, _ = self.tf_buffer.lookup_pose2d(frame, self.base_frame, 0.0)
+            x, y, _ = buf.lookup_pose2d(frame, self.base_frame, 0.0)
+            stamp = buf.latest_common_time(frame, self.base_frame)
         except FleetsimError as err:
             self._warn_once("tf", f"cannot find the robot ({self.base_frame}) in {frame}: {err}")
             return None
+        now, tolerance = self.now(), self.params.transform_tolerance
+        if stamp > 0 and now - stamp > tolerance:  # stamp 0: static transforms only
+            self._warn_once(
+                "tf timeout",
+                f"robot pose ({self.base_frame} in {frame}) is {now - stamp:.3f} s old, more "
+                f"than transform_tolerance {tolerance} s: not exploring until tf catches up",
+            )
+            return None
+        self._warned.discard("tf timeout")
         return x, y
 
     def _peer_positions(self, frame: str) -> list[tuple[float, float]]:
@@ -244,7 +274,11 @@ class Explore(Node):
 
     def stop(self, why: str) -> None:
         self.finished = True
+        self.gave_up = bool(self.frontiers)  # what is left is all blacklisted
+        if self.gave_up:
+            why += f" (gave up: {len(self.frontiers)} frontiers left, all blacklisted)"
         if self._handle is not None:
+            self.withdrawn_goals.add(self._handle.id)
             self.move_base.cancel_all_goals()
         self.timer.cancel()
         self._announce(None)

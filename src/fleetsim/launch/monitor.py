@@ -13,13 +13,22 @@ SUCCEEDED, the robot's true position must be within the local planner's ``xy_goa
 result that ground truth contradicts (or that no ground truth can confirm) is counted as
 unconfirmed and fails the run. Ground truth is the engine when the simulator runs in this
 process, else the latest ``/gazebo/model_states`` (the model named as the namespace).
+
+Nodes that send goals for a purpose (send_goals' list, explore's frontiers) are *goal senders*
+(`GoalSender`): the monitor finds them among the run's nodes by ``sends_goals = True``; a run's
+goals are all done only once every sender is ``done``, and the run succeeds only if every
+sender also ``succeeded`` (send_goals: every goal reached; explore: it stopped with no frontier
+left, not with frontiers it had blacklisted). A goal a sender cancels itself because it no
+longer wants it (explore_lite cancels its active goal when it stops) is listed in the sender's
+``withdrawn_goals`` and counts as neither a goal nor a failure, like a goal replaced by
+another; any other cancel fails the goal.
 """
 
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, Protocol
 
 from fleetsim.errors import FleetsimError
 from fleetsim.launch.model import LaunchPlan
@@ -39,6 +48,25 @@ DEFAULT_XY_GOAL_TOLERANCE = 0.1
 DEFAULT_LOCAL_PLANNER = "base_local_planner/TrajectoryPlannerROS"
 #: goal frames that are the simulator's world frame (fleetsim's ``map`` is the world)
 WORLD_FRAMES = ("", "map", "world")
+
+
+class GoalSender(Protocol):
+    """What a goal-sending node tells the monitor (send_goals, explore, a user's node).
+
+    ``sends_goals`` (True) is how the monitor finds it; ``done``: it will send no more goals
+    and has the results of those it sent; ``succeeded`` (read once done): it achieved what it
+    sent the goals for, False when it gave up. Optional: ``withdrawn_goals``, the ids of goals
+    it canceled itself as no longer wanted (their PREEMPTED result is no failure); a node
+    without ``succeeded`` counts as succeeded once done (its goals' results still count).
+    """
+
+    sends_goals: bool
+
+    @property
+    def done(self) -> bool: ...
+
+    @property
+    def succeeded(self) -> bool: ...
 
 
 @dataclass
@@ -83,8 +111,8 @@ class RunMonitor:
     def __init__(self, runtime, plan: LaunchPlan, nodes: dict[str, Any]) -> None:
         self.runtime = runtime
         self.robots: dict[str, RobotResult] = {}
-        # nodes that send goals (send_goals, user nodes) say so with `sends_goals = True` and
-        # a `done` property; a run waits for them before its goals can all be done
+        # goal senders (`GoalSender`: send_goals, explore, user nodes): a run waits for them
+        # before its goals can all be done, and succeeds only if they succeeded
         self.senders = [n for n in nodes.values() if getattr(n, "sends_goals", False)]
         self.sim = next((n for n in nodes.values() if hasattr(n, "engine")), None)
         self._watched: set[str] = set()
@@ -172,16 +200,37 @@ class RunMonitor:
             msg.status.status == S.PREEMPTED and "another goal" in msg.status.text
         ):
             r.goals_sent -= 1  # replaced by a newer goal: not a failure, not a goal of its own
+        elif msg.status.status == S.PREEMPTED and (
+            sender := self._withdrawn_by(msg.status.goal_id.id)
+        ):
+            r.goals_sent -= 1  # its sender canceled it, no longer wanting it: not a failure
+            r.last_text = f"canceled by {sender}, which no longer wanted it"
         else:
             r.goals_failed += 1
         r.time_of_last_result = self.runtime.now()
 
+    def _withdrawn_by(self, goal_id: str) -> str:
+        """The name of the sender that withdrew goal ``goal_id`` ("" if none did)."""
+        for s in self.senders:
+            if goal_id in getattr(s, "withdrawn_goals", ()):
+                return str(getattr(s, "full_name", type(s).__name__))
+        return ""
+
     def all_goals_done(self) -> bool:
-        """True once every sender has sent everything and every goal has a result."""
+        """True once every sender has sent everything and every goal has a result (with
+        senders, also when they finished without sending a goal)."""
         if any(not s.done for s in self.senders):
             return False
         active = [r for r in self.robots.values() if r.goals_sent > 0]
-        return bool(active) and all(r.all_done for r in active)
+        return (bool(active) or bool(self.senders)) and all(r.all_done for r in active)
+
+    def senders_failed(self) -> list[str]:
+        """Names of the goal senders that are not done, or done and gave up."""
+        return [
+            str(getattr(s, "full_name", type(s).__name__))
+            for s in self.senders
+            if not s.done or not getattr(s, "succeeded", True)
+        ]
 
     def _confirm(self, r: RobotResult, goal, text: str) -> None:
         """Count a SUCCEEDED result as reached only if ground truth puts the robot at ``goal``."""
@@ -279,5 +328,12 @@ class RunMonitor:
         return [self.robots[k] for k in sorted(self.robots)]
 
     def success(self) -> bool:
+        """Every goal reached (confirmed by ground truth), every goal sender done and
+        succeeded, no collision; a run with neither goals nor senders did not succeed."""
         rs = [r for r in self.results() if r.goals_sent > 0]
-        return bool(rs) and all(r.ok for r in rs) and all(r.collisions == 0 for r in self.results())
+        return (
+            (bool(rs) or bool(self.senders))
+            and all(r.ok for r in rs)
+            and not self.senders_failed()
+            and all(r.collisions == 0 for r in self.results())
+        )

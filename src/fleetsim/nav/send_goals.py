@@ -150,6 +150,11 @@ class SendGoals(Node):
         """True once every robot has had a result for each of its goals (never with loop)."""
         return all(r.finished for r in self._robots)
 
+    @property
+    def succeeded(self) -> bool:
+        """True once done with every goal reached (the run monitor's `GoalSender`)."""
+        return self.done and all(o.reached for outs in self.results.values() for o in outs)
+
     def _tick(self) -> None:
         if self.now() < self._start - 1e-9:
             return

@@ -209,3 +209,76 @@ def test_me_publisher_takes_a_cloud_of_one_pose_as_no_uncertainty():
     rt.run(duration=0.3)
     assert me.uncertainty(0.0, 0.0) == 0.0
     assert robot.got[-1].radius == pytest.approx(math.hypot(0.2, 0.2))
+
+
+def in_frame(msg, frame):
+    msg.header.frame_id = frame
+    return msg
+
+
+@pytest.mark.parametrize(
+    "msg, words",
+    [
+        (in_frame(shared("r5", 1.0, 0.0, 1.0), "r_odom/odom"), "'r5'.*frame 'r_odom/odom'.*'map'"),
+        (in_frame(shared("r6", 1.0, 0.0, 1.0), "lizi6/base_link"), "frame 'lizi6/base_link'"),
+        (shared("r7", 1.0, 0.0, 1.0, radius=-0.3), "'r7' shared radius -0.3 m"),
+        (shared("r8", 1.0, 0.0, 1.0, radius=0.0), "'r8' shared radius 0.0 m"),
+    ],
+)
+def test_a_pose_in_another_frame_or_a_radius_not_above_zero_is_rejected(msg, words):
+    table = NeighbourTable()
+    problem = table.update(msg)
+    assert problem is not None and re.search(words, problem), problem
+    assert table.robots == {}
+
+
+@pytest.mark.parametrize("frame", ["map", "/map", ""])
+def test_the_shared_frame_is_accepted_with_or_without_slash_or_unset(frame):
+    table = NeighbourTable()
+    assert table.update(in_frame(shared("r1", 1.0, 0.0, 1.0), frame)) is None
+
+
+def test_a_message_stamped_far_in_the_future_is_not_fresh():
+    """t = 1000 s heard at 900 s would stay fresh for 102 s; more than 2 s ahead of the
+    listener's clock, its sender's clock is another one: dropped, reported naming the robot."""
+    bad = []
+    table = NeighbourTable(on_bad=bad.append)
+    table.update(shared("ahead", 1.0, 0.0, 1000.0))
+    table.update(shared("near", 2.0, 0.0, 901.5))  # 1.5 s ahead: clocks a little apart
+    assert table.get("ahead", 900.0) is None
+    assert [r.robot_id for r in table.fresh(900.0)] == ["near"]
+    assert "ahead" not in table.robots and table.get("near", 900.0) is not None
+    assert bad and all(b.robot_id == "ahead" and "'ahead'" in b for b in bad)
+    assert "100.000 s ahead" in bad[0]
+
+
+def test_one_warning_per_bad_robot_however_many_nodes_listen(caplog):
+    """Every robot's move_base listens to /position_share; a broken robot is warned about once
+    in the process (the issue: "ignored with one warning naming it"), per kind of fault."""
+    rt = Runtime()
+    shares = [PositionShare(Node(rt, "move_base", f"/lizi{k}")) for k in range(1, 5)]
+    pub = Node(rt, "talker", "/").create_publisher(
+        collvoid_msgs.PoseTwistWithCovariance, "/position_share"
+    )
+    with caplog.at_level(logging.WARNING):
+        for k in range(5):
+            pub.publish(shared("ghost", math.nan, 0.0, 0.1 * k))
+            pub.publish(shared("late", 1.0, 0.0, 100.0))
+            pub.publish(shared("ok", 1.0, 0.0, 0.1 * k))
+            rt.run(duration=0.1)
+            for s in shares:
+                s.table.near(rt.now(), (0.0, 0.0), 5.0, 10)
+    said = [r.getMessage() for r in caplog.records]
+    assert len([m for m in said if "'ghost'" in m]) == 1
+    assert len([m for m in said if "'late'" in m and "ahead of this clock" in m]) == 1
+    assert all(list(s.table.robots) == ["ok"] for s in shares)
+    assert all(s.rejected == 5 for s in shares)
+    # another process (runtime) warns for itself
+    rt2 = Runtime()
+    PositionShare(Node(rt2, "move_base", "/lizi1"))
+    Node(rt2, "talker", "/").create_publisher(
+        collvoid_msgs.PoseTwistWithCovariance, "/position_share"
+    ).publish(shared("ghost", math.nan, 0.0, 0.0))
+    with caplog.at_level(logging.WARNING):
+        rt2.run(duration=0.1)
+    assert len([r for r in caplog.records if "'ghost'" in r.getMessage()]) == 2

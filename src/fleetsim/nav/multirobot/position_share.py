@@ -7,10 +7,14 @@ local planner, the robots costmap layer) keeps the newest message per ``robot_id
 `NeighbourTable`:
 
 * entries older than ``last_seen_threshold`` (collvoid's name, 2 s) by their header stamp are
-  dropped;
-* a message with a NaN or infinite pose, velocity or radius, an empty or non-finite footprint,
-  or no ``robot_id`` is rejected (`neighbour_from_msg` says why); `PositionShare` warns once per
-  robot and keeps the others;
+  dropped, and so are entries stamped more than ``FUTURE_TOLERANCE`` (2 s) ahead of the
+  listener's clock (a publisher on another clock: its messages would never go stale);
+* a message with a NaN or infinite pose, velocity or radius, a radius <= 0, an empty or
+  non-finite footprint, a ``header.frame_id`` other than the shared frame (``map``; an empty
+  one is taken as the shared frame), or no ``robot_id`` is rejected (`neighbour_from_msg` says
+  why); `PositionShare` keeps the others and warns once per robot and reason in a process (a
+  runtime), whichever of its listening nodes hears it first (the warning names that node):
+  ten robots' move_bases hearing one broken robot give one warning, not ten;
 * `NeighbourTable.near` gives the robots within a radius, nearest first, at most
   ``max_neighbors``, as arrays in the map frame.
 
@@ -21,17 +25,37 @@ other through the Zenoh bridge like any other topic (the message is CDR-able).
 from __future__ import annotations
 
 import math
+import weakref
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from fleetsim.msgs import collvoid_msgs
+from fleetsim.tf.names import normalize_frame
 from fleetsim.tf.quaternions import yaw_from_quaternion
 
 TOPIC = "/position_share"
 #: collvoid's ``~last_seen_threshold``: s after which a silent robot is forgotten
 LAST_SEEN_THRESHOLD = 2.0
+#: s a message may be stamped ahead of the listener's clock (beyond: the sender's clock is wrong)
+FUTURE_TOLERANCE = 2.0
+#: the frame every robot shares its pose in
+SHARED_FRAME = "map"
+
+
+class Rejection(str):
+    """Why a message is unusable (the text), with the robot it came from and the kind of fault
+    (the key of the one warning)."""
+
+    robot_id: str
+    kind: str
+
+    def __new__(cls, robot_id: str, kind: str, text: str) -> Rejection:
+        out = super().__new__(cls, text)
+        out.robot_id, out.kind = robot_id, kind
+        return out
 
 
 @dataclass(frozen=True)
@@ -58,27 +82,44 @@ class Neighbour:
         )
 
 
-def neighbour_from_msg(msg: Any) -> Neighbour | str:
-    """The `Neighbour` a position_share message describes, or the reason it is unusable."""
+def neighbour_from_msg(msg: Any, frame: str = SHARED_FRAME) -> Neighbour | Rejection:
+    """The `Neighbour` a position_share message describes, or the reason it is unusable
+    (``frame``: the shared frame its pose must be in)."""
     rid = str(msg.robot_id or "")
     if not rid:
-        return "a message without robot_id"
+        return Rejection("", "robot_id", "a message without robot_id")
+    given = str(msg.header.frame_id or "")
+    if given and given.lstrip("/") != normalize_frame(frame):
+        return Rejection(
+            rid,
+            "frame",
+            f"robot '{rid}' shared its pose in frame '{given}', not the shared frame "
+            f"'{normalize_frame(frame)}'",
+        )
     p = msg.pose.pose
     pose = (p.position.x, p.position.y)
     q = p.orientation
     v = msg.holonomic_velocity
     numbers = (*pose, q.x, q.y, q.z, q.w, v.x, v.y, msg.radius)
     if not all(math.isfinite(float(x)) for x in numbers):
-        return (
+        return Rejection(
+            rid,
+            "non-finite",
             f"robot '{rid}' shared a non-finite pose, velocity or radius "
-            f"(pose {pose[0]}, {pose[1]}; velocity {v.x}, {v.y}; radius {msg.radius})"
+            f"(pose {pose[0]}, {pose[1]}; velocity {v.x}, {v.y}; radius {msg.radius})",
+        )
+    if not float(msg.radius) > 0.0:
+        return Rejection(
+            rid, "radius", f"robot '{rid}' shared radius {msg.radius} m (it must be > 0)"
         )
     pts = msg.footprint.polygon.points
     fp = np.array([[pt.x, pt.y] for pt in pts], dtype=np.float64).reshape(-1, 2)
     if fp.shape[0] < 3 or not np.isfinite(fp).all():
-        return (
+        return Rejection(
+            rid,
+            "footprint",
             f"robot '{rid}' shared an empty or invalid footprint ({fp.shape[0]} points; a "
-            "polygon needs at least 3 finite points)"
+            "polygon needs at least 3 finite points)",
         )
     stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
     yaw = yaw_from_quaternion((q.x, q.y, q.z, q.w))
@@ -98,31 +139,58 @@ class NeighbourArrays:
 
 
 class NeighbourTable:
-    """The newest state of every robot on ``/position_share`` (see the module doc)."""
+    """The newest state of every robot on ``/position_share`` (see the module doc).
 
-    def __init__(self, last_seen_threshold: float = LAST_SEEN_THRESHOLD) -> None:
+    ``on_bad``: called with the `Rejection` of an entry `fresh` or `get` drop for being stamped
+    in the future (messages rejected on arrival are returned by `update` instead)."""
+
+    def __init__(
+        self,
+        last_seen_threshold: float = LAST_SEEN_THRESHOLD,
+        frame: str = SHARED_FRAME,
+        on_bad: Callable[[Rejection], None] | None = None,
+    ) -> None:
         self.last_seen_threshold = last_seen_threshold
+        self.frame = frame
+        self.on_bad = on_bad
         self.robots: dict[str, Neighbour] = {}
 
-    def update(self, msg: Any) -> str | None:
+    def update(self, msg: Any) -> Rejection | None:
         """Store a message; returns the reason when it was rejected."""
-        got = neighbour_from_msg(msg)
+        got = neighbour_from_msg(msg, self.frame)
         if isinstance(got, str):
             return got
         self.robots[got.robot_id] = got
         return None
 
+    def _usable(self, r: Neighbour, now: float) -> bool:
+        """Fresh: not older than last_seen_threshold, not stamped beyond FUTURE_TOLERANCE."""
+        if r.stamp - now > FUTURE_TOLERANCE:
+            if self.on_bad is not None:
+                self.on_bad(
+                    Rejection(
+                        r.robot_id,
+                        "future",
+                        f"robot '{r.robot_id}' shared a message stamped {r.stamp:.3f} s, "
+                        f"{r.stamp - now:.3f} s ahead of this clock ({now:.3f} s; more than "
+                        f"{FUTURE_TOLERANCE:g} s: its clock is not this one)",
+                    )
+                )
+            return False
+        return now - r.stamp <= self.last_seen_threshold
+
     def get(self, robot_id: str, now: float) -> Neighbour | None:
         """One robot's fresh entry, or None."""
         r = self.robots.get(robot_id)
-        if r is None or now - r.stamp > self.last_seen_threshold:
+        if r is None or not self._usable(r, now):
             return None
         return r
 
     def fresh(self, now: float) -> list[Neighbour]:
-        """Every robot heard from within ``last_seen_threshold``; older ones are dropped."""
-        stale = [k for k, r in self.robots.items() if now - r.stamp > self.last_seen_threshold]
-        for k in stale:
+        """Every robot heard from within ``last_seen_threshold`` (and not stamped in the
+        future); the others are dropped."""
+        bad = [k for k, r in self.robots.items() if not self._usable(r, now)]
+        for k in bad:
             del self.robots[k]
         return [self.robots[k] for k in sorted(self.robots)]
 
@@ -145,21 +213,34 @@ class NeighbourTable:
         )
 
 
+#: per runtime (one process of robots), the (robot, kind of fault) already warned about
+_WARNED: weakref.WeakKeyDictionary[Any, set[tuple[str, str]]] = weakref.WeakKeyDictionary()
+
+
 class PositionShare:
     """A node's subscription to ``/position_share`` feeding a `NeighbourTable`; a robot whose
-    message is rejected is warned about once (by robot) and ignored."""
+    message is rejected is ignored, and warned about once per robot and kind of fault in the
+    node's runtime (not once per listening node)."""
 
     def __init__(self, node: Any, last_seen_threshold: float = LAST_SEEN_THRESHOLD) -> None:
         self.node = node
-        self.table = NeighbourTable(last_seen_threshold)
+        self.table = NeighbourTable(last_seen_threshold, on_bad=self.warn)
         self.rejected = 0
         self.sub = node.create_subscription(
             collvoid_msgs.PoseTwistWithCovariance, TOPIC, self.on_message, queue_size=0
         )
+
+    def warn(self, problem: Rejection) -> None:
+        """Warn about ``problem`` unless this runtime already has."""
+        warned = _WARNED.setdefault(self.node.runtime, set())
+        key = (problem.robot_id, problem.kind)
+        if key not in warned:
+            warned.add(key)
+            self.node.get_logger().warning(f"{TOPIC}: ignoring {problem}")
 
     def on_message(self, msg: Any) -> None:
         problem = self.table.update(msg)
         if problem is not None:
             self.rejected += 1
             self.table.robots.pop(str(msg.robot_id or ""), None)
-            self.node._warn_once(f"position_share:{msg.robot_id}", f"{TOPIC}: ignoring {problem}")
+            self.warn(problem)

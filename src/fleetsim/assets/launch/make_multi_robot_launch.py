@@ -68,6 +68,15 @@ def _group(k: int, robot: tuple, minimum: int) -> str:
   </group>"""
 
 
+#: the args every scenario takes with a fixed set of values: name -> the values
+CHOICES = {"planner": ("collvoid", "trajectory"), "localization": ("fake", "amcl")}
+#: their checks (a value not in the set is a launch error that names the arg and the values)
+CHOICE_CHECKS = "\n".join(
+    f"""  <arg name="{name}_checked" value="$(eval {name} if {name} in {values!r} else """
+    f"""{name}_must_be_{"_or_".join(values)})"/>"""
+    for name, values in CHOICES.items()
+)
+
 #: swap_corridor's ``width`` arg: corridor width (m) -> world
 CORRIDOR_WORLDS = {2.0: "corridor", 1.0: "corridor_narrow"}
 
@@ -88,7 +97,8 @@ def _world_arg(world: str | dict[float, str]) -> str:
 
 def scenario(name: str, doc: str, world: str | dict, counts: tuple[int, int], robots: list) -> str:
     small, large = counts
-    # an unknown name in $(eval) is a launch error that names it: robots_must_be_2_or_4
+    # an unknown name <arg>_must_be_<a>_or_<b> in $(eval) is a launch error naming the arg, its
+    # value and the allowed ones (fleetsim.launch.substitutions)
     bad = f"robots_must_be_{small}_or_{large}"
     check = f"$(eval robots if int(robots) in ({small}, {large}) else {bad})"
     groups = "".join(_group(k + 1, r, small if k < small else large) for k, r in enumerate(robots))
@@ -106,6 +116,7 @@ def scenario(name: str, doc: str, world: str | dict, counts: tuple[int, int], ro
 {_world_arg(world)}
   <arg name="gui" default="true" doc="open the live view when run with --viz"/>
   <arg name="robots_checked" value="{check}"/>
+{CHOICE_CHECKS}
 
   <param name="/use_sim_time" value="true"/>
   <node pkg="map_server" type="map_server" name="map_server" args="$(arg map)">

@@ -121,11 +121,15 @@ def sample(
     true.append((float(pos[0]), float(pos[1])))
 
 
-def office(max_time: float, seed: int, robots: int = 1, robot: str = "hunter") -> float:
+def office(
+    max_time: float, seed: int, robots: int = 1, robot: str = "hunter", trace: bool = False
+) -> float:
     """Explore the office with ``robots`` robots (slam_explore robots:=N robot:=...); the sim
     time it took. One hunter is the manual's hunter_run (no namespace), any other robot runs in
-    namespaces ``<robot>1``, ``<robot>2``."""
+    namespaces ``<robot>1``, ``<robot>2``. ``trace``: print where the time went
+    (`explore_trace`)."""
     import fleetsim
+    from explore_trace import ExploreTrace
     from fleetsim.cli.launch import resolve_launch_file
     from fleetsim.launch.runner import LaunchSession, load_plan
     from fleetsim.nav.map_io import load_map
@@ -135,9 +139,12 @@ def office(max_time: float, seed: int, robots: int = 1, robot: str = "hunter") -
     plan = load_plan(resolve_launch_file("slam_explore"), {"robots": str(robots), "robot": robot})
     alone = robots == 1 and robot == "hunter"
     names = [""] if alone else [f"{robot}{i + 1}" for i in range(robots)]
-    with update_timer() as times, LaunchSession(plan, seed=seed) as s:
+    tracer = ExploreTrace()
+    patched = tracer.patch() if trace else contextlib.nullcontext()
+    with update_timer() as times, patched, LaunchSession(plan, seed=seed) as s:
         explorers = [s.nodes[f"/{n}/explore".replace("//", "/")] for n in names]
         est, true = [[] for _ in names], [[] for _ in names]
+        slam_node = s.nodes[f"/{names[0]}/slam_gmapping".replace("//", "/")]
         while not all(ex.finished for ex in explorers) and s.runtime.now() < max_time:
             s.runtime.run(duration=1.0)
             for i, n in enumerate(names):
@@ -146,16 +153,19 @@ def office(max_time: float, seed: int, robots: int = 1, robot: str = "hunter") -
                     sample(s, est[i], true[i], n, f"{n}/base_link", frame)
                 else:
                     sample(s, est[i], true[i])
+            if trace:
+                grid = slam_node.grid_msg if robots == 1 else s.nodes["/map_merge"].merged
+                by_ns = {ex.namespace: ex for ex in explorers}
+                tracer.sample(s.runtime.now(), by_ns, [t[-1] for t in true], grid)
         explored_at = s.runtime.now()
-        if robots == 1:
-            slam = s.nodes[f"/{names[0]}/slam_gmapping".replace("//", "/")].grid_msg
-        else:
-            slam = s.nodes["/map_merge"].merged
+        slam = slam_node.grid_msg if robots == 1 else s.nodes["/map_merge"].merged
     state = ", ".join(
         f"{n or robot}: finished={ex.finished} blacklisted={len(ex.blacklist)}"
         for n, ex in zip(names, explorers)
     )
     print(f"office ({robots} {robot}(s) explore, seed {seed}): {state}")
+    if trace:
+        tracer.summary()
     if robots > 1:
         from fleetsim.slam.quality import ate
 
@@ -339,6 +349,7 @@ def main() -> None:
     ap.add_argument("--max-time", type=float, default=1500.0)
     ap.add_argument("--seeds", default="1", help="comma-separated runtime seeds, run in turn")
     ap.add_argument("--robot", default="hunter", help="office1: the robot (hunter or lizi)")
+    ap.add_argument("--trace", action="store_true", help="office: where the time went")
     ap.add_argument(
         "--only", choices=["update", "office", "office1", "office2", "willow"], default=None
     )
@@ -348,8 +359,12 @@ def main() -> None:
         update_30x360()
     for seed in seeds:
         if a.only in (None, "office", "office1", "office2"):
-            one = office(a.max_time, seed, robot=a.robot) if a.only != "office2" else None
-            two = office(a.max_time, seed, robots=2) if a.only != "office1" else None
+            one = (
+                office(a.max_time, seed, robot=a.robot, trace=a.trace)
+                if a.only != "office2"
+                else None
+            )
+            two = office(a.max_time, seed, robots=2, trace=a.trace) if a.only != "office1" else None
             if one is not None and two is not None:
                 print(f"two hunters explored the office in {two / one:.0%} of one hunter's time")
         if a.only in (None, "willow"):

@@ -221,3 +221,59 @@ def test_a_peer_frame_tf_does_not_know_is_warned_about_and_ignored(caplog):
         rt.run(duration=1.5)
     assert "cannot find the peer nobody/base_link in map" in caplog.text
     assert len(sink.goals) == 1
+
+
+class AbortingMoveBase(Node):
+    """A move_base that aborts every goal at once."""
+
+    def __init__(self, rt):
+        super().__init__(rt, "move_base")
+        self.goals = []
+        self.server = self.create_action_server(
+            move_base_msgs.MoveBase, "move_base", goal_callback=self.on_goal
+        )
+
+    def on_goal(self):
+        p = self.server.accept_new_goal().target_pose.pose.position
+        self.goals.append((round(p.x, 2), round(p.y, 2)))
+        self.server.set_aborted(text="no path")
+
+
+def test_a_frontier_a_peer_blacklisted_is_skipped_and_its_own_blacklist_is_published():
+    data = np.full((20, 30), -1, dtype=np.int8)
+    data[:, :10] = 0
+    data[:4, :6] = -1
+    big, small = frontiers_from_grid(data, 0.1, (0.0, 0.0), (0.35, 1.05))
+    big_goal, small_goal = (tuple(round(v, 2) for v in f.centroid) for f in (big, small))
+    rt = Runtime(seed=0)
+    rt.params.set("/explore/peer_blacklists", ["/peer/explore/blacklist"])
+    FakeWorld(rt, data)
+    sink = GoalSink(rt)
+    peer = Node(rt, "peer").create_publisher(
+        geometry_msgs.PoseArray, "/peer/explore/blacklist", 1, latch=True
+    )
+    # the peer gave up on the big frontier: this explorer does not drive there
+    peer.publish(
+        geometry_msgs.PoseArray(
+            poses=[geometry_msgs.Pose(position=geometry_msgs.Point(x=big_goal[0], y=big_goal[1]))]
+        )
+    )
+    Explore(rt)
+    rt.run(duration=1.5)
+    assert sink.goals == [small_goal]
+
+
+def test_an_explorer_publishes_what_it_blacklists_for_its_peers():
+    data = np.full((20, 30), -1, dtype=np.int8)
+    data[:, :10] = 0
+    rt = Runtime(seed=0)
+    FakeWorld(rt, data)
+    mb = AbortingMoveBase(rt)
+    published = []
+    rt.graph.subscribe("/explore/blacklist", geometry_msgs.PoseArray, published.append)
+    ex = Explore(rt)
+    rt.run(duration=1.5)
+    assert mb.goals and ex.blacklist
+    assert published[-1].header.frame_id == "map"
+    got = [(q.position.x, q.position.y) for q in published[-1].poses]
+    assert np.allclose(got, ex.blacklist) and len(got) == len(ex.blacklist)

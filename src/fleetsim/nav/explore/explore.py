@@ -23,10 +23,13 @@ Explorers sharing one map (slam_explore ``robots:=2``) would all head for the sa
 frontier; fleetsim adds ``peer_goals``: each explorer announces its goal on ``~goal`` and leaves
 frontiers within ``peer_radius`` of a peer's goal to that peer, unless every frontier is; with
 ``peer_frames`` (the peers' base frames, found in the shared map through tf) it also leaves to
-a peer every frontier whose nearest cell is nearer to that peer than to itself, so that each
+a peer every frontier whose centroid is nearer to that peer than to itself, so that each
 robot takes the frontiers on its side instead of both heading for the same region (the pair of
-hunters crossed the office's corridor to each other's end). The preference falls back step by
-step: frontiers nearer to it that no peer heads for, then any no peer heads for, then any.
+hunters crossed the office's corridor to each other's end); ``switch_distance`` keeps it on the
+frontier it heads for unless another is clearly cheaper; each explorer publishes its blacklist
+on ``~blacklist`` (geometry_msgs/PoseArray) and skips the frontiers its peers blacklisted
+(``peer_blacklists``: two hunters each gave up on a corner of the office and then crossed the
+office to the corner the other had given up on). The rules: `fleetsim.nav.explore.peers`.
 
 ``costmap_updates_topic`` is accepted but fleetsim's costmaps publish whole grids only (see
 `fleetsim.nav.costmap.costmap_ros`), so it is not subscribed. ``orientation_scale`` is accepted
@@ -35,6 +38,7 @@ and, as in explore_lite, unused.
 
 from __future__ import annotations
 
+import itertools
 import math
 from dataclasses import dataclass
 from typing import Any
@@ -48,6 +52,7 @@ from fleetsim.runtime import Node, param
 from fleetsim.tf.names import resolve_frame_once
 
 from .frontier_search import Frontier, frontiers_from_grid
+from .peers import frontier_for_robot
 
 BLACKLIST_RADIUS_CELLS = 5  # explore_lite's goalOnBlacklist tolerance
 SUCCEEDED, ABORTED = 3, 4
@@ -84,6 +89,15 @@ class ExploreParams:
     peer_frames: list = param(
         [], help="other explorers' base frames: frontiers nearer to one of them are its"
     )
+    peer_blacklists: list = param(
+        [], help="other explorers' ~blacklist topics (geometry_msgs/PoseArray): skipped too"
+    )
+    switch_distance: float = param(
+        0.0,
+        unit="m",
+        range=(0.0, None),
+        help="keep the frontier it heads for unless another is cheaper by this much distance",
+    )
 
 
 class Explore(Node):
@@ -111,6 +125,18 @@ class Explore(Node):
         self.frontiers: list[Frontier] = []
         self.peers: dict[str, tuple[float, float] | None] = {}
         self.goal_pub = self.create_publisher(geometry_msgs.PointStamped, "~goal", 1, latch=True)
+        self.blacklist_pub = self.create_publisher(
+            geometry_msgs.PoseArray, "~blacklist", 1, latch=True
+        )
+        self.peer_blacklists: dict[str, list[tuple[float, float]]] = {}
+        for topic in p.peer_blacklists:
+            self.peer_blacklists[str(topic)] = []
+            self.create_subscription(
+                geometry_msgs.PoseArray,
+                str(topic),
+                lambda m, t=str(topic): self.on_peer_blacklist(t, m),
+                1,
+            )
         for topic in p.peer_goals:
             self.peers[str(topic)] = None
             self.create_subscription(
@@ -144,6 +170,23 @@ class Explore(Node):
     def on_peer(self, topic: str, msg: geometry_msgs.PointStamped) -> None:
         x, y = msg.point.x, msg.point.y
         self.peers[topic] = (x, y) if math.isfinite(x) and math.isfinite(y) else None
+
+    def on_peer_blacklist(self, topic: str, msg: geometry_msgs.PoseArray) -> None:
+        self.peer_blacklists[topic] = [(q.position.x, q.position.y) for q in msg.poses]
+
+    def _blacklist(self, goal: tuple[float, float]) -> None:
+        """Blacklist a goal and tell the peers (~blacklist)."""
+        self.blacklist.append(goal)
+        frame = self.grid.header.frame_id if self.grid is not None else ""
+        self.blacklist_pub.publish(
+            geometry_msgs.PoseArray(
+                header=std_msgs.Header(stamp=self.now_msg(), frame_id=frame),
+                poses=[
+                    geometry_msgs.Pose(position=geometry_msgs.Point(x=float(x), y=float(y)))
+                    for x, y in self.blacklist
+                ],
+            )
+        )
 
     def _announce(self, goal: tuple[float, float] | None, frame: str = "") -> None:
         """Publish the goal on ~goal for peer explorers (NaN: none)."""
@@ -213,34 +256,36 @@ class Explore(Node):
         if self.marker_pub is not None:
             self._publish_markers(frame)
         tolerance = BLACKLIST_RADIUS_CELLS * info.resolution
+        blacklist = [*self.blacklist, *itertools.chain(*self.peer_blacklists.values())]
         candidates = [
             f
             for f in self.frontiers
-            if not any(math.dist(f.centroid, b) < tolerance for b in self.blacklist)
+            if not any(math.dist(f.centroid, b) < tolerance for b in blacklist)
         ]
         if not candidates:
             self.stop("all frontiers traversed/tried out, stopping")
             return
-        taken = [g for g in self.peers.values() if g is not None]
-        free = [
-            f for f in candidates if all(math.dist(f.centroid, g) >= p.peer_radius for g in taken)
-        ]
-        others = self._peer_positions(frame)
-        nearer = [f for f in free if _nearest_to_me(f, others)]
-        # all taken by peers: help with the best one
-        candidates = nearer or free or candidates
-        target = candidates[0].centroid
+        chosen = frontier_for_robot(
+            candidates,
+            robot,
+            self.goal,
+            [g for g in self.peers.values() if g is not None],
+            self._peer_positions(frame),
+            p.peer_radius,
+            p.potential_scale * info.resolution * p.switch_distance,
+        )
+        target = chosen.centroid
         same = self.goal is not None and math.dist(target, self.goal) < 1e-6
         # progress as explore_lite measures it: towards the frontier's nearest cell (its
         # centroid may lie behind a wall the robot has to go round)
-        distance = candidates[0].min_distance
+        distance = chosen.min_distance
         now = self.now()
         if not same or distance < self._best_distance:
             self._best_distance = distance
             self._last_progress = now
         if same and now - self._last_progress > p.progress_timeout:
             self.get_logger().info(f"no progress towards {target} for {p.progress_timeout} s")
-            self.blacklist.append(target)
+            self._blacklist(target)
             self.goal = None
             self.make_plan()
             return
@@ -267,7 +312,7 @@ class Explore(Node):
         self._handle = None
         if status == ABORTED:
             self.get_logger().info(f"move_base aborted the goal {goal}; blacklisting it")
-            self.blacklist.append(goal)
+            self._blacklist(goal)
         self.goal = None
         self._announce(None)
         self.runtime.call_later(0.0, self.make_plan)  # explore_lite replans on reaching a goal
@@ -304,14 +349,3 @@ class Explore(Node):
                 )
             )
         self.marker_pub.publish(visualization_msgs.MarkerArray(markers=markers))
-
-
-def _nearest_to_me(frontier: Frontier, others: list[tuple[float, float]]) -> bool:
-    """Whether no other robot (positions, m) is nearer to the frontier's nearest cell to it
-    than this robot is (``frontier.min_distance``); ties stay with this robot."""
-    for x, y in others:
-        if np.hypot(frontier.points[:, 0] - x, frontier.points[:, 1] - y).min() < (
-            frontier.min_distance
-        ):
-            return False
-    return True

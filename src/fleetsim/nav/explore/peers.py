@@ -1,0 +1,90 @@
+"""Which frontier an explorer takes when peers explore the same map (fleetsim addition).
+
+explore_lite has no notion of other robots; two explorers on one merged map both head for the
+same cheapest frontier. Multi-robot frontier explorers (Burgard et al.'s coordinated
+exploration, multirobot_exploration's assigners) give each robot a frontier with the peers'
+known goals taken into account; here each robot runs its own explorer and decides for itself
+from what its peers announce (their goals, positions and blacklists), so no central planner
+is needed:
+
+- a frontier within ``peer_radius`` of a peer's goal is the peer's (it will map it);
+- of the others, it prefers those whose centroid (the goal it would send) is nearer to it than
+  to every peer (each robot keeps to its side);
+- the preference falls back step by step: frontiers on its side that no peer heads for, then
+  any that no peer heads for (a robot whose side is done helps with the peer's side, nearest
+  first), then any;
+- with ``switch_distance`` > 0 it keeps the frontier it is heading for (the free frontier
+  nearest its goal) unless another is cheaper by at least ``potential_scale * res *
+  switch_distance``: the side a frontier falls on changes as the robots move, and with nearly
+  equal costs explore_lite's replanning flipped the goal between two frontiers every plan
+  (office, two hunters, seed 1: 45 of hunter1's 55 goals replaced before they were reached).
+
+With no peers and ``switch_distance`` 0 the choice is explore_lite's: the cheapest frontier.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+from .frontier_search import Frontier
+
+#: m: the frontier nearest the current goal (centroid or a cell this near) is still "the same"
+TRACK_RADIUS = 1.0
+
+
+def frontier_for_robot(
+    candidates: Sequence[Frontier],
+    robot: tuple[float, float],
+    goal: tuple[float, float] | None,
+    peer_goals: Sequence[tuple[float, float]],
+    peer_positions: Sequence[tuple[float, float]],
+    peer_radius: float,
+    switch_margin: float = 0.0,
+) -> Frontier:
+    """The frontier this robot should head for.
+
+    Parameters
+    ----------
+    candidates : frontiers not blacklisted, cheapest first (explore_lite's cost); not empty.
+    robot : this robot's (x, y), m, in the frontiers' frame.
+    goal : the goal (x, y) it is heading for, or None.
+    peer_goals : the peers' announced goals (x, y), m.
+    peer_positions : where the peers are (x, y), m.
+    peer_radius : m; frontiers with a centroid this near a peer's goal are that peer's.
+    switch_margin : cost (explore_lite's units) by which another frontier must beat the one it
+        heads for to replace it; 0 replaces it whenever another is cheapest.
+    """
+    free = [
+        f for f in candidates if all(math.dist(f.centroid, g) >= peer_radius for g in peer_goals)
+    ]
+    mine = [f for f in free if _nearer_to_robot(f, robot, peer_positions)]
+    best = (mine or free or candidates)[0]
+    if switch_margin <= 0.0 or goal is None:
+        return best
+    current = _tracked(free, goal)
+    if current is not None and current.cost < best.cost + switch_margin:
+        return current
+    return best
+
+
+def _nearer_to_robot(
+    frontier: Frontier, robot: tuple[float, float], others: Sequence[tuple[float, float]]
+) -> bool:
+    """Whether no other robot is nearer to the frontier's centroid than this one (ties mine)."""
+    mine = math.dist(frontier.centroid, robot)
+    return all(math.dist(frontier.centroid, o) >= mine for o in others)
+
+
+def _tracked(frontiers: Sequence[Frontier], goal: tuple[float, float]) -> Frontier | None:
+    """The frontier the goal was sent to, as it is now: its centroid moves as it shrinks, so
+    the one whose centroid, or a cell, lies within `TRACK_RADIUS` of the goal (nearest
+    centroid first)."""
+    near = [
+        f
+        for f in frontiers
+        if math.dist(f.centroid, goal) < TRACK_RADIUS
+        or ((f.points[:, 0] - goal[0]) ** 2 + (f.points[:, 1] - goal[1]) ** 2).min()
+        < TRACK_RADIUS**2
+    ]
+    return min(near, key=lambda f: math.dist(f.centroid, goal), default=None)

@@ -11,7 +11,7 @@ import math
 import re
 
 import pytest
-from nav_harness import PACKAGE, WILLOW, lesson_starts
+from nav_harness import WILLOW, lesson_starts
 
 from fleetsim.cli.launch import resolve_launch_file
 from fleetsim.launch.runner import LaunchSession, load_plan
@@ -141,16 +141,25 @@ def test_plain_trajectory_planner_runs_into_the_other_robot(monkeypatch, tmp_pat
 
 
 def test_lesson_lizis_swap_starts_in_willow(monkeypatch, tmp_path):
+    """The shipped willow_swap: the lesson's three lizis (its starts moved to the nearest cells
+    a lizi fits in) sent through each other's paths in the Willow Garage map."""
     monkeypatch.chdir(tmp_path)
     starts = lesson_starts(load_map(WILLOW))
-    args = {f"{k}{i}": str(v) for i, st in enumerate(starts, 1) for k, v in zip("xy", st[:2])}
-    launch = PACKAGE / "launch" / "collvoid_swap.launch"
-    with LaunchSession(load_plan(launch, args), seed=1) as s:
+    with session("willow_swap", gui="false") as s:
+        spawned = {}
+        for n in s.plan.nodes:
+            if (n.pkg, n.type) == ("gazebo_ros", "spawn_model"):
+                a = n.args
+                xy = [float(a[a.index("-x") + 1]), float(a[a.index("-y") + 1])]
+                spawned[n.namespace.rstrip("/")] = xy
         s.run(duration=60.0, until_goals=True)
         assert_clean_success(s, tmp_path)
         goals = {r.namespace: r.goal for r in s.monitor.results()}
-        assert goals["/lizi1"] == pytest.approx(starts[2][:2])
-        assert goals["/lizi2"] == pytest.approx(starts[0][:2])
+    for k, st in enumerate(starts, 1):
+        assert spawned[f"/lizi{k}"] == pytest.approx(st[:2])
+    assert goals["/lizi1"] == pytest.approx(starts[2][:2])
+    assert goals["/lizi2"] == pytest.approx(starts[0][:2])
+    assert goals["/lizi3"] == pytest.approx(starts[1][:2])
 
 
 @pytest.mark.parametrize(
@@ -158,6 +167,8 @@ def test_lesson_lizis_swap_starts_in_willow(monkeypatch, tmp_path):
     [
         ("swap_corridor", {"robots": "3"}, "arg 'robots' is '3'; it must be 2 or 4"),
         ("circle", {"robots": "5"}, "arg 'robots' is '5'; it must be 8 or 16"),
+        ("willow_swap", {"robots": "2"}, "arg 'robots' is '2'; it must be 3"),
+        ("willow_swap", {"planner": "foo"}, "'planner' is 'foo'; it must be collvoid or traj"),
         ("swap_corridor", {"width": "1.5"}, "arg 'width' is '1.5'; it must be 2 or 1"),
         ("swap_corridor", {"planner": "foo"}, "'planner' is 'foo'; it must be collvoid or traj"),
         ("circle", {"planner": "dwa"}, "arg 'planner' is 'dwa'; it must be collvoid or traj"),
@@ -178,6 +189,6 @@ def test_the_scenarios_refuse_args_they_do_not_know(name, args, words):
 def test_the_scenarios_are_shipped():
     from fleetsim.cli.launch import scenarios
 
-    assert {"swap_corridor", "circle"} <= set(scenarios())
-    for name in ("swap_corridor", "circle"):
+    assert {"swap_corridor", "circle", "willow_swap"} <= set(scenarios())
+    for name in ("swap_corridor", "circle", "willow_swap"):
         load_plan(resolve_launch_file(name), {"planner": "trajectory", "localization": "amcl"})

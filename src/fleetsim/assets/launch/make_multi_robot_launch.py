@@ -1,4 +1,5 @@
-"""Write the multi-robot avoidance scenarios ``swap_corridor.launch`` and ``circle.launch``.
+"""Write the multi-robot avoidance scenarios ``swap_corridor.launch``, ``circle.launch`` and
+``willow_swap.launch``.
 
 * ``swap_corridor`` (world ``corridor``: 12 m long, 2 m wide, free x 1..13, y 1..3): arg
   ``robots`` 2 or 4. With 2, lizi1 at the west end and lizi2 at the east end exchange places;
@@ -8,8 +9,11 @@
   1.0 m wide, too narrow for two lizis: the deadlock rule makes one back out into a wide end.
 * ``circle`` (world ``open_room``): arg ``robots`` 8 or 16 on a circle of 6 m diameter around
   (7, 7), facing its centre; each goes to the antipodal point.
+* ``willow_swap`` (world ``willow-full``, the lesson's Willow Garage map, shipped in
+  fleetsim_maps): the lesson's three lizis (``robots`` 3) sent through each other's paths,
+  lizi1 to lizi3's start, lizi2 to lizi1's, lizi3 to lizi2's.
 
-Both take ``solo`` (run only the named robot: the reference for makespan and path length),
+All take ``solo`` (run only the named robot: the reference for makespan and path length),
 ``planner`` (``collvoid``, default: collvoid_local_planner/CollvoidLocalPlanner with
 position sharing and a robots layer; ``trajectory``: plain TrajectoryPlannerROS, the robots
 unaware of each other), ``localization`` (fake | amcl) and ``start_delay``. Pass criterion
@@ -28,6 +32,9 @@ from pathlib import Path
 CORRIDOR_Y = 2.0  # m, the corridor's centre line
 CIRCLE_CENTRE = (7.0, 7.0)
 CIRCLE_RADIUS = 3.0  # m (a 6 m circle)
+#: the lesson's starts (20, 15), (22, 15), (24, 15) at the nearest free cells for a lizi
+#: (tests/scenarios/nav_harness.py lesson_starts), lizi1 facing east, the others west
+WILLOW_STARTS = ((20.25, 14.95, 0.0), (22.0, 15.0, math.pi), (23.95, 14.95, math.pi))
 
 
 def swap_corridor_robots(n: int) -> list[tuple[float, float, float, float, float, float]]:
@@ -49,6 +56,18 @@ def circle_robots(n: int) -> list[tuple[float, float, float, float, float, float
         x, y = cx + CIRCLE_RADIUS * math.cos(a), cy + CIRCLE_RADIUS * math.sin(a)
         heading = math.remainder(a + math.pi, 2 * math.pi)
         out.append((x, y, heading, 2 * cx - x, 2 * cy - y, heading))
+    return out
+
+
+def willow_swap_robots() -> list[tuple[float, float, float, float, float, float]]:
+    """The lesson's three starts, moved to the nearest cells a lizi fits in (its own starts,
+    (20, 15), (22, 15) and (24, 15), touch the clutter), each sent to the next one's start:
+    lizi1 east to lizi3's, lizi2 and lizi3 west to lizi1's and lizi2's."""
+    starts = WILLOW_STARTS
+    out = []
+    for k, (x, y, yaw) in enumerate(starts):
+        gx, gy, _ = starts[(k + 2) % 3]
+        out.append((x, y, yaw, gx, gy, yaw))
     return out
 
 
@@ -95,19 +114,20 @@ def _world_arg(world: str | dict[float, str]) -> str:
   <arg name="map" default="$(find fleetsim_maps)/$(arg world).yaml"/>"""
 
 
-def scenario(name: str, doc: str, world: str | dict, counts: tuple[int, int], robots: list) -> str:
-    small, large = counts
+def scenario(name: str, doc: str, world: str | dict, counts: tuple[int, ...], robots: list) -> str:
     # an unknown name <arg>_must_be_<a>_or_<b> in $(eval) is a launch error naming the arg, its
     # value and the allowed ones (fleetsim.launch.substitutions)
-    bad = f"robots_must_be_{small}_or_{large}"
-    check = f"$(eval robots if int(robots) in ({small}, {large}) else {bad})"
-    groups = "".join(_group(k + 1, r, small if k < small else large) for k, r in enumerate(robots))
+    bad = "robots_must_be_" + "_or_".join(str(c) for c in counts)
+    check = f"$(eval robots if int(robots) in {tuple(counts)} else {bad})"
+    groups = "".join(
+        _group(k + 1, r, min(c for c in counts if c > k)) for k, r in enumerate(robots)
+    )
     return f"""<launch>
   <!-- {doc}
        Written by make_multi_robot_launch.py (see its docstring); pass criterion: every robot
        reaches its goal without touching another robot or a wall. -->
   <master auto="start"/>
-  <arg name="robots" default="{small}" doc="{small} or {large} robots"/>
+  <arg name="robots" default="{counts[0]}" doc="{" or ".join(str(c) for c in counts)} robots"/>
   <arg name="planner" default="collvoid"
        doc="collvoid (ORCA, position sharing) | trajectory (plain TrajectoryPlannerROS)"/>
   <arg name="localization" default="fake" doc="fake | amcl"/>
@@ -140,6 +160,14 @@ def write(outdir: Path) -> list[Path]:
             CORRIDOR_WORLDS,
             (2, 4),
             swap_corridor_robots(4),
+        ),
+        "willow_swap.launch": scenario(
+            "willow_swap",
+            "The lesson's three lizis in the Willow Garage map sent through each other's paths:\n"
+            "       lizi1 to lizi3's start, lizi2 to lizi1's, lizi3 to lizi2's.",
+            "willow-full",
+            (3,),
+            willow_swap_robots(),
         ),
         "circle.launch": scenario(
             "circle",

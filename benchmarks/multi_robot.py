@@ -1,7 +1,8 @@
 """Multi-robot collision avoidance (issue 18): collvoid's local planner against plain
 TrajectoryPlannerROS, side by side, on the shipped scenarios.
 
-For each scenario (``swap_corridor`` with 2 and 4 robots, ``circle`` with 8 and 16), each planner
+For each scenario (``swap_corridor`` with 2 and 4 robots, ``circle`` with 8 and 16, ``willow_swap``:
+the lesson's 3 lizis in the Willow Garage map sent through each other's paths), each planner
 (``collvoid``, ``trajectory``) and each seed, one in-process run with fake_localization, up to
 ``--limit`` s of sim time, sampled every 0.1 s of sim time from the simulator's ground truth:
 
@@ -213,7 +214,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--seeds", type=int, default=10)
     ap.add_argument("--first-seed", type=int, default=0, help="0: the exact starts, no jitter")
-    ap.add_argument("--scenarios", default="swap_corridor:2,swap_corridor:4,circle:8,circle:16")
+    ap.add_argument(
+        "--scenarios", default="swap_corridor:2,swap_corridor:4,circle:8,circle:16,willow_swap:3"
+    )
     ap.add_argument("--planners", default="collvoid,trajectory")
     ap.add_argument("--limit", type=float, default=120.0, help="s of sim time per run")
     ap.add_argument("--jitter", type=float, default=0.02, help="m (and rad) of start noise")

@@ -258,6 +258,26 @@ class XmlLoader(ParamElements, NodeElements):
             ctx.args[name] = current if current is not None else attrs["default"]
         else:
             ctx.args[name] = current
+        self._check_choices(el, scope, name, ctx.args[name])
+
+    def _check_choices(self, el, scope: _Scope, name: str, value: str | None) -> None:
+        """ROS 2's ``<arg name="x"><choice value="a"/>...</arg>`` (DeclareLaunchArgument's
+        choices), read in ROS 1 files too (roslaunch ignores an arg's children): a value
+        outside the choices is an error naming the arg and the allowed values."""
+        choices = []
+        for child in el:
+            if not isinstance(child.tag, str):
+                continue
+            if child.tag != "choice" or set(child.attrib) != {"value"}:
+                raise LaunchError(
+                    f'{self._where(scope, child)}: <arg> may hold only <choice value="..."/>'
+                )
+            choices.append(child.attrib["value"])
+        if choices and value is not None and value not in choices:
+            raise LaunchError(
+                f"{self._where(scope, el)}: arg '{name}' is '{value}'; allowed values: "
+                + ", ".join(choices)
+            )
 
     def _master(self, el, attrs, scope) -> None:
         self.plan.notes.append(f"{self._where(scope, el)}: ignoring defunct <master/> tag")

@@ -184,3 +184,43 @@ def test_the_continuous_score_has_no_jumps_where_gmappings_has():
     # no more than the slope allows: 60 beams x d/dd exp(-d^2/sigma) <= 2 reach/sigma, x step
     assert steps[0.05] <= 60 * 2 * 0.05 / 0.05 * 0.0005
     assert np.all(np.diff(scores[0.05]) <= 1e-9)  # and it falls steadily away from the hits
+
+
+@pytest.mark.parametrize("iterations", [5, 3, 1])
+def test_the_fast_matcher_finds_the_exact_matchers_pose(iterations):
+    # climb_skip 3: the climber scores every 4th of 360 beams, then its last round every beam
+    # for the parabola. 24 particles sampled up to 8 cm and 0.06 rad off; with one halving
+    # only, the climber's last step is 2.5 cm / 0.025 rad, and without the full round's
+    # parabola its pose would stay up to half of that off
+    rng = np.random.default_rng(0)
+    maps = room_maps(particles=24)
+    true = np.array([0.2, -0.1, 0.05])
+    ranges, angles = scan_from(true, n=360)
+    start = true + rng.uniform(-1, 1, (24, 3)) * [0.08, 0.08, 0.06]
+    args = (maps.pool, maps.table, start, LASER, ranges, angles, maps.geom, 1, 0.05, 0.075, 0)
+    steps = (0.05, 0.05, iterations, 0.0, 0.05)
+    exact, exact_scores, exact_likes = matched_poses(*args, *steps, 0)
+    fast, fast_scores, fast_likes = matched_poses(*args, *steps, 3)
+    assert np.abs(fast[:, :2] - exact[:, :2]).max() < 0.0035
+    assert np.abs(fast[:, 2] - exact[:, 2]).max() < 0.0015
+    assert np.abs(fast[:, :2] - true[:2]).max() < 0.0025
+    assert np.abs(fast[:, 2] - true[2]).max() < 0.003
+    # score and likelihood of every beam at the final pose
+    assert fast_scores == pytest.approx(exact_scores, rel=0.01)
+    assert fast_likes == pytest.approx(exact_likes, abs=0.1)
+    for p in (0, 11):
+        ref_score, ref_like = reference_score(maps, p, fast[p], ranges, angles, reach=0.05)
+        assert fast_scores[p] == pytest.approx(ref_score, rel=1e-6)
+        assert fast_likes[p] == pytest.approx(ref_like, rel=1e-6, abs=1e-6)
+
+
+def test_the_fast_matcher_keeps_the_sampled_pose_below_the_minimum_score():
+    maps = room_maps(particles=2)
+    ranges, angles = scan_from(np.zeros(3), n=360)
+    start = np.array([[0.03, -0.02, 0.01], [0.0, 0.0, 0.0]])
+    out, scores, _ = matched_poses(
+        maps.pool, maps.table, start, LASER, ranges, angles, maps.geom, 1, 0.05, 0.075, 0,
+        0.05, 0.05, 3, 1e9, 0.05, 3,
+    )  # fmt: skip
+    assert np.array_equal(out, start)
+    assert scores.min() > 0.9 * 360  # the score still says how well the scan matched

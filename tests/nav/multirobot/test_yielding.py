@@ -168,5 +168,29 @@ def test_retreat_keeps_the_way_it_came_and_cuts_the_retreat_off_after_a_yield():
     assert r.refuge_final and -3.9 < r.refuge[0] < -3.5 and r.refuge[1] < -0.3
     r.extend(np.array([-2.0, 0.0]))  # the yield is over where the robot now stands
     assert r.refuge is None and r.trail[-1] == pytest.approx((-2.0, 0.0), abs=0.06)
+    r.reset()  # a new goal: the way it came is still free
+    assert r.refuge is None and r.trail[-1] == pytest.approx((-2.0, 0.0), abs=0.06)
+
+
+def test_with_no_wide_place_on_the_whole_trail_the_refuge_is_its_far_end():
+    """A closed corridor 1.0 m wide, all of it in view: nowhere wide enough for two, so the
+    yielder backs out to where its trail began (the way it came, as far as it goes)."""
+    cm = costmap([(-6.2, 0.5, 6.2, 0.7), (-6.2, -0.7, 6.2, -0.5)])
+    trail = np.c_[np.arange(-4.0, 2.01, 0.1), np.zeros(61)]
+    point, wide = refuge(trail, trail.shape[0] - 1, *args(cm), 0.31, 0.25)
+    assert not wide and point == pytest.approx([-4.0, 0.0])
+
+
+def test_a_yielder_replanned_every_cycle_still_backs_out_along_the_way_it_came():
+    """move_base hands the plan over every cycle in the odom frame; under amcl the goal there
+    moves by a few cm with each map -> odom correction, which the planner takes for a new goal
+    (Retreat.reset). The trail must survive it: a yielder whose trail was cleared had nowhere
+    to go and waited in the middle of the passage (swap_corridor localization:=amcl)."""
+    cm = costmap(narrow_corridor_walls())
+    r = Retreat()
+    for x in np.arange(-5.0, 0.01, 0.02):
+        r.reset()  # a replan under amcl
+        r.extend(np.array([x, 0.0]))
     r.reset()
-    assert r.trail == []
+    v = r.velocity(cm, np.array([0.0, 0.0]), 0.31, 0.25, 0.5, 0.6)
+    assert v[0] < -0.4 and r.refuge_final and r.refuge[0] < -3.4

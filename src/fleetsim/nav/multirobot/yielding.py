@@ -18,11 +18,12 @@ robot has gone by:
 * `refuge`: walking back along the plan from the robot's place, the first plan point where the
   width allows both robots, moved aside to its right as far as the walls allow; while no such
   point lies inside the (rolling) local costmap, the farthest plan point back that does, so the
-  robot keeps retreating and finds the wide place when it comes into view;
+  robot keeps retreating and finds the wide place when it comes into view, or ends at the far
+  end of its trail when there is none;
 * `has_passed`: the robot yielded to is behind the yielding one along its way to the goal, clear
   of it;
 * `Retreat`: one robot's trail (the way it came, which a replanned path does not keep: it
-  starts where the robot stands) and its refuge while it yields.
+  starts where the robot stands; kept across goals) and its refuge while it yields.
 """
 
 from __future__ import annotations
@@ -196,12 +197,14 @@ def refuge(
     h, w = costs.shape
     need = width_needed(own_radius, other_radius, margin)
 
+    def inside(p: np.ndarray) -> bool:
+        c, r = (p[0] - origin[0]) / resolution, (p[1] - origin[1]) / resolution
+        return 0 <= c < w and 0 <= r < h
+
     def widths(i: int) -> tuple[np.ndarray, float, float] | None:
         """(heading, left, right) at plan point i, None outside the costmap or degenerate."""
         p = plan_xy[i]
-        c = (p[0] - origin[0]) / resolution
-        r = (p[1] - origin[1]) / resolution
-        if not (0 <= c < w and 0 <= r < h):
+        if not inside(p):
             return None
         ahead = plan_xy[i] - plan_xy[i - 1]
         norm = float(np.hypot(*ahead))
@@ -211,7 +214,11 @@ def refuge(
         return heading, *passage_width(costs, origin, resolution, p, heading, need)
 
     last_inside = plan_xy[index]
-    for i in range(index, 0, -1):
+    for i in range(index, -1, -1):
+        if i == 0:  # the far end (no width there: no way in to measure across)
+            if inside(plan_xy[0]):
+                last_inside = plan_xy[0]
+            break
         got = widths(i)
         if got is None:
             break
@@ -269,8 +276,12 @@ class Retreat:
         self.refuge_final = False  # the refuge is the wide place, not just the way back
 
     def reset(self) -> None:
-        """A new goal: a new trail."""
-        self.trail = []
+        """A new goal: the refuge is forgotten, the trail kept. The way the robot came stays
+        free whatever its goal, and move_base hands the plan over again every cycle in the local
+        costmap's frame (``odom``): under amcl each map -> odom correction moves the goal there
+        by a few cm, and the planner takes that for a new goal (~1 Hz); a trail cleared each
+        time was one or two points long, so a robot yielding in a passage backed out 0.2 m and
+        waited in the middle of it (swap_corridor localization:=amcl, 0/2 goals in 60 s)."""
         self.refuge, self.refuge_final = None, False
 
     def extend(self, xy: np.ndarray) -> None:

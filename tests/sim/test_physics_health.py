@@ -147,6 +147,36 @@ def test_nan_control_is_an_instability(diffbot):
         e.advance(0.05)
 
 
+@pytest.mark.parametrize(
+    "field, value",
+    [("position", [np.nan, 0.0, 0.1]), ("linear", [0.0, np.inf, 0.0]), ("orientation", [0] * 4)],
+)
+def test_set_model_state_refuses_a_non_finite_state_by_field(diffbot, field, value):
+    from fleetsim.errors import SimulationError
+
+    e = Engine(None)
+    e.spawn_robot("bot", diffbot)
+    before = e.data.qpos.copy()
+    with pytest.raises(SimulationError, match=rf"set_model_state 'bot': {field} "):
+        e.set_model_state("bot", **{field: value})
+    assert np.array_equal(e.data.qpos, before)  # nothing half-written
+
+
+def test_a_nan_state_written_past_the_checks_is_named_as_such(diffbot):
+    """A velocity set to NaN directly (a plugin writing qvel) is the cause the error names,
+    not a NaN-deep contact or a runaway at nan m/s."""
+    e = Engine(None)
+    e.spawn_robot("bot", diffbot)
+    e.advance(0.05)
+    e.data.qvel[0] = np.nan
+    with pytest.raises(
+        PhysicsInstability,
+        match=r"robot 'bot'.*likely cause: non-finite state: the velocity of joint 'free' .*"
+        r"was already NaN or infinite before this step",
+    ):
+        e.advance(0.05)
+
+
 @pytest.mark.parametrize("kind", ["mjWARN_CONTACTFULL", "mjWARN_CNSTRFULL"])
 def test_full_contact_memory_is_an_error(diffbot, kind):
     """MuJoCo drops contacts when its arena is full; the engine stops (flagged as MuJoCo does)."""

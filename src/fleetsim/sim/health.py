@@ -248,6 +248,9 @@ def likely_cause(engine, dof: int) -> tuple[str, str]:
             "check what applies forces (wrench services, plugins) for NaN",
         )
     dofs = _model_dofs(engine, model_i, dof)
+    bad_state = _non_finite_state(engine, model_i, dofs)
+    if bad_state is not None:
+        return bad_state
     force = np.abs(np.nan_to_num(d.qfrc_actuator[dofs], nan=0.0, posinf=1e300))
     accel = force / np.maximum(m.dof_M0[dofs], 1e-300)
     k = int(np.argmax(accel))
@@ -281,6 +284,39 @@ def likely_cause(engine, dof: int) -> tuple[str, str]:
         "stiff constraint forces (contacts or joint limits) the solver could not resolve",
         "a smaller physics step, or check collision shapes and joint limits of this model",
     )
+
+
+def _non_finite_state(engine, model_i: int, dofs: np.ndarray) -> tuple[str, str] | None:
+    """A position or velocity that was already NaN or infinite before the step (the state
+    `SolverGuard` kept): something wrote it into the state (a teleport, a plugin), the
+    integration did not make it."""
+    m = engine.model
+    state = engine.solver_guard.state
+    qpos, qvel = state[1 : 1 + m.nq], state[1 + m.nq : 1 + m.nq + m.nv]
+    bad_vel = dofs[~np.isfinite(qvel[dofs])]
+    if model_i >= 0:
+        qadr = np.flatnonzero(engine._body_model[m.jnt_bodyid] == model_i)
+    else:
+        qadr = np.array([int(m.dof_jntid[dofs[0]])])
+    bad_pos = [j for j in qadr.tolist() if not np.isfinite(qpos[_qpos_slice(m, j)]).all()]
+    if not bad_pos and not bad_vel.size:
+        return None
+    what = (
+        f"position of joint '{_local(m.joint(bad_pos[0]).name)}'"
+        if bad_pos
+        else f"velocity of {_joint_label(m, int(bad_vel[0]))}"
+    )
+    return (
+        f"non-finite state: the {what} was already NaN or infinite before this step",
+        "find what set it (a set_model_state / teleport, a plugin writing qpos or qvel) and "
+        "guard it",
+    )
+
+
+def _qpos_slice(m: mujoco.MjModel, j: int) -> slice:
+    a = int(m.jnt_qposadr[j])
+    n = {mujoco.mjtJoint.mjJNT_FREE: 7, mujoco.mjtJoint.mjJNT_BALL: 4}.get(int(m.jnt_type[j]), 1)
+    return slice(a, a + n)
 
 
 def _runaway(engine, dofs: np.ndarray, model_i: int) -> tuple[str, str] | None:
@@ -321,7 +357,12 @@ def _deepest_contact(engine, model_i: int) -> tuple[str, str] | None:
         return None
     geom = d.contact.geom[: d.ncon]
     dist = d.contact.dist[: d.ncon]
-    mine = (engine.geom_model[geom] == model_i).any(axis=1) if model_i >= 0 else np.ones(len(geom))
+    mine = (
+        (engine.geom_model[geom] == model_i).any(axis=1)
+        if model_i >= 0
+        else np.ones(len(geom), bool)
+    )
+    mine &= np.isfinite(dist)  # a NaN contact is not a measure of penetration
     if not mine.any():
         return None
     c = int(np.flatnonzero(mine)[np.argmin(dist[mine])])

@@ -128,6 +128,22 @@ class StateQueries:
         if j < 0:
             raise SimulationError(f"model '{name}' is static; its state cannot be set")
         qa, va = self.model.jnt_qposadr[j], self.model.jnt_dofadr[j]
+        fields = dict(position=position, orientation=orientation, linear=linear, angular=angular)
+        for field, value in fields.items():
+            if value is None:
+                continue
+            v = np.asarray(value, float)
+            if v.shape != ((4,) if field == "orientation" else (3,)):
+                raise SimulationError(
+                    f"set_model_state '{name}': {field} must have "
+                    f"{4 if field == 'orientation' else 3} values, got {list(v.ravel())}"
+                )
+            if not np.all(np.isfinite(v)):
+                raise SimulationError(
+                    f"set_model_state '{name}': {field} is not finite: {v.tolist()}"
+                )
+            if field == "orientation" and not np.linalg.norm(v) > 0:
+                raise SimulationError(f"set_model_state '{name}': orientation is a zero quaternion")
         if position is not None:
             self.data.qpos[qa : qa + 3] = position
         if orientation is not None:

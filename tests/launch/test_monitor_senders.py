@@ -93,7 +93,7 @@ def test_an_explorer_that_finished_with_a_goal_active_succeeds_and_its_cancel_is
     rt.run(duration=0.5)  # the cancel's result arrives
     r = monitor.robots["/"]
     assert (r.goals_sent, r.goals_failed) == (0, 0)
-    assert r.last_text == "canceled by /explore, which no longer wanted it"
+    assert r.last_text == "withdrawn by /explore"
     assert monitor.all_goals_done() and monitor.success()
 
 

@@ -204,7 +204,7 @@ class RunMonitor:
             sender := self._withdrawn_by(msg.status.goal_id.id)
         ):
             r.goals_sent -= 1  # its sender canceled it, no longer wanting it: not a failure
-            r.last_text = f"canceled by {sender}, which no longer wanted it"
+            r.last_text = f"withdrawn by {sender}"
         else:
             r.goals_failed += 1
         r.time_of_last_result = self.runtime.now()

@@ -194,3 +194,29 @@ def test_a_yielder_replanned_every_cycle_still_backs_out_along_the_way_it_came()
     r.reset()
     v = r.velocity(cm, np.array([0.0, 0.0]), 0.31, 0.25, 0.5, 0.6)
     assert v[0] < -0.4 and r.refuge_final and r.refuge[0] < -3.4
+
+
+def test_a_replan_during_the_yield_still_cuts_the_trail_where_the_robot_backed_to():
+    """A reset (a replan under amcl) while backing out must not make the trail grow on from
+    the farthest point reached: the way back from there would lead forwards, into the other
+    robot."""
+    cm = costmap(narrow_corridor_walls())
+    r = Retreat()
+    for x in np.arange(-5.0, 0.01, 0.02):
+        r.extend(np.array([x, 0.0]))
+    r.velocity(cm, np.array([0.0, 0.0]), 0.31, 0.25, 0.5, 0.6)  # backing out
+    r.reset()
+    r.extend(np.array([-1.5, 0.0]))  # a cycle not yielding, 1.5 m back
+    assert r.trail[-1] == pytest.approx((-1.5, 0.0), abs=0.06)
+    assert max(p[0] for p in r.trail) < -1.4
+
+
+def test_a_trail_pushed_sideways_is_not_a_wide_place():
+    """Pushed aside by a few cm while yielding, the trail steps across the corridor; the
+    passage is measured across the way it runs, not along the corridor."""
+    cm = costmap([(-6.2, 1.0, 6.2, 1.2), (-6.2, -1.2, 6.2, -1.0)])  # 2 m wide
+    xs = np.arange(-4.0, 0.01, 0.1)
+    trail = np.c_[xs, np.zeros_like(xs)]
+    trail = np.r_[trail, [[0.0, 0.1], [0.0, 0.2]]]  # the last two steps sideways
+    point, wide = refuge(trail, trail.shape[0] - 1, *args(cm), 0.85, 0.95)
+    assert not wide and abs(point[1]) < 1.0

@@ -43,6 +43,8 @@ PROBE_STEP = 0.025
 RECEDING_SPEED = 0.05
 #: m a yielding robot waits farther back than the first place wide enough (`refuge`)
 REFUGE_SETBACK = 0.6
+#: m of the way (plan or trail) over which its direction at a point is taken
+HEADING_BASE = 0.3
 #: m from the refuge that count as there (closer, a skid steer only turns on the spot)
 REFUGE_TOLERANCE = 0.15
 #: cells around a probe that count: a wall a laser marks at a grazing angle is a dotted line,
@@ -201,12 +203,19 @@ def refuge(
         c, r = (p[0] - origin[0]) / resolution, (p[1] - origin[1]) / resolution
         return 0 <= c < w and 0 <= r < h
 
+    # the way's direction at a point: over HEADING_BASE m of it, not one step (a trail wiggles
+    # by a few cm where the robot was pushed aside; a sideways step read as the way's direction
+    # measured the passage along its length and took a corridor for a wide place)
+    arc = np.r_[0.0, np.cumsum(np.hypot(*np.diff(plan_xy, axis=0).T))]
+
     def widths(i: int) -> tuple[np.ndarray, float, float] | None:
         """(heading, left, right) at plan point i, None outside the costmap or degenerate."""
         p = plan_xy[i]
         if not inside(p):
             return None
-        ahead = plan_xy[i] - plan_xy[i - 1]
+        # the last point at least HEADING_BASE back (else the first): k <= i - 1
+        k = max(int(np.searchsorted(arc, arc[i] - HEADING_BASE, side="right")) - 1, 0)
+        ahead = plan_xy[i] - plan_xy[k]
         norm = float(np.hypot(*ahead))
         if norm < 1e-9:
             return np.zeros(2), 0.0, 0.0
@@ -274,6 +283,7 @@ class Retreat:
         self.trail: list[tuple[float, float]] = []
         self.refuge: np.ndarray | None = None
         self.refuge_final = False  # the refuge is the wide place, not just the way back
+        self.retreated = False  # backing out since the trail last grew: cut it when it does
 
     def reset(self) -> None:
         """A new goal: the refuge is forgotten, the trail kept. The way the robot came stays
@@ -287,7 +297,8 @@ class Retreat:
     def extend(self, xy: np.ndarray) -> None:
         """The robot is at ``xy`` (2,), not yielding: the trail grows every TRAIL_STEP m; back
         from a yield, it first ends where the robot now is (the retreat is cut off)."""
-        if self.refuge is not None:
+        if self.retreated:
+            self.retreated = False
             self.refuge, self.refuge_final = None, False
             if self.trail:
                 back = np.asarray(self.trail)
@@ -307,6 +318,7 @@ class Retreat:
         deceleration: float,
     ) -> np.ndarray:
         """(2,) m/s to the refuge (found the first time, kept once it is the wide place)."""
+        self.retreated = True
         if not self.refuge_final:
             # the trail only: its last point is within TRAIL_STEP of the robot, and a shorter
             # last step would give the way's direction there by noise

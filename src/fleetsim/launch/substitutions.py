@@ -167,22 +167,12 @@ def _eval(expr: str, ctx: Context, where: str) -> str:
     except LaunchError:
         raise
     except NameError as e:
-        raise LaunchError(f"{where}: {_undefined(expr, e, ctx, where)}") from None
+        raise LaunchError(
+            f"{where}: $(eval {expr}): {e}; declare it with <arg> or call arg('name')"
+        ) from None
     except Exception as e:
         raise LaunchError(f"{where}: $(eval {expr}) failed: {type(e).__name__}: {e}") from None
     return str(value)
-
-
-def _undefined(expr: str, err: NameError, ctx: Context, where: str) -> str:
-    """The message for a name $(eval) does not know. The shipped scenarios check an arg's value
-    with ``$(eval x if x in (...) else x_must_be_a_or_b)``: a name ``<arg>_must_be_<values>``
-    of a declared arg reports a value not allowed, not an undeclared name."""
-    name = getattr(err, "name", None) or ""
-    arg, sep, allowed = name.partition("_must_be_")
-    if sep and (arg in ctx.args or arg in ctx.passed):
-        value = ctx.arg(arg, where)
-        return f"arg '{arg}' is {value!r}; it must be {allowed.replace('_or_', ' or ')}"
-    return f"$(eval {expr}): {err}; declare it with <arg> or call arg('name')"
 
 
 def substitute(text: str | None, ctx: Context, where: str) -> str | None:

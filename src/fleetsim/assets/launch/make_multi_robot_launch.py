@@ -87,38 +87,32 @@ def _group(k: int, robot: tuple, minimum: int) -> str:
   </group>"""
 
 
-#: the args every scenario takes with a fixed set of values: name -> the values
-CHOICES = {"planner": ("collvoid", "trajectory"), "localization": ("fake", "amcl")}
-#: their checks (a value not in the set is a launch error that names the arg and the values)
-CHOICE_CHECKS = "\n".join(
-    f"""  <arg name="{name}_checked" value="$(eval {name} if {name} in {values!r} else """
-    f"""{name}_must_be_{"_or_".join(values)})"/>"""
-    for name, values in CHOICES.items()
-)
+def _choices(values) -> str:
+    """ROS 2's ``<choice>`` children of an ``<arg>``: any other value is a launch error naming
+    the arg and the allowed values (fleetsim's XML frontend; roslaunch ignores them)."""
+    return "".join(f'<choice value="{v}"/>' for v in values)
+
 
 #: swap_corridor's ``width`` arg: corridor width (m) -> world
 CORRIDOR_WORLDS = {2.0: "corridor", 1.0: "corridor_narrow"}
 
 
 def _world_arg(world: str | dict[float, str]) -> str:
-    """The ``map`` arg: one world, or one per ``width`` (a launch error names other widths)."""
+    """The ``map`` arg: one world, or one per ``width`` (its choices)."""
     if isinstance(world, str):
         return f"""  <arg name="map" default="$(find fleetsim_maps)/{world}.yaml"/>"""
     widths = sorted(world, reverse=True)
-    choice = " else ".join(f"'{world[w]}' if float(width) == {w}" for w in widths)
-    names = "_or_".join(f"{w:g}".replace(".", "_") for w in widths)
+    choice = " else ".join(f"'{world[w]}' if float(width) == {w}" for w in widths[:-1])
     return f"""  <arg name="width" default="{widths[0]}"
-       doc="corridor width, m: {" or ".join(f"{w:g}" for w in widths)} (narrowed for its middle 6 m:
-            too narrow for two lizis to pass; one backs out into a wide end)"/>
-  <arg name="world" value="$(eval {choice} else width_must_be_{names})"/>
+       doc="corridor width, m: {" or ".join(f"{w}" for w in widths)} (narrowed for its middle 6 m:
+            too narrow for two lizis to pass; one backs out into a wide end)">
+    {_choices(widths)}
+  </arg>
+  <arg name="world" value="$(eval {choice} else '{world[widths[-1]]}')"/>
   <arg name="map" default="$(find fleetsim_maps)/$(arg world).yaml"/>"""
 
 
 def scenario(name: str, doc: str, world: str | dict, counts: tuple[int, ...], robots: list) -> str:
-    # an unknown name <arg>_must_be_<a>_or_<b> in $(eval) is a launch error naming the arg, its
-    # value and the allowed ones (fleetsim.launch.substitutions)
-    bad = "robots_must_be_" + "_or_".join(str(c) for c in counts)
-    check = f"$(eval robots if int(robots) in {tuple(counts)} else {bad})"
     groups = "".join(
         _group(k + 1, r, min(c for c in counts if c > k)) for k, r in enumerate(robots)
     )
@@ -127,16 +121,20 @@ def scenario(name: str, doc: str, world: str | dict, counts: tuple[int, ...], ro
        Written by make_multi_robot_launch.py (see its docstring); pass criterion: every robot
        reaches its goal without touching another robot or a wall. -->
   <master auto="start"/>
-  <arg name="robots" default="{counts[0]}" doc="{" or ".join(str(c) for c in counts)} robots"/>
+  <arg name="robots" default="{counts[0]}" doc="{" or ".join(str(c) for c in counts)} robots">
+    {_choices(counts)}
+  </arg>
   <arg name="planner" default="collvoid"
-       doc="collvoid (ORCA, position sharing) | trajectory (plain TrajectoryPlannerROS)"/>
-  <arg name="localization" default="fake" doc="fake | amcl"/>
+       doc="collvoid (ORCA, position sharing) | trajectory (plain TrajectoryPlannerROS)">
+    {_choices(("collvoid", "trajectory"))}
+  </arg>
+  <arg name="localization" default="fake" doc="fake | amcl">
+    {_choices(("fake", "amcl"))}
+  </arg>
   <arg name="start_delay" default="2.0" doc="sim seconds before the goals go out"/>
   <arg name="solo" default="" doc="run only this robot (e.g. lizi3): its time and path alone"/>
 {_world_arg(world)}
   <arg name="gui" default="true" doc="open the live view when run with --viz"/>
-  <arg name="robots_checked" value="{check}"/>
-{CHOICE_CHECKS}
 
   <param name="/use_sim_time" value="true"/>
   <node pkg="map_server" type="map_server" name="map_server" args="$(arg map)">

@@ -350,7 +350,8 @@ def run_layer(
 
 
 # -- printing ------------------------------------------------------------------------------------
-def table(sizes: list[int], layers: list[str], duration: float, seed: int, repeats: int) -> None:
+def table(sizes: list[int], layers: list[str], duration: float, seed: int, repeats: int) -> bool:
+    """Print the table; False when a run failed (its cell is '-' and the error is printed)."""
     what = "CPU" if os.environ.get("FLEET_RTF_CLOCK") == "cpu" else "wall"
     print(
         f"Willow, lizis, {duration:g} sim s per run after {WARMUP:g} s warm-up, seed {seed}, "
@@ -363,6 +364,7 @@ def table(sizes: list[int], layers: list[str], duration: float, seed: int, repea
     head += "   MB per robot (" + ", ".join(layers) + ")"
     print(head)
     notes: list[str] = []
+    failed = False
     first: dict[str, tuple[int, float]] = {}  # layer -> (N, MB) of the smallest fleet
     for n in sizes:
         res = {layer: run_layer(layer, n, duration, seed, 1, repeats) for layer in layers}
@@ -373,6 +375,7 @@ def table(sizes: list[int], layers: list[str], duration: float, seed: int, repea
             if "missing" in r and r["missing"] not in notes:
                 notes.append(r["missing"])
             if "error" in r:
+                failed = True
                 notes.append(f"N={n} {layer}: {r['error']}")
             if r.get("warnings"):
                 notes.append(
@@ -405,9 +408,11 @@ def table(sizes: list[int], layers: list[str], duration: float, seed: int, repea
         "targets at N=10: robots >= 10x, fake/rob >= 0.6, amcl/rob >= 0.4; "
         "at N=100: fake and amcl >= 1x"
     )
+    return not failed
 
 
-def soak(minutes: float, localization: str, seed: int, planner: str = "trajectory") -> None:
+def soak(minutes: float, localization: str, seed: int, planner: str = "trajectory") -> bool:
+    """Print the soak's figures; False when the run failed (e.g. a physics instability)."""
     chunks = max(2, round(minutes / 10))
     print(
         f"soak: 10 lizis, {localization}, {planner} local planner, random goals, {minutes:g} "
@@ -417,7 +422,7 @@ def soak(minutes: float, localization: str, seed: int, planner: str = "trajector
     r = run_layer(layer, 10, minutes * 60.0, seed, chunks)
     if "error" in r:
         print("failed:", r["error"])
-        return
+        return False
     for k, c in enumerate(r["chunks"]):
         print(f"  part {k + 1:>2}: {c['rtf']:6.2f}x real time, resident {c['rss_mb']:7.1f} MB")
     first, last = r["chunks"][0], r["chunks"][-1]
@@ -430,9 +435,11 @@ def soak(minutes: float, localization: str, seed: int, planner: str = "trajector
     )
     for text in r["first_warnings"]:
         print("  WARNING", text)
+    return True
 
 
-def main() -> None:
+def main() -> int:
+    """Exit status 1 when a run failed (not when a target is missed: the figures say that)."""
     ap = argparse.ArgumentParser(
         description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
     )
@@ -459,10 +466,13 @@ def main() -> None:
     if args.worker:
         layer, n, duration, seed, chunks = args.worker
         print(json.dumps(worker(layer, int(n), float(duration), int(seed), int(chunks))))
-        return
+        return 0
     if args.soak:
-        soak(args.soak_minutes, args.soak_localization, args.seed, args.soak_planner)
-        return
+        return (
+            0
+            if soak(args.soak_minutes, args.soak_localization, args.seed, args.soak_planner)
+            else 1
+        )
     layers = [x for x in args.layers.split(",") if x]
     unknown = sorted(set(layers) - set(LAYERS))
     if unknown:
@@ -470,8 +480,10 @@ def main() -> None:
     if "robots" not in layers:
         layers.insert(0, "robots")
     sizes = [int(x) for x in args.sizes.split(",") if x]
-    table(sizes, layers, args.duration, args.seed, max(1, args.repeats))
+    if not sizes or min(sizes) < 1:
+        ap.error(f"--sizes: fleet sizes must be >= 1, got {args.sizes!r}")
+    return 0 if table(sizes, layers, args.duration, args.seed, max(1, args.repeats)) else 1
 
 
 if __name__ == "__main__":
-    main()
+    sys.exit(main())

@@ -3,9 +3,12 @@ every sender is done and succeeded; a goal its sender withdrew is no failure, an
 is. Explore is the sender here (finished vs. gave up), with a stand-in move_base and no
 simulator."""
 
+import sys
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 
 from fleetsim.launch.monitor import GoalSender, RunMonitor
 from fleetsim.msgs import actionlib_msgs, move_base_msgs, nav_msgs, std_msgs
@@ -13,6 +16,9 @@ from fleetsim.nav.explore import Explore
 from fleetsim.nav.send_goals import SendGoals
 from fleetsim.runtime import Node, Runtime
 from fleetsim.tf import StaticTransformBroadcaster, make_transform_stamped
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "nav"))
+from fake_move_base import FakeMoveBase  # tests/nav/fake_move_base.py
 
 PLAN = SimpleNamespace(
     nodes=[SimpleNamespace(pkg="move_base", type="move_base", namespace="/", name="move_base")]
@@ -147,3 +153,18 @@ def test_a_sender_that_is_not_done_fails_the_run():
     assert monitor.all_goals_done() and monitor.success()
     sender.succeeded = False
     assert monitor.senders_failed() == ["/s"] and not monitor.success()
+
+
+@pytest.mark.parametrize(
+    ("goals", "succeeded"),
+    [([[1.0, 0.0], [1.0, 1.0]], True), ([[1.0, 0.0], [-2.0, 0.0]], False), ([], False)],
+)
+def test_send_goals_succeeded_only_when_it_reached_every_goal(goals, succeeded):
+    """FakeMoveBase aborts goals with x < 0; a send_goals given no goals did not succeed."""
+    rt = Runtime(seed=0)
+    FakeMoveBase(rt, "/lizi1")
+    rt.params.set("/send_goals/goals", {"lizi1": goals} if goals else {})
+    sg = SendGoals(rt)
+    assert not sg.succeeded
+    rt.run(until=lambda: sg.done, duration=30.0)
+    assert sg.done and sg.succeeded is succeeded

@@ -152,8 +152,10 @@ class SendGoals(Node):
 
     @property
     def succeeded(self) -> bool:
-        """True once done with every goal reached (the run monitor's `GoalSender`)."""
-        return self.done and all(o.reached for outs in self.results.values() for o in outs)
+        """True once done with every goal reached (the run monitor's `GoalSender`); a node
+        given no goals did not succeed."""
+        outcomes = [o for outs in self.results.values() for o in outs]
+        return self.done and bool(outcomes) and all(o.reached for o in outcomes)
 
     def _tick(self) -> None:
         if self.now() < self._start - 1e-9:

@@ -13,11 +13,11 @@ For ``fleetsim launch --until-goals`` the node is a goal sender (`fleetsim.launc
 GoalSender`: ``sends_goals``, ``done`` once it has stopped): the run ends when exploration
 does. Exploration *finished* (``succeeded``, exit status 0) when it stopped because the map has
 no frontier left; it *gave up* (``gave_up``, exit status 1) when it stopped with frontiers left,
-every one of them blacklisted (move_base aborted its goal, or no progress for
-``progress_timeout``). A frontier blacklisted on the way that the robot's laser later maps from
-elsewhere is no longer a frontier and does not count. explore_lite stops either way; the goal
-it cancels on stopping is listed in ``withdrawn_goals``, so that the run monitor does not count
-it as a failed goal.
+every one of them blacklisted, by it or (``peer_blacklists``) by a peer (move_base aborted the
+goal, or no progress for ``progress_timeout``). A frontier blacklisted on the way that the
+robot's laser later maps from elsewhere is no longer a frontier and does not count.
+explore_lite stops either way; the goal it cancels on stopping is listed in
+``withdrawn_goals``, so that the run monitor does not count it as a failed goal.
 
 Explorers sharing one map (slam_explore ``robots:=2``) would all head for the same best
 frontier; fleetsim adds ``peer_goals``: each explorer announces its goal on ``~goal`` and leaves

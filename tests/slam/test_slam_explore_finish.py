@@ -60,7 +60,7 @@ def test_one_hunter_explores_open_room_to_the_end_and_exits_zero(tmp_path):
     assert not any("gave up" in m for m in log)
     assert not [r.getMessage() for r in records.records if r.levelno >= logging.WARNING]
     precision, recall = precision_recall(out.with_suffix(".yaml"), (4.0, 10.0))
-    assert precision >= 0.95 and recall >= 0.95, (precision, recall)
+    assert precision >= 0.90 and recall >= 0.90, (precision, recall)  # the target
     assert not Path("MUJOCO_LOG.TXT").exists()
 
 
@@ -83,6 +83,6 @@ def test_two_hunters_explore_open_room_to_the_end(tmp_path, caplog):
     for ns in ("/hunter1", "/hunter2"):  # both explored
         assert results[ns].path_length > 5.0 and results[ns].collisions == 0, results[ns]
     precision, recall = precision_recall(out.with_suffix(".yaml"), (1.5, 1.5))
-    assert precision >= 0.95 and recall >= 0.95, (precision, recall)
+    assert precision >= 0.90 and recall >= 0.90, (precision, recall)  # the target
     assert not caplog.records, [r.getMessage() for r in caplog.records]
     assert not Path("MUJOCO_LOG.TXT").exists()

@@ -50,10 +50,11 @@ class ExploreTrace:
                 trace._end(ex, old, how)
             f = next((f for f in ex.frontiers if math.dist(f.centroid, target) < 1e-6), None)
             peers = [g for g in ex.peers.values() if g is not None]
+            at = trace.paths[ex.namespace][-1] if trace.paths[ex.namespace] else (math.nan,) * 2
             trace.events[ex.namespace].append(
                 dict(t=ex.now(), kind="send", goal=target, size=f.size if f else 0,
                      distance=f.min_distance if f else math.nan, frontiers=len(ex.frontiers),
-                     peer_goal=peers[0] if peers else None)
+                     peer_goal=peers[0] if peers else None, at=at)
             )  # fmt: skip
             return send(ex, target, frame)
 
@@ -107,7 +108,8 @@ class ExploreTrace:
                     line = f"    {e['t']:6.0f} s {name:8s} {e['kind']:11s} ({gx:5.1f}, {gy:5.1f})"
                     if e["kind"] == "send":
                         peer = e["peer_goal"]
-                        line += (f" size {e['size']:3d} at {e['distance']:4.1f} m of "
+                        line += (f" from ({e['at'][0]:.1f}, {e['at'][1]:.1f})"
+                                 f" size {e['size']:3d} at {e['distance']:4.1f} m of "
                                  f"{e['frontiers']} frontiers")  # fmt: skip
                         if peer:
                             line += f", peer -> ({peer[0]:.1f}, {peer[1]:.1f})"

@@ -88,8 +88,12 @@ def test_a_robot_whose_side_is_done_helps_with_the_nearest_frontier_the_peer_lea
     candidates = ranked(west, east)
     chosen = frontier_for_robot(candidates, ME, None, [east.centroid], [PEER], 3.0)
     assert chosen is west
-    # only the peer's frontier left: it goes there too rather than stopping
-    assert frontier_for_robot([east], ME, None, [east.centroid], [PEER], 3.0) is east
+    # only the peer's frontier left, the peer nearer to it: wait rather than follow the peer
+    assert frontier_for_robot([east], ME, None, [east.centroid], [PEER], 3.0) is None
+    # ... unless this robot is the nearer one (the peer leaves it when it sees this goal)
+    assert frontier_for_robot([west], ME, None, [west.centroid], [(30.0, 10.0)], 3.0) is west
+    # a peer whose position tf does not know: go anyway (peer_goals without peer_frames)
+    assert frontier_for_robot([east], ME, None, [east.centroid], [], 3.0) is east
 
 
 @pytest.mark.parametrize("goal", [None, (1.4, 1.0)])

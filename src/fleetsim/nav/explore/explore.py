@@ -274,6 +274,14 @@ class Explore(Node):
             p.peer_radius,
             p.potential_scale * info.resolution * p.switch_distance,
         )
+        if chosen is None:  # the peers have every frontier left: wait for them
+            if self._handle is not None:
+                self.move_base.cancel_all_goals()
+                self._handle = None
+            if self.goal is not None:
+                self.goal = None
+                self._announce(None)
+            return
         target = chosen.centroid
         same = self.goal is not None and math.dist(target, self.goal) < 1e-6
         # progress as explore_lite measures it: towards the frontier's nearest cell (its

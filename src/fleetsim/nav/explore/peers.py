@@ -12,7 +12,10 @@ is needed:
   to every peer (each robot keeps to its side);
 - the preference falls back step by step: frontiers on its side that no peer heads for, then
   any that no peer heads for (a robot whose side is done helps with the peer's side, nearest
-  first), then any;
+  first), then one a peer heads for but this robot is nearer to (the peer leaves it when it
+  sees this robot's goal); when a peer heads for every frontier left and is nearer to each,
+  none: the robot waits (without stopping) instead of following the peer into the same room
+  (seed 1: both hunters drove to the office's last corner, 12 and 13 m away);
 - with ``switch_distance`` > 0 it keeps the frontier it is heading for (the free frontier
   nearest its goal) unless another is cheaper by at least ``potential_scale * res *
   switch_distance``: the side a frontier falls on changes as the robots move, and with nearly
@@ -41,8 +44,8 @@ def frontier_for_robot(
     peer_positions: Sequence[tuple[float, float]],
     peer_radius: float,
     switch_margin: float = 0.0,
-) -> Frontier:
-    """The frontier this robot should head for.
+) -> Frontier | None:
+    """The frontier this robot should head for; None: wait, the peers have the rest.
 
     Parameters
     ----------
@@ -59,7 +62,13 @@ def frontier_for_robot(
         f for f in candidates if all(math.dist(f.centroid, g) >= peer_radius for g in peer_goals)
     ]
     mine = [f for f in free if _nearer_to_robot(f, robot, peer_positions)]
-    best = (mine or free or candidates)[0]
+    if mine or free:
+        best = (mine or free)[0]
+    else:
+        ours = [f for f in candidates if _nearer_to_robot(f, robot, peer_positions)]
+        if not ours:
+            return None
+        best = ours[0]
     if switch_margin <= 0.0 or goal is None:
         return best
     current = _tracked(free, goal)

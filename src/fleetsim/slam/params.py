@@ -91,9 +91,10 @@ class GmappingParams:
         3,
         range=(0, None),
         help="fleetsim addition, with continuous_score: the hill climber scores every "
-        "(climb_skip+1)-th of the beams lskip leaves, then its last round is scored again with "
-        "all of them for the parabola, which may move the pose by up to a step (the matcher "
-        "~2.3x faster; 0: every beam all the way, as gmapping; see fleetsim.slam.scan_match)",
+        "(climb_skip+1)-th of the beams lskip leaves, then Gauss-Newton steps of a "
+        "point-to-line fit of all of them finish the match (the matcher ~2.5x faster; 0: "
+        "every beam all the way and the parabola, gmapping's climber; see "
+        "fleetsim.slam.scan_match and fleetsim.slam.scan_align)",
     )
     # --- motion model ---
     srr: float = param(0.1, range=(0.0, None), help="translation noise from translation")

@@ -42,19 +42,21 @@ gmapping's: beams without a hit still cost ``nullLikelihood``.
 The fast matcher (``climb_skip``, a fleetsim addition, on by default with the continuous
 score). Each halving of the climber's steps costs 2-3 rounds of 6 scores of every beam, ~66-86
 scores a particle in all, most of an update's time. With ``climb_skip`` 3 the climber scores
-every 4th beam (of those ``lskip`` leaves) all the way down, as gmapping's own ``lskip`` would;
-the continuous score of a quarter of the beams has its top within a step or two of the full
-scan's. Its last round is then scored again with every beam and the pose moved to the top of
-the parabolas through those scores, as above, but by up to a whole step (the top need not lie
-within half a step of where the quarter of the beams left the climber); the score and the
-likelihood are those of every beam at that pose. Cost: a quarter of the climb plus 8 scores
-of every beam a particle (30 particles x 360 beams: the matcher 11 instead of 25 ms; Willow
-seed 1 with the manual's parameters: precision 0.955 -> 0.975, recall 0.889 -> 0.895, ATE
-0.026 -> 0.025 m). Tried first and dropped: Gauss-Newton steps after the quarter-beam climb.
-Point-to-point (ICP on the mean hits, the score's own residual) slid along walls a third of the
-remaining way per step; point-to-line (the line through a kernel window's hits) converged in
-two steps, to 0.02 mm on tests/slam's room, but left a corridor's unconstrained direction where
-the climber had stopped, on its grid, and Willow seed 1 lost precision (0.94, ATE 0.033 m).
+every 4th beam (of those ``lskip`` leaves) all the way down, as gmapping's own ``lskip`` would,
+which gets it within a few millimetres of the top; then a few Gauss-Newton steps of a
+point-to-line fit of every beam finish the match (`fleetsim.slam.scan_align`), replacing the
+parabola; the score and the likelihood are those of every beam at that pose. What it
+approximates: the pose is the top of the fit of the endpoints to the walls through the cells'
+mean hits, not the top of the score over those mean hits (they differ by a millimetre or two
+along walls). Cost on 30 particles x 360 beams: the matcher ~0.4 of the exact climber's time.
+Quality, Willow seeds 1-3 with the manual's parameters (benchmarks/slam_quality.py): precision
+0.941 / 0.994 / 0.988, recall 0.886 / 0.915 / 0.910, ATE 0.033 / 0.019 / 0.017 m, against the
+exact climber's 0.955 / 0.960 / 0.943, 0.889 / 0.893 / 0.891, 0.026 / 0.032 / 0.066 m. Tried
+and dropped: the quarter-beam climb finished by its last round scored again with every beam
+and the parabola through it (0.975 / 0.886 / 0.924, recall 0.895 / 0.854 / 0.877: a quarter
+of the beams puts the climber's top a few millimetres off, more than a step of the last
+round corrects), and that round after the fit (with scan_align's corner test; seeds 1, 2:
+precision 0.90, 0.88).
 
 Geometry arguments shared by the kernels:
 ``geom = (origin_x, origin_y, delta)`` (m, m, m/cell) of cell (0, 0)'s corner;
@@ -69,6 +71,7 @@ import math
 import numba
 import numpy as np
 
+from .scan_align import refined_pose
 from .tiles import FAR, writable_tile
 from .tiles import MASK as _MASK
 from .tiles import SHIFT as _SHIFT
@@ -161,18 +164,6 @@ def _vertex(below, centre, above, step):
 
 
 @numba.njit(cache=True, inline="always")
-def _vertex_within(below, centre, above, step):
-    """`_vertex`, where ``centre`` need not be the highest: within one step, and a whole step
-    towards the higher neighbour when the three scores do not curve down."""
-    curve = below - 2.0 * centre + above
-    if curve >= 0.0:
-        if above > centre and above >= below:
-            return step
-        return -step if below > centre else 0.0
-    return min(max(0.5 * step * (below - above) / curve, -step), step)
-
-
-@numba.njit(cache=True, inline="always")
 def _moved(pose, move, ld, ad, out):
     """``out`` = ``pose`` after the climber's move (+x, -x, -y, +y, +yaw, -yaw by ld, ad)."""
     out[0], out[1], out[2] = pose[0], pose[1], pose[2]
@@ -208,8 +199,9 @@ def matched_poses(
         scores 0). The likelihood is gmapping's either way.
     climb_skip : with ``reach > 0`` and ``climb_skip > 0`` (the fast matcher, see the module
         docstring) the climber scores every ``(climb_skip + 1)``-th of the beams ``skip``
-        leaves; its last round is then scored again with all of them for the parabola, which
-        may move the pose by up to a step; the score is the one at the final pose.
+        leaves, and its pose is then refined on all of those by Gauss-Newton steps
+        (`fleetsim.slam.scan_align`) instead of the parabola; the score is the continuous
+        score at the refined pose.
 
     Returns
     -------
@@ -226,6 +218,7 @@ def matched_poses(
     fast = reach > 0.0 and climb_skip > 0
     # the climber's beams: every (skip+1)-th, or in the fast matcher a (climb_skip+1)-th of those
     climb = (skip + 1) * (climb_skip + 1) - 1 if fast else skip
+    used_x, used_y = ex[:: skip + 1].copy(), ey[:: skip + 1].copy()  # what scan_align fits
     for p in range(n):
         cur = poses[p].copy()
         cur_score, _ = _match(
@@ -265,19 +258,11 @@ def matched_poses(
             if not (cur_score > best_score or refinement < iterations):
                 break
         if fast:
-            # the last round again with every beam, and the top of its parabolas
-            centre, _ = _match(
-                pool, table, p, cur, laser, ex, ey, geom, kernel, sigma, lsigma, skip, reach, False
-            )
-            for move in range(6):
-                _moved(cur, move, ld, ad, cand)
-                move_scores[move], _ = _match(
-                    pool, table, p, cand, laser, ex, ey, geom, kernel, sigma, lsigma, skip,
-                    reach, False,
-                )  # fmt: skip
-            cur[0] += _vertex_within(move_scores[1], centre, move_scores[0], ld)
-            cur[1] += _vertex_within(move_scores[2], centre, move_scores[3], ld)
-            cur[2] += _vertex_within(move_scores[5], centre, move_scores[4], ad)
+            # the point-to-line fit of every beam from the climber's pose (scan_align)
+            cur = refined_pose(
+                pool, table, p, cur, laser, used_x, used_y, geom, kernel, sigma, reach, lstep,
+                astep,
+            )  # fmt: skip
             # score and likelihood of every used beam in one pass
             best_score, like = _match(
                 pool, table, p, cur, laser, ex, ey, geom, kernel, sigma, lsigma, skip, reach, True

@@ -31,8 +31,9 @@ the simulator's pose every 0.1 sim s; two runs of seed 1 gave the same figures; 
 note here said the drive was not deterministic, which the current code does not show).
 
 Usage: python benchmarks/slam_quality.py [--max-time 1500] [--seeds 1,2,3]
-       [--only update|office|office1|office2|willow]
-       (office: one hunter then two; office1: one only; office2: two only; each seed in turn)
+       [--only update|office|office1|office2|willow] [--trace]
+       (office: one hunter then two; office1: one only; office2: two only; each seed in turn;
+       --trace: each explorer's goals and where the exploration time went, `explore_trace`)
 """
 
 from __future__ import annotations

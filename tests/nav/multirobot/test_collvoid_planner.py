@@ -316,3 +316,22 @@ def test_a_robot_passes_one_parked_off_the_middle_of_a_corridor():
     f = Fleet([(-3, 0.4, 0), parked], [(3, 0.0, 0), parked], walls=walls)
     assert f.run(40.0)
     assert f.min_gap > 0.0 and np.all(np.abs(f.state[:, 1]) < 1.0 - BODY)
+
+
+def test_a_goal_nudged_by_localization_is_the_same_goal_to_the_deadlock_rule():
+    """move_base hands the plan over every cycle in odom, where each amcl correction moves the
+    goal a few cm: the no-progress clock and the trail survive that, not a new goal."""
+    fleet = Fleet([(0.0, 0.0, 0.0)], [(4.0, 0.0, 0.0)])
+    pl = fleet.planners[0]
+    fleet.run(1.0)
+    pl.deadlock.best_time = -7.0  # progress last made long ago
+    pl.retreat.extend(np.array([0.3, 0.0]))
+    trail = len(pl.retreat.trail)
+    line = np.linspace((0.0, 0.05), (4.0, 0.05), 50)
+    pl.set_plan(np.c_[line, np.zeros(50)])  # the same goal, 5 cm aside
+    assert pl.deadlock.best_time == -7.0
+    assert len(pl.retreat.trail) == trail
+    assert not pl.is_goal_reached()
+    line = np.linspace((0.0, 0.0), (0.0, 3.0), 50)
+    pl.set_plan(np.c_[line, np.zeros(50)])  # a new goal
+    assert pl.deadlock.best_time == pytest.approx(fleet.rt.now())

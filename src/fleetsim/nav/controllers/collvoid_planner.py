@@ -87,6 +87,11 @@ KEEP_RIGHT_UNTIL = 1.0
 #: share of the preferred speed under which the walls block the circumscribed disc (then the
 #: inscribed disc steers and the footprint keeps off the walls, `_wall_halfplanes`)
 WALLS_BLOCK = 0.25
+#: m; a goal that moved less than this is the same goal to the deadlock rule and the retreat.
+#: move_base hands the plan over every cycle in the local costmap's frame (odom), where every
+#: amcl map -> odom correction moves the goal by a few cm; taken as a new goal each time (~1 Hz)
+#: the no-progress clock restarted and the deadlock rule could never fire under amcl
+SAME_GOAL_SHIFT = 0.5
 
 
 class CollvoidLocalPlanner(CollvoidDrive, LocalPlanner):
@@ -169,11 +174,13 @@ class CollvoidLocalPlanner(CollvoidDrive, LocalPlanner):
             raise EmptyPlan(f"set_plan: a plan must be (N, 3) x, y, yaw poses, got {poses.shape}")
         if poses.shape[1] == 2:
             poses = np.concatenate([poses, np.zeros((poses.shape[0], 1))], axis=1)
-        same_goal = self.plan.shape[0] > 0 and np.allclose(self.plan[-1], poses[-1], atol=1e-6)
+        shift = math.hypot(*(self.plan[-1, :2] - poses[-1, :2])) if self.plan.shape[0] else math.inf
+        moved = shift > 1e-6 or not np.isclose(self.plan[-1, 2], poses[-1, 2], atol=1e-6)
         self.plan = poses
-        if not same_goal:
+        if moved:  # as TrajectoryPlannerROS::setPlan: the goal is judged afresh
             self.reached_goal = False
             self.xy_tolerance_latch = False
+        if shift > SAME_GOAL_SHIFT:
             self.deadlock.reset(self.node.now())
             self.retreat.reset()
             self.escape_from = None

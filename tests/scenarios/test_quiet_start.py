@@ -30,6 +30,7 @@ SCENARIOS = [
     ("visual_servoing", {}),
     ("slam_explore", {}),
     ("swap_corridor", {}),
+    ("swap_corridor", {"localization": "amcl"}),
     ("circle", {}),
     ("willow_swap", {}),
 ]

@@ -36,6 +36,7 @@ from fleetsim.tf import (
     resolve_frame_once,
 )
 from fleetsim.tf.names import normalize_frame
+from fleetsim.tf.patience import TransformPatience
 from fleetsim.tf.transforms import compose_pose2d, inverse_pose2d
 
 from .estimate import covariance_3x3
@@ -72,6 +73,7 @@ class Amcl(Node):
         self.global_frame = normalize_frame(p.global_frame_id)
         self.filter = ParticleFilter(p, self.rng, None)
         self.map_received = False
+        self._tf_patience = TransformPatience()
         self._pending_initial_pose: geometry_msgs.PoseWithCovarianceStamped | None = None
         self._laser_poses: dict[str, np.ndarray] = {}
         self._map_to_odom: np.ndarray | None = None
@@ -291,8 +293,14 @@ class Amcl(Node):
             self._warn_once("tf_old", f"dropping a scan older than tf's history: {err}")
             return True
         except FleetsimError as err:
-            self._warn_once(f"tf:{laser_frame}", f"skipping scans until tf is available: {err}")
+            # a frame not there yet in the first moments (the laser's static transform follows
+            # its first period) is waited for; reported once it stays missing (tf.patience)
+            if self._tf_patience.missing_too_long(laser_frame, self.now()):
+                self._warn_once(f"tf:{laser_frame}", f"skipping scans until tf is available: {err}")
+            else:
+                self.get_logger().debug(f"scan skipped until tf is available: {err}")
             return True
+        self._tf_patience.found(laser_frame)
         if self.filter.grid is None:
             return True
         if not self.filter.needs_update(odom_pose):  # not moved enough: the scan is not read

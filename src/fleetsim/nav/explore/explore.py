@@ -16,8 +16,9 @@ no frontier left; it *gave up* (``gave_up``, exit status 1) when it stopped with
 every one of them blacklisted, by it or (``peer_blacklists``) by a peer (move_base aborted the
 goal, or no progress for ``progress_timeout``). A frontier blacklisted on the way that the
 robot's laser later maps from elsewhere is no longer a frontier and does not count.
-explore_lite stops either way; the goal it cancels on stopping is listed in
-``withdrawn_goals``, so that the run monitor does not count it as a failed goal.
+explore_lite stops either way; a goal it cancels itself (on stopping, or to wait while a peer
+takes the frontiers left) is listed in ``withdrawn_goals``, so that the run monitor does not
+count it as a failed goal.
 
 Explorers sharing one map (slam_explore ``robots:=2``) would all head for the same best
 frontier; fleetsim adds ``peer_goals``: each explorer announces its goal on ``~goal`` and leaves
@@ -116,7 +117,8 @@ class Explore(Node):
         self.finished = False
         #: stopped with frontiers left, all blacklisted (see the module docstring)
         self.gave_up = False
-        #: ids of the goals it canceled itself on stopping (for the run monitor)
+        #: ids of the goals it canceled itself: on stopping, or to wait while a peer takes the
+        #: frontiers left (for the run monitor, which does not count them as failed)
         self.withdrawn_goals: set[str] = set()
         self.goals_sent = 0
         self._handle: Any = None
@@ -276,6 +278,7 @@ class Explore(Node):
         )
         if chosen is None:  # the peers have every frontier left: wait for them
             if self._handle is not None:
+                self.withdrawn_goals.add(self._handle.id)  # our own cancel: no failed goal
                 self.move_base.cancel_all_goals()
                 self._handle = None
             if self.goal is not None:

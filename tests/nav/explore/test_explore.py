@@ -95,6 +95,7 @@ def test_slam_explore_two_hunters_explore_through_the_merged_map(caplog, tmp_pat
         costmap = s.nodes["/hunter2/move_base"].global_costmap
         engine = s.monitor.sim.engine
         starts = [engine.model_pose(f"hunter{i}")[0] for i in (1, 2)]  # where they are now
+        driven = [r.path_length for r in sorted(s.monitor.results(), key=lambda r: r.namespace)]
     # each maps on its own, in its own frame ...
     assert [g.header.frame_id for g in own] == ["hunter1/map", "hunter2/map"]
     # ... the merged map (frame map) holds both, and each explorer works on it
@@ -109,8 +110,9 @@ def test_slam_explore_two_hunters_explore_through_the_merged_map(caplog, tmp_pat
     assert costmap.global_frame == "map"
     for ex in explorers:
         assert ex.goals_sent >= 1 and ex.grid.header.frame_id == "map"
-    # both drove away from their starts, west and east of the corridor
-    assert all(math.hypot(p[0] - x0, p[1] - 10.0) > 1.0 for p, x0 in zip(starts, (4.0, 26.0)))
+    # both drove (an explorer may bring its robot back near its start: path length, not the
+    # distance from the start), and each stays on its side, west and east of the corridor
+    assert all(d > 1.5 for d in driven), driven
     assert starts[0][0] < starts[1][0]
     saved = load_map(out.with_suffix(".yaml"))  # the merged map is the one saved
     assert saved.data.shape == data.shape

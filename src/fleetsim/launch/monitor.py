@@ -69,6 +69,11 @@ class GoalSender(Protocol):
     def succeeded(self) -> bool: ...
 
 
+def _sender_name(sender: Any) -> str:
+    """A goal sender's node name (its class name if it is not a node)."""
+    return str(getattr(sender, "full_name", type(sender).__name__))
+
+
 @dataclass
 class RobotResult:
     namespace: str
@@ -213,7 +218,7 @@ class RunMonitor:
         """The name of the sender that withdrew goal ``goal_id`` ("" if none did)."""
         for s in self.senders:
             if goal_id in getattr(s, "withdrawn_goals", ()):
-                return str(getattr(s, "full_name", type(s).__name__))
+                return _sender_name(s)
         return ""
 
     def all_goals_done(self) -> bool:
@@ -227,9 +232,7 @@ class RunMonitor:
     def senders_failed(self) -> list[str]:
         """Names of the goal senders that are not done, or done and gave up."""
         return [
-            str(getattr(s, "full_name", type(s).__name__))
-            for s in self.senders
-            if not s.done or not getattr(s, "succeeded", True)
+            _sender_name(s) for s in self.senders if not s.done or not getattr(s, "succeeded", True)
         ]
 
     def _confirm(self, r: RobotResult, goal, text: str) -> None:

@@ -209,10 +209,14 @@ def _joint_label(m: mujoco.MjModel, dof: int) -> str:
     return f"{joint}, DOF {dof}"
 
 
+def _qpos_joints(m: mujoco.MjModel, qadr) -> np.ndarray:
+    """The joints that hold position coordinates ``qadr`` (an index or an array of them)."""
+    return np.maximum(np.searchsorted(m.jnt_qposadr, qadr, side="right") - 1, 0)
+
+
 def _qpos_dof(m: mujoco.MjModel, qadr: int) -> int:
     """The first DOF of the joint that holds position coordinate ``qadr``."""
-    jnt = int(np.searchsorted(m.jnt_qposadr, qadr, side="right")) - 1
-    return int(m.jnt_dofadr[max(jnt, 0)])
+    return int(m.jnt_dofadr[int(_qpos_joints(m, qadr))])
 
 
 def _actuator_dof(m: mujoco.MjModel, act: int) -> int:
@@ -294,11 +298,8 @@ def _non_finite_state(engine, model_i: int, dofs: np.ndarray) -> tuple[str, str]
     state = engine.solver_guard.state
     qpos, qvel = state[1 : 1 + m.nq], state[1 + m.nq : 1 + m.nq + m.nv]
     bad_vel = dofs[~np.isfinite(qvel[dofs])]
-    if model_i >= 0:
-        qadr = np.flatnonzero(engine._body_model[m.jnt_bodyid] == model_i)
-    else:
-        qadr = np.array([int(m.dof_jntid[dofs[0]])])
-    bad_pos = [j for j in qadr.tolist() if not np.isfinite(qpos[_qpos_slice(m, j)]).all()]
+    mine = set(m.dof_jntid[dofs].tolist())  # every joint with coordinates has DOFs
+    bad_pos = [j for j in _qpos_joints(m, np.flatnonzero(~np.isfinite(qpos))).tolist() if j in mine]
     if not bad_pos and not bad_vel.size:
         return None
     what = (
@@ -311,12 +312,6 @@ def _non_finite_state(engine, model_i: int, dofs: np.ndarray) -> tuple[str, str]
         "find what set it (a set_model_state / teleport, a plugin writing qpos or qvel) and "
         "guard it",
     )
-
-
-def _qpos_slice(m: mujoco.MjModel, j: int) -> slice:
-    a = int(m.jnt_qposadr[j])
-    n = {mujoco.mjtJoint.mjJNT_FREE: 7, mujoco.mjtJoint.mjJNT_BALL: 4}.get(int(m.jnt_type[j]), 1)
-    return slice(a, a + n)
 
 
 def _runaway(engine, dofs: np.ndarray, model_i: int) -> tuple[str, str] | None:

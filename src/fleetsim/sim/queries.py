@@ -133,10 +133,11 @@ class StateQueries:
             if value is None:
                 continue
             v = np.asarray(value, float)
-            if v.shape != ((4,) if field == "orientation" else (3,)):
+            size = 4 if field == "orientation" else 3
+            if v.shape != (size,):
                 raise SimulationError(
-                    f"set_model_state '{name}': {field} must have "
-                    f"{4 if field == 'orientation' else 3} values, got {list(v.ravel())}"
+                    f"set_model_state '{name}': {field} must have {size} values, "
+                    f"got {list(v.ravel())}"
                 )
             if not np.all(np.isfinite(v)):
                 raise SimulationError(

@@ -18,6 +18,7 @@ import math
 import numba
 import numpy as np
 
+from .scan_align import laser_origin
 from .tiles import MASK, SHIFT, writable_tile
 
 _SATURATED = 65535  # uint16 counts stop here (a cell visited that often is settled)
@@ -48,10 +49,7 @@ def cast_counts(
     x1s = np.empty(nb, dtype=np.int64)
     y1s = np.empty(nb, dtype=np.int64)
     for p in range(start, poses.shape[0]):
-        c, s = math.cos(poses[p, 2]), math.sin(poses[p, 2])
-        lx = poses[p, 0] + c * laser[0] - s * laser[1]
-        ly = poses[p, 1] + s * laser[0] + c * laser[1]
-        lt = poses[p, 2] + laser[2]
+        lx, ly, lt = laser_origin(poses[p, 0], poses[p, 1], poses[p, 2], laser)
         x0 = math.floor((lx - ox) / delta)
         y0 = math.floor((ly - oy) / delta)
         bx0, bx1, by0, by1 = x0, x0, y0, y0

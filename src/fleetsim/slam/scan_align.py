@@ -45,6 +45,14 @@ STEP_TOLERANCE = 1e-5
 DAMPING = 1e-4
 
 
+@numba.njit(cache=True, inline="always")
+def laser_origin(x, y, th, laser):
+    """Where the laser is, ``(lx, ly, heading)`` in the map frame, for a robot at (x, y, th)
+    (``laser``: its (x, y, yaw) in the base frame); shared by the matcher's kernels."""
+    c, s = math.cos(th), math.sin(th)
+    return x + c * laser[0] - s * laser[1], y + s * laser[0] + c * laser[1], th + laser[2]
+
+
 @numba.njit(cache=True, fastmath=True, error_model="numpy")
 def aligned_pose(pool, table, p, pose, laser, ex, ey, geom, kernel, sigma, reach):
     """One damped Gauss-Newton step of particle p's base pose (point-to-line, see the module).
@@ -65,10 +73,8 @@ def aligned_pose(pool, table, p, pose, laser, ex, ey, geom, kernel, sigma, reach
     """
     ox, oy, delta = geom[0], geom[1], geom[2]
     inv = 1.0 / delta
-    c, s = math.cos(pose[2]), math.sin(pose[2])
-    lx = pose[0] + c * laser[0] - s * laser[1]
-    ly = pose[1] + s * laser[0] + c * laser[1]
-    cl, sl = math.cos(pose[2] + laser[2]), math.sin(pose[2] + laser[2])
+    lx, ly, lt = laser_origin(pose[0], pose[1], pose[2], laser)
+    cl, sl = math.cos(lt), math.sin(lt)
     inv_sigma = 1.0 / sigma
     cap = reach * reach
     far = math.exp(-cap * inv_sigma)

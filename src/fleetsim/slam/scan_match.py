@@ -71,7 +71,7 @@ import math
 import numba
 import numpy as np
 
-from .scan_align import refined_pose
+from .scan_align import laser_origin, refined_pose
 from .tiles import FAR, writable_tile
 from .tiles import MASK as _MASK
 from .tiles import SHIFT as _SHIFT
@@ -100,10 +100,8 @@ def _match(pool, table, p, pose, laser, ex, ey, geom, kernel, sigma, lsigma, ski
     """
     ox, oy, delta = geom[0], geom[1], geom[2]
     inv = 1.0 / delta
-    c, s = math.cos(pose[2]), math.sin(pose[2])
-    lx = pose[0] + c * laser[0] - s * laser[1]
-    ly = pose[1] + s * laser[0] + c * laser[1]
-    cl, sl = math.cos(pose[2] + laser[2]), math.sin(pose[2] + laser[2])
+    lx, ly, lt = laser_origin(pose[0], pose[1], pose[2], laser)
+    cl, sl = math.cos(lt), math.sin(lt)
     no_hit = NULL_LIKELIHOOD / lsigma
     inv_sigma = 1.0 / sigma
     cap = reach * reach if reach > 0.0 else NO_HIT
@@ -307,10 +305,7 @@ def endpoint_cells(poses, laser, ranges, angles, geom):
     hits = np.empty((n, b, 2))
     ox, oy, delta = geom[0], geom[1], geom[2]
     for p in range(n):
-        c, s = math.cos(poses[p, 2]), math.sin(poses[p, 2])
-        lx = poses[p, 0] + c * laser[0] - s * laser[1]
-        ly = poses[p, 1] + s * laser[0] + c * laser[1]
-        lt = poses[p, 2] + laser[2]
+        lx, ly, lt = laser_origin(poses[p, 0], poses[p, 1], poses[p, 2], laser)
         for i in range(b):
             hx = lx + ranges[i] * math.cos(lt + angles[i])
             hy = ly + ranges[i] * math.sin(lt + angles[i])

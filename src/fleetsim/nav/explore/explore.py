@@ -190,6 +190,14 @@ class Explore(Node):
             )
         )
 
+    def _withdraw_goal(self) -> None:
+        """Cancel the active goal, if any, as no longer wanted: listed in ``withdrawn_goals``
+        so that the run monitor does not count the cancel as a failed goal."""
+        if self._handle is not None:
+            self.withdrawn_goals.add(self._handle.id)
+            self.move_base.cancel_all_goals()
+            self._handle = None
+
     def _announce(self, goal: tuple[float, float] | None, frame: str = "") -> None:
         """Publish the goal on ~goal for peer explorers (NaN: none)."""
         x, y = goal if goal is not None else (math.nan, math.nan)
@@ -277,10 +285,7 @@ class Explore(Node):
             p.potential_scale * info.resolution * p.switch_distance,
         )
         if chosen is None:  # the peers have every frontier left: wait for them
-            if self._handle is not None:
-                self.withdrawn_goals.add(self._handle.id)  # our own cancel: no failed goal
-                self.move_base.cancel_all_goals()
-                self._handle = None
+            self._withdraw_goal()
             if self.goal is not None:
                 self.goal = None
                 self._announce(None)
@@ -333,9 +338,7 @@ class Explore(Node):
         self.gave_up = bool(self.frontiers)  # what is left is all blacklisted
         if self.gave_up:
             why += f" (gave up: {len(self.frontiers)} frontiers left, all blacklisted)"
-        if self._handle is not None:
-            self.withdrawn_goals.add(self._handle.id)
-            self.move_base.cancel_all_goals()
+        self._withdraw_goal()
         self.timer.cancel()
         self._announce(None)
         self.get_logger().info(why)

@@ -286,12 +286,10 @@ class Retreat:
         self.retreated = False  # backing out since the trail last grew: cut it when it does
 
     def reset(self) -> None:
-        """A new goal: the refuge is forgotten, the trail kept. The way the robot came stays
-        free whatever its goal, and move_base hands the plan over again every cycle in the local
-        costmap's frame (``odom``): under amcl each map -> odom correction moves the goal there
-        by a few cm, and the planner takes that for a new goal (~1 Hz); a trail cleared each
-        time was one or two points long, so a robot yielding in a passage backed out 0.2 m and
-        waited in the middle of it (swap_corridor localization:=amcl, 0/2 goals in 60 s)."""
+        """A new goal: the refuge is forgotten, the trail kept: the way the robot came stays
+        free whatever its goal. (A goal only nudged by a localization correction is not a new
+        goal at all: the planner's ``set_plan`` tells them apart,
+        `fleetsim.nav.controllers.collvoid_planner.SAME_GOAL_SHIFT`.)"""
         self.refuge, self.refuge_final = None, False
 
     def extend(self, xy: np.ndarray) -> None:

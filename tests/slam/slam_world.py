@@ -1,5 +1,6 @@
 """A synthetic world for the SLAM tests: axis-aligned boxes, their true occupancy, exact scans,
-and a fake robot node publishing drifting odometry tf and 360-beam scans at 10 Hz."""
+and a fake robot node publishing drifting odometry tf and 360-beam scans at 10 Hz (another
+robot in its view: a disc, ``peer_disc``)."""
 
 from __future__ import annotations
 
@@ -49,6 +50,17 @@ def exact_ranges(pose, angles, max_range):
             t = np.where(tmin > 0, tmin, 0.0)
             best = np.where(hit & (t < best), t, best)
     return np.where(best <= max_range, best, np.inf)
+
+
+def disc_ranges(pose, angles, centre, radius):
+    """(B,) ranges from sensor pose ``(x, y, yaw)`` to a disc (another robot); inf if missed."""
+    a = pose[2] + np.asarray(angles, dtype=float)
+    dx, dy = np.cos(a), np.sin(a)
+    ox, oy = pose[0] - centre[0], pose[1] - centre[1]
+    b = ox * dx + oy * dy
+    disc = b * b - (ox * ox + oy * oy - radius * radius)
+    t = -b - np.sqrt(np.maximum(disc, 0.0))
+    return np.where((disc >= 0) & (t > 0), t, np.inf)
 
 
 # a loop through free space, about 30 m
@@ -118,6 +130,7 @@ class FakeRobot(Node):
             self._laser_sent = False
             self.create_timer(0.05, send_laser_tf)
         self.flip = r != 0.0
+        self.peer_disc: tuple[float, float, float] | None = None  # (x, y, radius) in view, m
         self.scan_pub = self.create_publisher(sensor_msgs.LaserScan, "scan", queue_size=1)
         self.create_timer(0.1, self.tick, priority=-50)
         self.tick()
@@ -139,6 +152,10 @@ class FakeRobot(Node):
         inc = 2 * np.pi / n
         angles = -np.pi + inc * np.arange(n)
         ranges = exact_ranges(sensor, -angles if self.flip else angles, 12.0)
+        if self.peer_disc is not None:
+            x, y, radius = self.peer_disc
+            disc = disc_ranges(sensor, -angles if self.flip else angles, (x, y), radius)
+            ranges = np.minimum(ranges, disc)
         ranges = ranges + 0.01 * self.rng.standard_normal(n)
         self.scan_pub.publish(
             sensor_msgs.LaserScan(

@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from fleetsim.errors import ExtrapolationError, FleetsimError, TransformError
+from fleetsim.errors import ExtrapolationError, FleetsimError, ParameterError, TransformError
 from fleetsim.msgs import nav_msgs, sensor_msgs, std_msgs
 from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.nav.map_io import OccupancyMap
@@ -42,6 +42,7 @@ from fleetsim.tf.transforms import compose_pose2d, inverse_pose2d
 from .errors import SlamError
 from .filter import Beams, GmappingFilter
 from .params import GmappingParams, gmapping_params
+from .peers import PeerLookup, beams_clear_of_peers, peers_in_base
 
 SCAN_QUEUE_SIZE = 5  # gmapping's tf::MessageFilter queue
 TF_GRACE = 1.0  # s of sim time before missing odometry or laser tf is reported
@@ -62,6 +63,13 @@ class SlamGmapping(Node):
         self.base_frame = resolve_frame_once(prefix, p.base_frame)
         self.odom_frame = resolve_frame_once(prefix, p.odom_frame)
         self.map_frame = resolve_frame_once(prefix, p.map_frame)
+        self.peer_frames = [str(f).lstrip("/") for f in p.peer_frames]
+        if self.base_frame in self.peer_frames:
+            raise ParameterError(
+                f"{self.full_name}: peer_frames {p.peer_frames} holds the robot's own base "
+                f"frame {self.base_frame}; list the other robots' base frames"
+            )
+        self.peer_beams_dropped = 0  # beams left out as ending on a peer, over the run
         self.filter: GmappingFilter | None = None
         self.map_to_odom = np.zeros(3)
         self.grid_msg: nav_msgs.OccupancyGrid | None = None
@@ -155,6 +163,15 @@ class SlamGmapping(Node):
         except SlamError as err:
             self._warn_once(f"scan:{err}", str(err))
             return True
+        if self.peer_frames:
+            found = peers_in_base(
+                self.tf_buffer, self.base_frame, self.peer_frames, stamp, self.now(), TF_GRACE
+            )
+            if found.wait:
+                return False
+            if found.skip:  # the first moments: a scan from before the peers' first tf
+                return True
+            beams = self._off_peers(beams, found)
         assert self.filter is not None
         result = self.filter.process(odom, stamp, beams)
         if result.updated:
@@ -221,10 +238,37 @@ class SlamGmapping(Node):
         keep = np.isfinite(ranges) & (ranges > 0.0) & (ranges <= self.filter.max_range)
         return Beams(ranges[keep], angles[keep])
 
+    def _off_peers(self, beams: Beams, found: PeerLookup) -> Beams:
+        """The beams that do not end on a peer found (`fleetsim.slam.peers`)."""
+        for frame, why in found.missing.items():
+            self._warn_once(
+                f"peer:{frame}",
+                f"keeping the beams of {self.scan_topic} that may end on the peer {frame}: {why}; "
+                "they may map that robot as an obstacle",
+            )
+        for frame in self.peer_frames:
+            if frame not in found.missing:
+                self._warned.discard(f"peer:{frame}")  # warn again should it go missing again
+        assert self.filter is not None
+        p = self.params
+        keep = beams_clear_of_peers(
+            beams.ranges,
+            beams.angles,
+            self.filter.laser,
+            found.positions,
+            p.peer_radius + p.peer_margin,
+        )
+        dropped = int(len(keep) - np.count_nonzero(keep))
+        if not dropped:
+            return beams
+        self.peer_beams_dropped += dropped
+        return Beams(beams.ranges[keep], beams.angles[keep])
+
     # ----- outputs -----
     def _publish_transform(self) -> None:
-        if self.filter is None:
-            return
+        # before the first scan: the identity, as gmapping's publishLoop does (map_to_odom_ starts
+        # as the identity, and the first scan puts the map frame on the odometry pose); a peer's
+        # slam_gmapping looks this robot up through it (fleetsim.slam.peers)
         x, y, yaw = (float(v) for v in self.map_to_odom)
         delay = self.params.tf_delay if self.params.tf_delay is not None else self.tf_period
         self.tf_pub.send_transform(

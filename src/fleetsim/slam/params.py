@@ -96,6 +96,23 @@ class GmappingParams:
         "every beam all the way and the parabola, gmapping's climber; see "
         "fleetsim.slam.scan_match and fleetsim.slam.scan_align)",
     )
+    # --- peers (fleetsim addition; see fleetsim.slam.peers) ---
+    peer_frames: list = param(
+        [],
+        help="fleetsim addition: other robots' base frames (full tf names, e.g. "
+        "hunter2/base_link); beams that end within peer_radius + peer_margin of one, found "
+        "through tf at the scan's time, are left out of scan matching and the map (empty: off, "
+        "gmapping's behaviour)",
+    )
+    peer_radius: float = param(
+        0.35, unit="m", range=(0.0, None), help="radius of a disc covering a peer's body"
+    )
+    peer_margin: float = param(
+        0.1,
+        unit="m",
+        range=(0.0, None),
+        help="added to peer_radius for the error of the two robots' pose estimates",
+    )
     # --- motion model ---
     srr: float = param(0.1, range=(0.0, None), help="translation noise from translation")
     srt: float = param(0.2, range=(0.0, None), help="rotation noise from translation")
@@ -127,6 +144,12 @@ class GmappingParams:
     lasamplestep: float = param(0.005, unit="rad", help="no effect (gmapping never uses it)")
 
     def __post_init__(self) -> None:
+        for frame in self.peer_frames:
+            if not isinstance(frame, builtins.str) or not frame.strip("/"):
+                raise ParameterError(
+                    f"slam_gmapping: peer_frames holds {frame!r}; give each peer's base frame "
+                    "as a tf frame name, e.g. 'hunter2/base_link'"
+                )
         if self.xmin >= self.xmax or self.ymin >= self.ymax:
             raise ParameterError(
                 f"slam_gmapping: the map extent xmin..xmax = {self.xmin}..{self.xmax}, "

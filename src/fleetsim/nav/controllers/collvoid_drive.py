@@ -164,7 +164,11 @@ class CollvoidDrive:
             self.last_w = 0.0
             return VelocityCommand()
         self.rotating_to_goal = True
-        v = _clamp(abs(ang), p.min_in_place_vel_theta, p.max_vel_theta)
+        # max_vel_theta, slowed only as far as acc_lim_theta needs to stop on the goal yaw (Nav2
+        # RegulatedPurePursuit's rotateToHeading); base_local_planner's rate |ang| (a gain of
+        # 1/s) made the last 0.8 rad of a lizi's turn take 1.8 s (its skid steer turns at ~0.57
+        # of the command): willow_swap's last robot arrived sideways and crept round
+        v = p.max_vel_theta
         ramp = max(0.0, self.last_w if ang > 0 else -self.last_w) + p.acc_lim_theta * self.dt
         v = min(v, math.sqrt(2 * p.acc_lim_theta * abs(ang)), ramp)
         v = max(v, p.min_in_place_vel_theta)

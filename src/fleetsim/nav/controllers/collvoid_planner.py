@@ -51,6 +51,7 @@ from fleetsim.errors import ParameterError, TransformError
 from fleetsim.msgs import geometry_msgs
 from fleetsim.nav.controllers.base import EmptyPlan, LocalPlanner, VelocityCommand
 from fleetsim.nav.controllers.collvoid_drive import UNTRUNCATED, CollvoidDrive
+from fleetsim.nav.controllers.collvoid_hold import CollvoidHold
 from fleetsim.nav.controllers.collvoid_params import CollvoidParams
 from fleetsim.nav.costmap.footprint import footprint_radii, outline_points
 from fleetsim.nav.multirobot.deadlock import DeadlockRule
@@ -94,7 +95,7 @@ WALLS_BLOCK = 0.25
 SAME_GOAL_SHIFT = 0.5
 
 
-class CollvoidLocalPlanner(CollvoidDrive, LocalPlanner):
+class CollvoidLocalPlanner(CollvoidDrive, CollvoidHold, LocalPlanner):
     """ORCA among the robots on /position_share, for one move_base (see the module doc)."""
 
     Params = CollvoidParams
@@ -157,6 +158,7 @@ class CollvoidLocalPlanner(CollvoidDrive, LocalPlanner):
         self.retreat = Retreat()  # the way back and the refuge of a yield
         self.lines = (np.zeros((0, 2)), np.zeros((0, 2)), 0)  # this cycle's half-planes
         self.feasible = True
+        self._start_hold()
 
     @classmethod
     def from_namespace(cls, node: Any, costmap_ros: Any, ns: dict | None, where: str):
@@ -191,6 +193,7 @@ class CollvoidLocalPlanner(CollvoidDrive, LocalPlanner):
     def compute_velocity_commands(self, pose, velocity) -> VelocityCommand:
         p = self.params
         x, y, yaw = (float(v) for v in pose)
+        self.last_cycle = self.node.now()
         if self.plan.shape[0] == 0:
             raise EmptyPlan("CollvoidLocalPlanner: no plan; call set_plan first")
         xy = np.array([x, y])
@@ -225,41 +228,40 @@ class CollvoidLocalPlanner(CollvoidDrive, LocalPlanner):
             return 0.0, 0.0, 0.0
         return self.node.tf_buffer.lookup_pose2d(self.frame, MAP_FRAME, 0.0)
 
-    def holonomic_velocity(self, xy, yaw, vel, carrot, remaining) -> np.ndarray:
-        """The ORCA velocity for this cycle, (2,) m/s in the local costmap's frame."""
+    def _neighbours(self, xy: np.ndarray) -> tuple:
+        """The robots around ``xy`` (m, local costmap frame) on /position_share, in that frame:
+        (own position in map (2,), ids, positions (N, 2), velocities (N, 2), radii (N,),
+        ORCA responsibilities (N,): all of it for a robot not ``controlled`` or standing
+        still, half otherwise; controlled (N,) bool, yaws (N,)). None around without tf."""
         p, now = self.params, self.node.now()
+        ids: list[str] = []
+        pos, nvel, radii = np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0)
+        resp, controlled, yaws = np.zeros(0), np.zeros(0, dtype=bool), np.zeros(0)
         try:
             tx, ty, tyaw = self._map_to_local()
         except TransformError:
-            tx = ty = tyaw = None
+            return xy, ids, pos, nvel, radii, resp, controlled, yaws
+        map_xy = rotated(xy - [tx, ty], -tyaw)
+        near = self.share.table.near(
+            now, (map_xy[0], map_xy[1]), p.neighbor_dist, p.max_neighbors, self.robot_id
+        )
+        cr, sr = math.cos(tyaw), math.sin(tyaw)
+        rot = np.array([[cr, -sr], [sr, cr]])
+        pos = near.positions @ rot.T + [tx, ty]
+        nvel = near.velocities @ rot.T
+        still = np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED
+        resp = np.where(~near.controlled | still, 1.0, 0.5)
+        yaws = np.array([r.yaw for r in near.robots]) + tyaw
+        return map_xy, near.ids, pos, nvel, near.radii, resp, near.controlled, yaws
+
+    def holonomic_velocity(self, xy, yaw, vel, carrot, remaining) -> np.ndarray:
+        """The ORCA velocity for this cycle, (2,) m/s in the local costmap's frame."""
+        p, now = self.params, self.node.now()
         pref = preferred_velocity(
             carrot, xy, remaining, p.max_vel_x, p.min_vel_x, DECELERATION * p.acc_lim_x
         )
-        pos = np.zeros((0, 2))
-        nvel = np.zeros((0, 2))
-        radii = np.zeros(0)
-        resp = np.zeros(0)
-        ids: list[str] = []
-        controlled = np.zeros(0, dtype=bool)
-        yaws = np.zeros(0)
-        speed = float(np.hypot(*vel))
-        map_xy = xy
-        if tx is not None:
-            map_xy = rotated(xy - [tx, ty], -tyaw)
-            near = self.share.table.near(
-                now, (map_xy[0], map_xy[1]), p.neighbor_dist, p.max_neighbors, self.robot_id
-            )
-            ids = near.ids
-            cr, sr = math.cos(tyaw), math.sin(tyaw)
-            rot = np.array([[cr, -sr], [sr, cr]])
-            pos = near.positions @ rot.T + [tx, ty]
-            nvel = near.velocities @ rot.T
-            radii = near.radii
-            still = np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED
-            resp = np.where(~near.controlled | still, 1.0, 0.5)
-            controlled = near.controlled
-            yaws = np.array([r.yaw for r in near.robots]) + tyaw
-        own_r = self.own_radius(speed, map_xy)
+        map_xy, ids, pos, nvel, radii, resp, controlled, yaws = self._neighbours(xy)
+        own_r = self.own_radius(float(np.hypot(*vel)), map_xy)
         dist = np.hypot(pos[:, 0] - xy[0], pos[:, 1] - xy[1])
         active = {k: d for k, d, c in zip(ids, dist.tolist(), controlled) if c}
         narrow: list[str] = []
@@ -291,6 +293,13 @@ class CollvoidLocalPlanner(CollvoidDrive, LocalPlanner):
             if not near_goal and self._oncoming(pos - xy, nvel, vel, pref, dist, remaining).any():
                 pref = rotated(pref, p.left_pref)
             pref = self._around_still(pref, xy, pos - xy, nvel, own_r + radii, controlled)
+        return self._orca(xy, vel, pref, pos - xy, nvel, own_r + radii, resp)
+
+    def _orca(self, xy, vel, pref, rel, nvel, radii, resp) -> np.ndarray:
+        """The velocity nearest ``pref`` (2,) m/s that the half-planes of the local costmap's
+        walls and of the robots (``rel`` (N, 2) m, ``nvel`` (N, 2) m/s, combined ``radii`` (N,)
+        m, responsibilities ``resp`` (N,)) admit; the half-planes are kept in ``lines``."""
+        p = self.params
         lines_p, lines_d = [], []
         obst = obstacle_points(
             self.costmap.costs,
@@ -304,10 +313,8 @@ class CollvoidLocalPlanner(CollvoidDrive, LocalPlanner):
             lp, ld = self._wall_halfplanes(obst - xy, vel, pref)
             lines_p.append(lp)
             lines_d.append(ld)
-        if ids:
-            lp, ld = orca_halfplanes(
-                pos - xy, vel - nvel, own_r + radii, vel, self.horizon, self.dt, resp
-            )
+        if rel.shape[0]:
+            lp, ld = orca_halfplanes(rel, vel - nvel, radii, vel, self.horizon, self.dt, resp)
             lines_p.append(lp)
             lines_d.append(ld)
         self.lines = (

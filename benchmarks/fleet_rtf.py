@@ -231,8 +231,9 @@ def measure_launch(layer: str, n: int, duration: float, seed: int, chunks: int =
 
                 got = [0]
 
-                def count(_msg) -> None:
+                def count(msg) -> None:
                     got[0] += 1
+                    _ = msg.ranges  # a scan is cast when read: read it, as its reader would
 
                 for i in range(n):
                     s.runtime.graph.subscribe(f"/lizi{i}/base_scan", sensor_msgs.LaserScan, count)

@@ -111,9 +111,9 @@ def test_a_laser_mounted_upside_down_sweeps_clockwise(roll):
 
 
 def test_noisy_ranges_equal_numpys_bit_for_bit():
-    """The fused noise kernel gives the array expression it replaced, bit for bit, and draws
-    one normal per noisy beam that hits."""
-    from fleetsim.sim.lasers import noisy_hit_count, noisy_ranges
+    """The fused noise kernel gives the array expression it replaced, bit for bit, with one
+    normal per beam, used where a noisy beam hits."""
+    from fleetsim.sim.lasers import noisy_ranges
 
     rng = np.random.default_rng(3)
     n = 5000
@@ -125,15 +125,73 @@ def test_noisy_ranges_equal_numpys_bit_for_bit():
     rmin, rmax = np.full(n, 0.1), np.full(n, 10.0)
     ranges[:5] = [0.1, 10.0, 0.05, np.inf, 10.5]
     hit = np.flatnonzero(noisy & np.isfinite(ranges))
-    assert noisy_hit_count(ranges, noisy) == len(hit)
-    z = rng.standard_normal(len(hit))
+    z = rng.standard_normal(n)
     want = ranges.copy()
-    want[hit] = np.clip(ranges[hit] + mean[hit] + std[hit] * z, rmin[hit], rmax[hit])
+    want[hit] = np.clip(ranges[hit] + mean[hit] + std[hit] * z[hit], rmin[hit], rmax[hit])
     want = want.astype(np.float32)
     got = np.empty(n, np.float32)
     noisy_ranges(ranges, noisy, mean, std, rmin, rmax, z, got)
     assert got.tobytes() == want.tobytes()
     assert (got[hit] == 0.1).sum() > 10 and (got[hit] == np.float32(10.0)).sum() > 10
+
+
+def test_scan_noise_streams_are_per_scan_and_per_laser():
+    """Each scan of each laser draws its own stream: the same key, laser and scan give the
+    same draws whatever was drawn before; another scan or laser gives others."""
+    from fleetsim.sim.lasers import scan_noise
+
+    a = scan_noise(7, 11, 3, 720)
+    scan_noise(7, 11, 2, 720)  # another scan drawn in between changes nothing
+    np.testing.assert_array_equal(a, scan_noise(7, 11, 3, 720))
+    for other in (scan_noise(7, 11, 4, 720), scan_noise(7, 12, 3, 720), scan_noise(8, 11, 3, 720)):
+        assert abs(np.corrcoef(a, other)[0, 1]) < 0.15
+    assert abs(a.mean()) < 0.15 and 0.9 < a.std() < 1.1
+
+
+def _noisy_engine(diffbot, seed=1):
+    from fleetsim.description import parse_urdf
+
+    text = diffbot.to_urdf().replace(
+        "<range>",
+        "<noise><type>gaussian</type><mean>0.0</mean><stddev>0.01</stddev></noise><range>",
+        1,
+    )
+    e = Engine(WILLOW, rng=np.random.default_rng(seed))
+    ent = e.spawn_robot("r", parse_urdf(text), (10.0, 10.0, 0, 0, 0, 0))
+    ent.plugins[0].command(0.5, 0.5, e.time)  # moving: a scan cast late must not see it moved
+    return e, next(p for p in ent.plugins if isinstance(p, LaserPlugin))
+
+
+def test_a_scan_is_cast_when_read_and_reads_the_same_either_way(diffbot):
+    """Readings are cast only when their ranges are read, with the state of their instant:
+    a scan read late equals the same scan read at once, and skipping scans unread does not
+    change the ones read after (their noise is keyed by the scan, not drawn in turn)."""
+    from fleetsim.sim.messages import LazyLaserScan, scan_msg
+
+    runs = []
+    for read_every in (1, 3):
+        e, laser = _noisy_engine(diffbot)
+        kept = []
+        for k in range(6):
+            e.advance(0.05)
+            (r,) = e.lasers.measure(e, [laser], e.time)
+            assert not r.cast  # nothing cast yet
+            if k % read_every == 0:
+                kept.append((k, r))
+                if read_every == 1:
+                    _ = r.ranges  # read at once
+        runs.append({k: r.ranges for k, r in kept})  # read_every 3: read late, moved since
+    for k, ranges in runs[1].items():
+        np.testing.assert_array_equal(ranges, runs[0][k])
+    finite = np.isfinite(runs[0][0]) & np.isfinite(runs[0][3])
+    assert np.abs(runs[0][0][finite] - runs[0][3][finite]).mean() > 0.02  # it moved meanwhile
+    # the message stands for a LaserScan until read, then holds the same ranges
+    e, laser = _noisy_engine(diffbot)
+    (r,) = e.lasers.measure(e, [laser], e.time)
+    msg = scan_msg(r)
+    assert isinstance(msg, LazyLaserScan) and not r.cast
+    assert len(msg.ranges) == laser.samples and r.cast
+    np.testing.assert_array_equal(msg.ranges, r.ranges)
 
 
 def test_bounding_circles_equal_the_numpy_grouping():

@@ -177,7 +177,7 @@ def normalized(msg: Any, where: str = "") -> Any:
 def serialize(msg: Any) -> bytes:
     """Encode a message as CDR (little-endian, with the 4-byte encapsulation header)."""
     name = type_name(msg)
-    cls = type(msg)
+    cls = getattr(type(msg), "__lazy_of__", type(msg))  # a lazily built message: its type
     if _READY.get(name) is not cls:
         _prepare(cls)
     msg = normalized(msg)

@@ -94,7 +94,7 @@ class Engine(StateQueries):
         self.model: mujoco.MjModel | None = None
         self.data: mujoco.MjData | None = None
         self.attacher = LinkAttacher()
-        self.lasers = LaserBatch()
+        self.lasers = LaserBatch(noise_key=int(self.rng.integers(2**63)))
         self.drives = DriveBatch()
         self.paused = False
         self.schedule = SensorSchedule()

@@ -13,7 +13,9 @@ the laser.
 
 from __future__ import annotations
 
+import zlib
 from dataclasses import dataclass
+from functools import partial
 
 import mujoco
 import numba
@@ -46,6 +48,7 @@ class _Layout:
     std: np.ndarray  # (R,) noise stddev of each beam, m
     beam_rmin: np.ndarray  # (R,)
     beam_rmax: np.ndarray  # (R,)
+    uid: np.ndarray  # (L,) uint64 each laser's noise stream (its namespace, topic and frame)
 
     @classmethod
     def of(cls, lasers: list) -> _Layout:
@@ -70,11 +73,19 @@ class _Layout:
             std=np.repeat([lz.noise_std for lz in lasers], nb),
             beam_rmin=np.repeat(rmin, nb),
             beam_rmax=np.repeat(rmax, nb),
+            uid=np.array([_uid(lz) for lz in lasers], np.uint64),
         )
 
 
+def _uid(laser) -> int:
+    """A laser's noise stream: stable across runs and respawns, unlike ``id``."""
+    name = f"{laser.ctx.namespace}|{laser.params.topicName}|{laser.frame_id}"
+    return zlib.crc32(name.encode())
+
+
 class LaserBatch:
-    def __init__(self) -> None:
+    def __init__(self, noise_key: int = 0) -> None:
+        self.noise_key = noise_key  # the world's laser noise, drawn once from its generator
         self.static_grid: raycast.PrimitiveGrid | None = None
         self.dynamic_ids = np.zeros(0, np.int64)
         self.occupancy = None
@@ -120,7 +131,14 @@ class LaserBatch:
         return centres, radii, ids, start, np.ascontiguousarray(prims)
 
     def measure(self, engine, lasers: list, t: float) -> list:
-        """Readings of ``lasers`` (``LaserPlugin``) from one batched cast."""
+        """Readings of ``lasers`` (``LaserPlugin``) at the current state, cast when read.
+
+        The sensors' poses and the movable bodies are taken now; each laser's beams are cast
+        the first time its ``ranges`` are read (``Sweep.ranges_of``), then kept. A reading no
+        one reads is never cast: a costmap that updates at 5 Hz reads one scan in eight of a
+        40 Hz laser and drops the rest unread. Noise is keyed by the laser, its scan count and
+        the beam (``scan_noise``), so a scan's ranges do not depend on which scans were
+        read or in what order."""
         key = ("laser", *map(id, lasers))
         lay = engine.layouts.get(key)
         if lay is None:
@@ -133,78 +151,135 @@ class LaserBatch:
         sign = np.where(np.einsum("nj,nj->n", R[:, 2, :], lay.zaxis) < 0, -1.0, 1.0)
         angle0 = np.arctan2(xaxis[:, 1], xaxis[:, 0]) + sign * lay.angle_min
         inc = sign * lay.inc
-        ranges = np.full(int(lay.nb.sum()), np.inf)
+        scans = np.empty(n, np.int64)
+        for k, lz in enumerate(lasers):
+            scans[k] = lz.scans_taken
+            lz.scans_taken += 1
+        sweep = Sweep(
+            self, lay, origins, angle0, inc, scans,
+            self.bodies(engine) if len(self.dynamic_ids) else None,
+        )  # fmt: skip
+        return [lz.reading(partial(sweep.ranges_of, k), t) for k, lz in enumerate(lasers)]
+
+
+_ZERO = np.zeros(1, np.int64)
+
+
+class Sweep:
+    """One batch of laser readings, taken at one instant and cast laser by laser when read.
+
+    Holds what the cast needs from that instant (origins, first-beam yaws, increments, the
+    movable bodies' primitives) and the world's static parts as they were bound then."""
+
+    def __init__(self, batch: LaserBatch, lay: _Layout, origins, angle0, inc, scans, bodies):
+        self.static_grid = batch.static_grid
+        self.occupancy, self.walls, self.wall_height = (
+            batch.occupancy,
+            batch.walls,
+            batch.wall_height,
+        )
+        self.noise_key = batch.noise_key
+        self.lay, self.origins, self.angle0, self.inc = lay, origins, angle0, inc
+        self.scans, self.bodies = scans, bodies
+
+    def ranges_of(self, k: int) -> np.ndarray:
+        """Laser ``k``'s ranges ((samples,) float32 m, noise applied), cast now."""
+        lay = self.lay
+        o, nb = int(lay.offsets[k]), int(lay.nb[k])
+        beams = slice(o, o + nb)
+        one = slice(k, k + 1)
+        ranges = np.full(nb, np.inf)
         if len(self.static_grid.prims):
-            which = np.repeat(np.arange(n), lay.nb)
-            beam = np.arange(len(ranges)) - lay.offsets[which]
             ranges = raycast.cast(
                 self.static_grid,
-                origins[which],
-                angle0[which] + beam * inc[which],
-                lay.beam_rmin,
-                lay.beam_rmax,
-                lay.owner[which],
+                np.repeat(self.origins[one], nb, axis=0),
+                self.angle0[k] + np.arange(nb) * self.inc[k],
+                lay.beam_rmin[beams],
+                lay.beam_rmax[beams],
+                lay.owner[k],
             )
         if self.occupancy is not None:
             g, wt = self.occupancy, self.walls
             occupancy_cast.ranges_from_walls(
-                origins, angle0, inc, lay.nb, lay.offsets, lay.rmin, lay.rmax,
-                wt.occupied, wt.boxes, wt.start, wt.items, wt.tile, wt.th, wt.tw,
-                g.origin[0], g.origin[1], g.resolution, self.wall_height, ranges,
+                self.origins[one], self.angle0[one], self.inc[one], lay.nb[one], _ZERO,
+                lay.rmin[one], lay.rmax[one], wt.occupied, wt.boxes, wt.start, wt.items, wt.tile,
+                wt.th, wt.tw, g.origin[0], g.origin[1], g.resolution, self.wall_height, ranges,
             )  # fmt: skip
-        if len(self.dynamic_ids):
-            centres, radii, ids, start, prims = self.bodies(engine)
+        if self.bodies is not None:
             raycast.ranges_with_bodies(
-                ranges, origins, angle0, inc, lay.nb, lay.offsets, lay.owner, lay.rmin,
-                lay.rmax, centres, radii, ids, start, prims,
+                ranges, self.origins[one], self.angle0[one], self.inc[one], lay.nb[one], _ZERO,
+                lay.owner[one], lay.rmin[one], lay.rmax[one], *self.bodies,
             )  # fmt: skip
-        # Gaussian noise on the beams that hit, drawn in laser order as the sensors would
-        z = engine.rng.standard_normal(noisy_hit_count(ranges, lay.noisy))
-        out = np.empty(len(ranges), np.float32)
-        noisy_ranges(ranges, lay.noisy, lay.mean, lay.std, lay.beam_rmin, lay.beam_rmax, z, out)
-        return [
-            lz.reading(out[o : o + k], t)
-            for lz, o, k in zip(lasers, lay.offsets.tolist(), lay.nb.tolist())
-        ]
+        out = np.empty(nb, np.float32)
+        if not lay.noisy[o]:
+            out[:] = ranges
+            return out
+        z = scan_noise(self.noise_key, int(lay.uid[k]), int(self.scans[k]), nb)
+        noisy_ranges(
+            ranges, lay.noisy[beams], lay.mean[beams], lay.std[beams], lay.beam_rmin[beams],
+            lay.beam_rmax[beams], z, out,
+        )  # fmt: skip
+        return out
+
+
+_M1, _M2 = np.uint64(0xBF58476D1CE4E5B9), np.uint64(0x94D049BB133111EB)
+_GOLDEN = np.uint64(0x9E3779B97F4A7C15)
+_S30, _S27, _S31, _S11 = np.uint64(30), np.uint64(27), np.uint64(31), np.uint64(11)
 
 
 @numba.njit(cache=True)
-def noisy_hit_count(ranges, noisy):
-    """How many beams get noise: those of noisy lasers that hit something (finite range).
+def _mix64(x):
+    """SplitMix64's finaliser: a bijective 64-bit hash whose output bits pass BigCrush."""
+    x = (x ^ (x >> _S30)) * _M1
+    x = (x ^ (x >> _S27)) * _M2
+    return x ^ (x >> _S31)
+
+
+@numba.njit(cache=True)
+def scan_noise(noise_key, uid, scan, n):
+    """``n`` standard normal draws for scan number ``scan`` of laser ``uid``, one per beam.
+
+    Counter-based: draw ``i`` is a function of (key, laser, scan, i) alone (SplitMix64 over
+    the counter, then Box-Muller), so a scan's noise is the same whichever scans were read
+    before it, or whether they were read at all. Written here rather than with NumPy's
+    counter-based ``Philox``: a Philox generator keyed per scan costs ~30 us to set up and
+    draw 720 normals, as much as casting the scan; this is a third of it.
 
     Parameters
     ----------
-    ranges : (R,) float64 m, inf where nothing is hit; noisy : (R,) bool.
+    noise_key, uid, scan : int, the world's noise key, the laser's id and its scan number.
+    n : int, draws (beams).
     """
-    n = 0
-    for i in range(ranges.shape[0]):
-        if noisy[i] and np.isfinite(ranges[i]):
-            n += 1
-    return n
+    base = _mix64(np.uint64(noise_key) ^ _mix64(np.uint64(uid) ^ _mix64(np.uint64(scan))))
+    z = np.empty(n)
+    for i in range(n):
+        c = base + np.uint64(2 * i) * _GOLDEN
+        u1 = (float(_mix64(c) >> _S11) + 0.5) * 2.0**-53  # (0, 1)
+        u2 = float(_mix64(c + _GOLDEN) >> _S11) * 2.0**-53  # [0, 1)
+        z[i] = np.sqrt(-2.0 * np.log(u1)) * np.cos(2.0 * np.pi * u2)
+    return z
 
 
 @numba.njit(cache=True)
 def noisy_ranges(ranges, noisy, mean, std, rmin, rmax, z, out):
     """Ranges with Gaussian noise on the beams that hit, as float32, into ``out``.
 
-    The ``k``-th noisy beam that hits (in beam order) gets ``(range + mean) + std z[k]``
-    clipped to its laser's ``[rmin, rmax]``, in float64 and in that order, then rounded to
-    float32: bit for bit what ``np.clip(r[hit] + mean[hit] + std[hit] * z, rmin[hit],
+    Beam ``i`` of a noisy laser that hits gets ``(range + mean) + std z[i]`` clipped to its
+    laser's ``[rmin, rmax]``, in float64 and in that order, then rounded to float32: bit for
+    bit what ``np.clip(r[hit] + mean[hit] + std[hit] * z[hit], rmin[hit],
     rmax[hit]).astype(np.float32)`` gives, in one pass instead of seven array operations.
 
     Parameters
     ----------
     ranges : (R,) float64 m, inf where nothing is hit; noisy : (R,) bool.
     mean, std, rmin, rmax : (R,) float64 m, per beam (its laser's).
-    z : (noisy_hit_count(ranges, noisy),) float64 standard normal draws.
+    z : (R,) float64 standard normal draws, one per beam (those that miss are unused).
     out : (R,) float32 m.
     """
-    k = 0
     for i in range(ranges.shape[0]):
         r = ranges[i]
         if noisy[i] and np.isfinite(r):
-            v = (r + mean[i]) + std[i] * z[k]
-            k += 1
+            v = (r + mean[i]) + std[i] * z[i]
             out[i] = min(max(v, rmin[i]), rmax[i])
         else:
             out[i] = r

@@ -74,12 +74,65 @@ def odometry_tf(r: OdometryReading) -> geometry_msgs.TransformStamped:
     )
 
 
+_RANGES = sensor_msgs.LaserScan.__dict__["ranges"]  # the slot the dataclass keeps them in
+_NOT_CAST = np.zeros(0, np.float32)
+
+
+class LazyLaserScan(sensor_msgs.LaserScan):
+    """A ``sensor_msgs/msg/LaserScan`` whose ranges are cast when first read.
+
+    A laser publishes at its rate whoever reads, but most readers take one scan in several (a
+    costmap updating at 5 Hz keeps the newest of a 40 Hz laser's scans): the beams of the
+    others need not be cast at all. To a reader this is the LaserScan it stands for: topics
+    take it for one (``__lazy_of__``), it serializes as one and compares equal to one with the
+    same fields; reading ``ranges`` casts them once (see ``fleetsim.sim.lasers.Sweep``)."""
+
+    __slots__ = ("_reading",)
+    __lazy_of__ = sensor_msgs.LaserScan
+
+    @property
+    def ranges(self) -> np.ndarray:
+        reading = getattr(self, "_reading", None)
+        if reading is not None:
+            self._reading = None
+            _RANGES.__set__(self, reading.ranges)
+        return _RANGES.__get__(self)
+
+    @ranges.setter
+    def ranges(self, value: np.ndarray) -> None:
+        self._reading = None
+        _RANGES.__set__(self, value)
+
+    def __eq__(self, other: object) -> bool:
+        if not isinstance(other, sensor_msgs.LaserScan):
+            return NotImplemented
+        names = [f for f, _ in sensor_msgs.LaserScan.__msgfields__]
+        return all(_same(getattr(self, f), getattr(other, f)) for f in names)
+
+    __hash__ = None  # type: ignore[assignment]  # mutable, as the dataclass it stands for
+
+
+def _same(a, b) -> bool:
+    if isinstance(a, np.ndarray) or isinstance(b, np.ndarray):
+        return bool(np.array_equal(a, b))
+    return a == b
+
+
 def scan_msg(r: ScanReading) -> sensor_msgs.LaserScan:
-    return _LaserScan(
+    """The reading as a LaserScan; a lazy one (``LazyLaserScan``) while its ranges are not cast."""
+    if r.cast:
+        return _LaserScan(
+            _Header(stamp(r.stamp), r.frame_id),
+            r.angle_min, r.angle_max, r.angle_increment, r.time_increment, r.scan_time,
+            r.range_min, r.range_max, r.ranges, r.intensities,
+        )  # fmt: skip
+    msg = LazyLaserScan(
         _Header(stamp(r.stamp), r.frame_id),
         r.angle_min, r.angle_max, r.angle_increment, r.time_increment, r.scan_time,
-        r.range_min, r.range_max, r.ranges, r.intensities,
+        r.range_min, r.range_max, _NOT_CAST, r.intensities,
     )  # fmt: skip
+    msg._reading = r
+    return msg
 
 
 def image_msg(t: float, frame_id: str, img: np.ndarray, encoding: str) -> sensor_msgs.Image:

@@ -100,7 +100,7 @@ class ToolPublisher:
 
         if self._pub is None:
             raise GraphError(f"publisher of {self.name} is closed")
-        if type(msg) is not self.type:
+        if type(msg) is not self.type and getattr(type(msg), "__lazy_of__", None) is not self.type:
             raise GraphError(f"{self.name} carries {self.type.__msgtype__}, not {type(msg)}")
         self._pub.put(serialize(msg), attachment=self._att)
 

@@ -25,6 +25,7 @@ import dataclasses
 import logging
 import typing
 from abc import ABC, abstractmethod
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, ClassVar
 
@@ -227,9 +228,22 @@ class ScanReading:
     scan_time: float
     range_min: float
     range_max: float
-    ranges: np.ndarray  # (N,) float32 m, inf where nothing is hit
+    # (N,) float32 m, inf where nothing is hit; or a function giving them, called when the
+    # ranges are first read (the laser batch casts a reading only when someone reads it)
+    source: np.ndarray | Callable[[], np.ndarray]
     intensities: np.ndarray = field(default_factory=lambda: np.zeros(0, np.float32))
     namespace: str = "/"  # ROS namespace the topic resolves in (set by the engine)
+
+    @property
+    def ranges(self) -> np.ndarray:
+        if callable(self.source):
+            self.source = self.source()
+        return self.source
+
+    @property
+    def cast(self) -> bool:
+        """Whether the ranges exist yet (read, or given as an array)."""
+        return not callable(self.source)
 
 
 @dataclass

@@ -10,6 +10,7 @@ as gazebo_ros_laser activates its sensor on the first connection.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import mujoco
@@ -112,8 +113,11 @@ class LaserPlugin(SensorPlugin):
         origin, a0, inc, owner = self.pose(engine)
         return np.tile(origin, (self.samples, 1)), a0 + inc * np.arange(self.samples), owner
 
-    def reading(self, ranges: np.ndarray, t: float) -> ScanReading:
-        """A scan of ``ranges`` ((samples,) float32 m, noise already applied by the batch)."""
+    scans_taken = 0  # readings taken so far: each one's noise has its own stream
+
+    def reading(self, ranges: np.ndarray | Callable[[], np.ndarray], t: float) -> ScanReading:
+        """A scan of ``ranges`` ((samples,) float32 m, noise already applied by the batch), or
+        of the function that casts them when they are first read."""
         return ScanReading(
             t,
             self.params.topicName,

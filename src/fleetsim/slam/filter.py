@@ -113,6 +113,7 @@ class GmappingFilter:
                 self.maps.pool, self.maps.table, self.poses, self.laser, ranges, angles,
                 self.maps.geom, p.kernelSize, p.sigma, p.lsigma, p.lskip, p.lstep, p.astep,
                 p.iterations, p.minimumScore, self.reach, p.climb_skip,
+                p.degeneracy_threshold if p.continuous_score else 0.0,
             )  # fmt: skip
             self.weights += likes
             self.weight_sums += likes

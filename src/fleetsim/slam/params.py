@@ -113,6 +113,15 @@ class GmappingParams:
         range=(0.0, None),
         help="added to peer_radius for the error of the two robots' pose estimates",
     )
+    degeneracy_threshold: float = param(
+        0.0,
+        range=(0.0, None),
+        help="fleetsim addition, with continuous_score: a direction of the match's translation "
+        "on which the scan gives less information than this (in beams' worth of a hit on a "
+        "wall square to it) keeps the motion model's sampled pose, as along a single wall in "
+        "range, where the climber drifts (0: off, gmapping's matcher; see "
+        "fleetsim.slam.scan_align.constrained_pose)",
+    )
     # --- motion model ---
     srr: float = param(0.1, range=(0.0, None), help="translation noise from translation")
     srt: float = param(0.2, range=(0.0, None), help="rotation noise from translation")

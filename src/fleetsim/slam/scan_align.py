@@ -54,23 +54,10 @@ def laser_origin(x, y, th, laser):
 
 
 @numba.njit(cache=True, fastmath=True, error_model="numpy")
-def aligned_pose(pool, table, p, pose, laser, ex, ey, geom, kernel, sigma, reach):
-    """One damped Gauss-Newton step of particle p's base pose (point-to-line, see the module).
-
-    Parameters
-    ----------
-    pool, table : the particles' hit maps (see `fleetsim.slam.scan_match`); p : the particle.
-    pose : (3,) base pose in the map frame (m, m, rad).
-    laser : (3,) laser in the base frame; ex, ey : (B,) beam endpoints in the laser frame (m).
-    geom : (origin x, origin y, delta) of the map (m, m, m/cell).
-    kernel : cells searched round an endpoint's cell; sigma : m^2; reach : the continuous
-        score's cap (m), > 0.
-
-    Returns
-    -------
-    new : (3,) the pose after the step (``pose`` when no beam has a hit within ``reach``);
-    score : the continuous score at ``pose`` (not at ``new``).
-    """
+def _normal_equations(pool, table, p, pose, laser, ex, ey, geom, kernel, sigma, reach):
+    """The point-to-line fit's normal equations of particle p at ``pose`` (arguments as
+    `aligned_pose`): ``(h00, h01, h02, h11, h12, h22, g0, g1, g2, score)``, H symmetric over
+    (x, y, yaw), g the gradient, score the continuous score at ``pose``."""
     ox, oy, delta = geom[0], geom[1], geom[2]
     inv = 1.0 / delta
     lx, ly, lt = laser_origin(pose[0], pose[1], pose[2], laser)
@@ -142,6 +129,30 @@ def aligned_pose(pool, table, p, pose, laser, ex, ey, geom, kernel, sigma, reach
             g0 += w * rx
             g1 += w * ry
             g2 += w * (ax * rx + ay * ry)
+    return h00, h01, h02, h11, h12, h22, g0, g1, g2, score
+
+
+@numba.njit(cache=True, fastmath=True, error_model="numpy")
+def aligned_pose(pool, table, p, pose, laser, ex, ey, geom, kernel, sigma, reach):
+    """One damped Gauss-Newton step of particle p's base pose (point-to-line, see the module).
+
+    Parameters
+    ----------
+    pool, table : the particles' hit maps (see `fleetsim.slam.scan_match`); p : the particle.
+    pose : (3,) base pose in the map frame (m, m, rad).
+    laser : (3,) laser in the base frame; ex, ey : (B,) beam endpoints in the laser frame (m).
+    geom : (origin x, origin y, delta) of the map (m, m, m/cell).
+    kernel : cells searched round an endpoint's cell; sigma : m^2; reach : the continuous
+        score's cap (m), > 0.
+
+    Returns
+    -------
+    new : (3,) the pose after the step (``pose`` when no beam has a hit within ``reach``);
+    score : the continuous score at ``pose`` (not at ``new``).
+    """
+    h00, h01, h02, h11, h12, h22, g0, g1, g2, score = _normal_equations(
+        pool, table, p, pose, laser, ex, ey, geom, kernel, sigma, reach
+    )
     new = pose.copy()
     lam = DAMPING * (h00 + h11 + h22)
     a00, a11, a22 = h00 + lam, h11 + lam, h22 + lam
@@ -173,3 +184,49 @@ def refined_pose(pool, table, p, pose, laser, ex, ey, geom, kernel, sigma, reach
     if math.hypot(cur[0] - pose[0], cur[1] - pose[1]) > lstep or abs(cur[2] - pose[2]) > astep:
         return pose.copy()
     return cur
+
+
+@numba.njit(cache=True)
+def constrained_pose(
+    pool, table, p, pose, sampled, laser, ex, ey, geom, kernel, sigma, reach, threshold
+):  # fmt: skip
+    """(3,) the matched ``pose`` with its translation from ``sampled`` (the particle's pose
+    from the motion model) kept only along the directions the scan constrains.
+
+    The information the fit has on the translation, with the yaw free (the Schur complement of
+    the normal matrix's yaw block, in beams' worth of a fully weighted hit on a wall square to
+    the move), is checked along its two principal directions; along one with less than
+    ``threshold`` the scan cannot tell where the robot is (a single wall in range, a corridor
+    with its ends out of range), the score is flat but for the ends of what the map holds of
+    the walls and the cells' noise, and the climber drifts along it. There the sampled pose is
+    kept, as the motion model put it (solution remapping, Zhang, Kaess and Singh, "On
+    degeneracy of optimization-based state estimation problems", ICRA 2016).
+    """
+    h00, h01, h02, h11, h12, h22, _, _, _, _ = _normal_equations(
+        pool, table, p, pose, laser, ex, ey, geom, kernel, sigma, reach
+    )
+    s00, s01, s11 = h00, h01, h11
+    if h22 > 0.0:
+        s00 -= h02 * h02 / h22
+        s01 -= h02 * h12 / h22
+        s11 -= h12 * h12 / h22
+    half = math.sqrt(0.25 * (s00 - s11) ** 2 + s01 * s01)
+    small, large = 0.5 * (s00 + s11) - half, 0.5 * (s00 + s11) + half
+    out = pose.copy()
+    if small >= threshold:
+        return out
+    if large < threshold:  # nothing in range constrains it: the motion model's translation
+        out[0], out[1] = sampled[0], sampled[1]
+        return out
+    # the eigenvector of the small eigenvalue: from the matrix row with the larger entries
+    vx, vy = s01, small - s00
+    if abs(s00 - small) < abs(s11 - small):
+        vx, vy = small - s11, s01
+    norm = math.hypot(vx, vy)
+    if norm == 0.0:
+        return out
+    vx, vy = vx / norm, vy / norm
+    along = (pose[0] - sampled[0]) * vx + (pose[1] - sampled[1]) * vy
+    out[0] -= along * vx
+    out[1] -= along * vy
+    return out

@@ -71,7 +71,7 @@ import math
 import numba
 import numpy as np
 
-from .scan_align import laser_origin, refined_pose
+from .scan_align import constrained_pose, laser_origin, refined_pose
 from .tiles import FAR, writable_tile
 from .tiles import MASK as _MASK
 from .tiles import SHIFT as _SHIFT
@@ -182,7 +182,7 @@ def _moved(pose, move, ld, ad, out):
 @numba.njit(cache=True)
 def matched_poses(
     pool, table, poses, laser, ranges, angles, geom, kernel, sigma, lsigma, skip,
-    lstep, astep, iterations, minimum_score, reach=0.0, climb_skip=0,
+    lstep, astep, iterations, minimum_score, reach=0.0, climb_skip=0, constrained=0.0,
 ):  # fmt: skip
     """Hill-climbed poses, scores and log-likelihoods of every particle (``ScanMatcher::optimize``
     then ``likelihoodAndScore``).
@@ -200,6 +200,9 @@ def matched_poses(
         leaves, and its pose is then refined on all of those by Gauss-Newton steps
         (`fleetsim.slam.scan_align`) instead of the parabola; the score is the continuous
         score at the refined pose.
+    constrained : with ``reach > 0``, > 0: the matched translation is kept only along the
+        directions on which the scan gives at least this much information, the sampled pose
+        along the others (`fleetsim.slam.scan_align.constrained_pose`); 0: off (gmapping).
 
     Returns
     -------
@@ -261,6 +264,11 @@ def matched_poses(
                 pool, table, p, cur, laser, used_x, used_y, geom, kernel, sigma, reach, lstep,
                 astep,
             )  # fmt: skip
+            if constrained > 0.0:
+                cur = constrained_pose(
+                    pool, table, p, cur, poses[p], laser, used_x, used_y, geom, kernel, sigma,
+                    reach, constrained,
+                )  # fmt: skip
             # score and likelihood of every used beam in one pass
             best_score, like = _match(
                 pool, table, p, cur, laser, ex, ey, geom, kernel, sigma, lsigma, skip, reach, True
@@ -277,6 +285,11 @@ def matched_poses(
                 out[p, 0] += _vertex(move_scores[1], best_score, move_scores[0], ld)
                 out[p, 1] += _vertex(move_scores[2], best_score, move_scores[3], ld)
                 out[p, 2] += _vertex(move_scores[5], best_score, move_scores[4], ad)
+                if constrained > 0.0:
+                    out[p] = constrained_pose(
+                        pool, table, p, out[p], poses[p], laser, used_x, used_y, geom, kernel,
+                        sigma, reach, constrained,
+                    )  # fmt: skip
         scores[p] = best_score
         _, likes[p] = _match(
             pool,

@@ -96,6 +96,15 @@ class GmappingParams:
         "every beam all the way and the parabola, gmapping's climber; see "
         "fleetsim.slam.scan_match and fleetsim.slam.scan_align)",
     )
+    degeneracy_threshold: float = param(
+        0.0,
+        range=(0.0, None),
+        help="fleetsim addition, with continuous_score: a direction of the match's translation "
+        "on which the scan gives less information than this (in beams' worth of a hit on a "
+        "wall square to it) keeps the motion model's sampled pose, as along a single wall in "
+        "range, where the climber drifts (0: off, gmapping's matcher; see "
+        "fleetsim.slam.scan_align.constrained_pose)",
+    )
     # --- peers (fleetsim addition; see fleetsim.slam.peers) ---
     peer_frames: list = param(
         [],
@@ -112,15 +121,6 @@ class GmappingParams:
         unit="m",
         range=(0.0, None),
         help="added to peer_radius for the error of the two robots' pose estimates",
-    )
-    degeneracy_threshold: float = param(
-        0.0,
-        range=(0.0, None),
-        help="fleetsim addition, with continuous_score: a direction of the match's translation "
-        "on which the scan gives less information than this (in beams' worth of a hit on a "
-        "wall square to it) keeps the motion model's sampled pose, as along a single wall in "
-        "range, where the climber drifts (0: off, gmapping's matcher; see "
-        "fleetsim.slam.scan_align.constrained_pose)",
     )
     # --- motion model ---
     srr: float = param(0.1, range=(0.0, None), help="translation noise from translation")

@@ -15,6 +15,10 @@ Frames get the robot's ``tf_prefix``, the map frame too (gmapping resolves all t
 robots in namespaces map on their own (``lizi1/map``). Bad input is reported naming the topic
 and frame: a scan whose beam count changes is dropped with an error, a laser that is not level
 is refused, an upside-down one is mirrored with a warning, missing odometry tf is warned about.
+
+With ``peer_frames`` (a fleetsim addition) the beams that end on another robot, found through
+tf, are left out of matching and mapping (`fleetsim.slam.peers`); a scan waits briefly for a
+peer's tf, and a peer missing from it is warned about once, naming its frame.
 """
 
 from __future__ import annotations

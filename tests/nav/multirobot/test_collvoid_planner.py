@@ -199,6 +199,26 @@ def test_detour_velocity_takes_the_tangent_on_the_side_the_ray_leans_to():
         assert k == -1 and v is pref
 
 
+def test_detour_velocity_keeps_the_side_taken_and_starts_on_the_side_it_is_heading_for():
+    """willow_swap: lizi1, under way east-south-east, met lizi3 parked on its plan's far side;
+    the tangent nearest the carrot made it turn 1.5-2 rad on the spot to go round on the plan's
+    side (2-3 s for a lizi), and a carrot swinging from one side to the other flipped it."""
+    pref = np.array([0.5, 0.0])
+    ahead = np.array([[1.0, 0.05]])  # leans left: the right tangent is nearest pref
+    v, _ = detour_velocity(pref, ahead, np.array([0.6]), 1.5, keep=np.array([1]))
+    assert v[1] > 0  # the left side, kept
+    v, _ = detour_velocity(pref, ahead, np.array([0.6]), 1.5, keep=np.array([-1]))
+    assert v[1] < 0
+    shut = np.array([[False, True]])  # the kept side closed by a wall: the other one
+    v, _ = detour_velocity(pref, ahead, np.array([0.6]), 1.5, shut, keep=np.array([1]))
+    assert v[1] < 0
+    # under way north-east: the left tangent first; standing (or creeping): nearest pref
+    v, _ = detour_velocity(pref, ahead, np.array([0.6]), 1.5, moving=np.array([0.3, 0.3]))
+    assert v[1] > 0
+    v, _ = detour_velocity(pref, ahead, np.array([0.6]), 1.5, moving=np.array([0.05, 0.05]))
+    assert v[1] < 0
+
+
 def make_rule(robot_id: str, **params) -> DeadlockRule:
     """A deadlock rule with the planner's parameter defaults, ``params`` changed."""
     return DeadlockRule.from_params(robot_id, dataclasses.replace(CollvoidParams(), **params))

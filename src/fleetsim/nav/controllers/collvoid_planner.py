@@ -158,6 +158,8 @@ class CollvoidLocalPlanner(CollvoidDrive, CollvoidHold, LocalPlanner):
         self.retreat = Retreat()  # the way back and the refuge of a yield
         self.lines = (np.zeros((0, 2)), np.zeros((0, 2)), 0)  # this cycle's half-planes
         self.feasible = True
+        #: robot id -> the side (0 right, 1 left) a robot standing in the way is gone round on
+        self.detour_sides: dict[str, int] = {}
         self._start_hold()
 
     @classmethod
@@ -183,6 +185,7 @@ class CollvoidLocalPlanner(CollvoidDrive, CollvoidHold, LocalPlanner):
             self.reached_goal = False
             self.xy_tolerance_latch = False
         if shift > SAME_GOAL_SHIFT:
+            self.detour_sides.clear()
             self.deadlock.reset(self.node.now())
             self.retreat.reset()
             self.escape_from = None
@@ -292,7 +295,7 @@ class CollvoidLocalPlanner(CollvoidDrive, CollvoidHold, LocalPlanner):
             near_goal = remaining < KEEP_RIGHT_UNTIL
             if not near_goal and self._oncoming(pos - xy, nvel, vel, pref, dist, remaining).any():
                 pref = rotated(pref, p.left_pref)
-            pref = self._around_still(pref, xy, pos - xy, nvel, own_r + radii, controlled)
+            pref = self._around_still(pref, xy, vel, pos - xy, nvel, own_r + radii, controlled, ids)
         return self._orca(xy, vel, pref, pos - xy, nvel, own_r + radii, resp)
 
     def _orca(self, xy, vel, pref, rel, nvel, radii, resp) -> np.ndarray:
@@ -372,10 +375,11 @@ class CollvoidLocalPlanner(CollvoidDrive, CollvoidHold, LocalPlanner):
         decel = DECELERATION * p.acc_lim_x
         return self.retreat.velocity(self.costmap, xy, own_r, other_r, p.max_vel_x, decel)
 
-    def _around_still(self, pref, xy, rel, nvel, radii, controlled) -> np.ndarray:
+    def _around_still(self, pref, xy, vel, rel, nvel, radii, controlled, ids) -> np.ndarray:
         """``pref`` turned round the nearest robot standing in its way (`detour_velocity`) on a
         side a wall leaves room on (`gaps_closed`), unless that robot stands on the goal (then
-        ORCA stops us short of it)."""
+        ORCA stops us short of it); a robot once gone round on one side is kept on that side
+        while it is within reach (`detour_sides`)."""
         still = (np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED) | ~controlled
         if not still.any():
             return pref
@@ -387,7 +391,15 @@ class CollvoidLocalPlanner(CollvoidDrive, CollvoidHold, LocalPlanner):
         cm = self.costmap
         grid = (cm.costs, (cm.origin_x, cm.origin_y), cm.resolution)
         closed = gaps_closed(grid, xy, rel[idx], r, self.body_radius + cm.resolution * 0.71)
-        out, _ = detour_velocity(pref, rel[idx], r, DETOUR_REACH, closed)
+        near = [ids[k] for k in idx]
+        sides = self.detour_sides
+        for k in [k for k in sides if k not in near]:
+            del sides[k]
+        keep = np.array([sides.get(k, -1) for k in near], dtype=int)
+        out, k = detour_velocity(pref, rel[idx], r, DETOUR_REACH, closed, keep, vel)
+        if k >= 0:
+            bearing = rel[idx[k]]
+            sides[near[k]] = int(bearing[0] * out[1] - bearing[1] * out[0] > 0.0)
         return out
 
     @staticmethod

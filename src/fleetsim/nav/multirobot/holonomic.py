@@ -25,6 +25,9 @@ import numpy as np
 from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
 from fleetsim.nav.multirobot.yielding import clear_distance
 
+#: m/s: a robot faster than this goes round a disc on the tangent nearest its direction
+MOVING_SPEED = 0.1
+
 
 def plan_carrot(
     plan_xy: np.ndarray, xy: np.ndarray, lookahead: float
@@ -79,6 +82,8 @@ def detour_velocity(
     radii: np.ndarray,
     reach: float,
     closed: np.ndarray | None = None,
+    keep: np.ndarray | None = None,
+    moving: np.ndarray | None = None,
 ) -> tuple[np.ndarray, int]:
     """``pref`` turned to the nearest heading whose ray is clear of every disc within ``reach``.
 
@@ -92,7 +97,13 @@ def detour_velocity(
     pref : (2,) m/s; rel_pos : (N, 2) disc centres relative to the robot, m; radii : (N,) m
     (combined: own + theirs + margin); closed : (N, 2) bool or None, the way past each disc on
     its right, on its left (as seen from the robot) shut by a wall (`gaps_closed`): that
-    tangent is no candidate. Returns (the velocity (2,) m/s, same speed; the index of the disc
+    tangent is no candidate; keep : (N,) int or None, the side the robot already goes round
+    each disc on (0: its right tangent, 1: its left, -1: none): the other side's tangent is
+    no candidate while one on the kept side is clear (else the robot, drawn by a carrot on
+    the other side, turns back and forth in front of the disc); moving : (2,) m/s or None,
+    the robot's velocity: the tangents are tried nearest its direction first (a differential
+    drive already under way turns least; the tangents nearest ``pref`` when it stands).
+    Returns (the velocity (2,) m/s, same speed; the index of the disc
     whose tangent it follows, or -1 when ``pref`` is clear or no heading is).
     """
     speed = float(np.hypot(*pref))
@@ -105,13 +116,23 @@ def detour_velocity(
     bearing = np.arctan2(rel_pos[:, 1], rel_pos[:, 0])
     half = np.arcsin(np.clip(radii / np.maximum(d, 1e-9), 0.0, 1.0)) + 1e-3
     heading = np.concatenate([bearing - half, bearing + half])  # right tangents, then left
-    turn = np.remainder(heading - math.atan2(u[1], u[0]) + math.pi, 2 * math.pi) - math.pi
+    ref = u
+    if moving is not None and float(np.hypot(*moving)) > MOVING_SPEED:
+        ref = np.asarray(moving, dtype=np.float64)
+    turn = np.remainder(heading - math.atan2(ref[1], ref[0]) + math.pi, 2 * math.pi) - math.pi
     order = np.argsort(np.abs(turn) + 1e-6 * (turn > 0), kind="stable")
     dirs = np.stack([np.cos(heading[order]), np.sin(heading[order])], axis=1)
     free = ~rays_blocked(dirs, rel_pos, radii, reach)
     if closed is not None:
         shut = np.concatenate([closed[:, 0], closed[:, 1]])  # right tangents, then left
         free &= ~shut[order]
+    if keep is not None:
+        n = rel_pos.shape[0]
+        side = (order >= n).astype(int)
+        committed = np.asarray(keep)[order % n]
+        kept = free & ((committed < 0) | (side == committed))
+        if kept.any():
+            free = kept
     if not free.any():
         return pref, -1
     first = int(np.argmax(free))

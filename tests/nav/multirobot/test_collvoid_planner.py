@@ -165,7 +165,7 @@ def test_robots_parked_in_the_way_are_gone_round(detour, monkeypatch):
     gap and stops it there; the preferred velocity turned onto the nearest clear tangent takes
     it round on the left."""
     if not detour:
-        monkeypatch.setattr("fleetsim.nav.controllers.collvoid_planner.DETOUR_REACH", 0.0)
+        monkeypatch.setattr("fleetsim.nav.controllers.collvoid_preference.DETOUR_REACH", 0.0)
     parked = [(0.0, 0.0, math.pi / 2), (0.0, -0.62, math.pi / 2)]
     f = Fleet([(-3, 0, 0), *parked], [(3, 0, 0), *parked])
     assert f.run(30.0) is detour

@@ -32,7 +32,13 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    (`fleetsim.nav.multirobot.footprint_check`: collvoid checks static obstacles with the
    footprint, base_local_planner-style, and keeps its velocity obstacles for the robots);
 6. within ``xy_goal_tolerance`` the robot stops and turns in place to the goal yaw, as
-   base_local_planner does.
+   base_local_planner does (at ``max_vel_theta``, slowed only to stop on the yaw);
+7. with ``active_collision_avoidance``, once the goal is reached the robot keeps running ORCA
+   towards where it stopped, along its heading (`collvoid_hold`, collvoid's standalone mode).
+
+The rules that shape the preferred velocity around other robots (keeping right, going round
+robots standing in the way on the side the robot heads for and keeping that side, yielding)
+are in `collvoid_preference`; the base's command in `collvoid_drive`.
 
 Neighbours arrive in the ``map`` frame; the local costmap's frame (often ``odom``) is reached
 through tf. Only ORCA is available: ``clearpath: true`` or ``orca: false`` is an error, and
@@ -53,11 +59,15 @@ from fleetsim.nav.controllers.base import EmptyPlan, LocalPlanner, VelocityComma
 from fleetsim.nav.controllers.collvoid_drive import UNTRUNCATED, CollvoidDrive
 from fleetsim.nav.controllers.collvoid_hold import CollvoidHold
 from fleetsim.nav.controllers.collvoid_params import CollvoidParams
+from fleetsim.nav.controllers.collvoid_preference import (
+    DECELERATION,
+    KEEP_RIGHT_UNTIL,
+    STILL_SPEED,
+    CollvoidPreference,
+)
 from fleetsim.nav.costmap.footprint import footprint_radii, outline_points
 from fleetsim.nav.multirobot.deadlock import DeadlockRule
 from fleetsim.nav.multirobot.holonomic import (
-    detour_velocity,
-    gaps_closed,
     obstacle_points,
     plan_carrot,
     preferred_velocity,
@@ -66,25 +76,13 @@ from fleetsim.nav.multirobot.holonomic import (
 from fleetsim.nav.multirobot.orca import orca_halfplanes, orca_velocity
 from fleetsim.nav.multirobot.position_share import PositionShare
 from fleetsim.nav.multirobot.uncertainty import uncertainty_radius
-from fleetsim.nav.multirobot.yielding import Retreat, has_passed, narrow_meetings
+from fleetsim.nav.multirobot.yielding import Retreat, narrow_meetings
 from fleetsim.runtime import load_params
 
 _log = logging.getLogger("fleetsim.nav.collvoid")
 MAP_FRAME = "map"
-#: m/s: a neighbour slower than this is treated as standing still (full responsibility)
-STILL_SPEED = 0.02
 #: bearing sectors for static obstacle points
 OBSTACLE_SECTORS = 24
-#: share of acc_lim_x used to slow down towards the goal
-DECELERATION = 0.25
-#: m added to the combined radius of a robot standing in the way when going round it
-DETOUR_MARGIN = 0.05
-#: m: a robot standing in the way nearer than this is gone round
-DETOUR_REACH = 1.0
-#: m: closer to the goal than this, no more keeping right (it only pushed arriving robots off
-#: their goal, to come back to it from the side and turn there); circle of 16, seeds 0-4: 1.5 m
-#: 21.0 / 24.0 s mean / max makespan, 1.0 m 20.3 / 23.6 s, 2.5 m 24.7 / 28.4 s
-KEEP_RIGHT_UNTIL = 1.0
 #: share of the preferred speed under which the walls block the circumscribed disc (then the
 #: inscribed disc steers and the footprint keeps off the walls, `_wall_halfplanes`)
 WALLS_BLOCK = 0.25
@@ -95,7 +93,7 @@ WALLS_BLOCK = 0.25
 SAME_GOAL_SHIFT = 0.5
 
 
-class CollvoidLocalPlanner(CollvoidDrive, CollvoidHold, LocalPlanner):
+class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, CollvoidHold, LocalPlanner):
     """ORCA among the robots on /position_share, for one move_base (see the module doc)."""
 
     Params = CollvoidParams
@@ -362,52 +360,3 @@ class CollvoidLocalPlanner(CollvoidDrive, CollvoidHold, LocalPlanner):
             rel, np.broadcast_to(vel, rel.shape), np.full(n, self.wall_radius + cell_r),
             vel, self.horizon_obst, self.dt, 1.0,
         )  # fmt: skip
-
-    def _yield_velocity(self, xy, to_goal, other, own_r, other_r, remaining, pref):
-        """Yielding (`fleetsim.nav.multirobot.yielding`): to the refuge back along the plan,
-        then wait there; the yield ends (``pref`` again) as soon as the other robot is level
-        with us (beside us in the refuge, out of the passage; ORCA keeps us apart from there)."""
-        p, now = self.params, self.node.now()
-        if has_passed(other - xy, to_goal, 0.0):
-            self.deadlock.release(now, remaining)
-            self.yielding_to = None
-            return pref
-        decel = DECELERATION * p.acc_lim_x
-        return self.retreat.velocity(self.costmap, xy, own_r, other_r, p.max_vel_x, decel)
-
-    def _around_still(self, pref, xy, vel, rel, nvel, radii, controlled, ids) -> np.ndarray:
-        """``pref`` turned round the nearest robot standing in its way (`detour_velocity`) on a
-        side a wall leaves room on (`gaps_closed`), unless that robot stands on the goal (then
-        ORCA stops us short of it); a robot once gone round on one side is kept on that side
-        while it is within reach (`detour_sides`)."""
-        still = (np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED) | ~controlled
-        if not still.any():
-            return pref
-        r = radii[still] + DETOUR_MARGIN
-        to_goal = self.plan[-1, :2] - xy
-        free = np.hypot(*(rel[still] - to_goal).T) > r
-        idx = np.flatnonzero(still)[free]
-        r = radii[idx] + DETOUR_MARGIN
-        cm = self.costmap
-        grid = (cm.costs, (cm.origin_x, cm.origin_y), cm.resolution)
-        closed = gaps_closed(grid, xy, rel[idx], r, self.body_radius + cm.resolution * 0.71)
-        near = [ids[k] for k in idx]
-        sides = self.detour_sides
-        for k in [k for k in sides if k not in near]:
-            del sides[k]
-        keep = np.array([sides.get(k, -1) for k in near], dtype=int)
-        out, k = detour_velocity(pref, rel[idx], r, DETOUR_REACH, closed, keep, vel)
-        if k >= 0:
-            bearing = rel[idx[k]]
-            sides[near[k]] = int(bearing[0] * out[1] - bearing[1] * out[0] > 0.0)
-        return out
-
-    @staticmethod
-    def _oncoming(rel, nvel, vel, pref, dist, reach) -> np.ndarray:
-        """(N,) robots ahead (along ``pref``), nearer than ``reach`` m, moving and closing in:
-        the meetings keeping right resolves (a robot standing still ahead is gone round,
-        `_around_still`)."""
-        rel_vel = nvel - vel
-        moving = np.hypot(nvel[:, 0], nvel[:, 1]) >= STILL_SPEED
-        closing = np.einsum("ij,ij->i", rel, rel_vel) < 0.0
-        return (rel @ pref > 0) & (dist < reach) & moving & closing

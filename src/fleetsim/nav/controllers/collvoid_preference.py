@@ -1,0 +1,81 @@
+"""The preferred velocity's rules around other robots, for ``CollvoidLocalPlanner``: keeping
+right in a meeting (`_oncoming`), going round robots that stand in the way (`_around_still`)
+and the velocity of a robot that yields (`_yield_velocity`).
+
+`CollvoidPreference` is mixed into the planner, which owns the state it reads (``params``,
+``node``, ``plan``, ``costmap``, ``body_radius``, ``deadlock``, ``retreat``, ``yielding_to``,
+``detour_sides``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from fleetsim.nav.multirobot.holonomic import detour_velocity, gaps_closed
+from fleetsim.nav.multirobot.yielding import has_passed
+
+#: m/s: a neighbour slower than this is treated as standing still (full responsibility)
+STILL_SPEED = 0.02
+#: share of acc_lim_x used to slow down towards the goal
+DECELERATION = 0.25
+#: m added to the combined radius of a robot standing in the way when going round it
+DETOUR_MARGIN = 0.05
+#: m: a robot standing in the way nearer than this is gone round
+DETOUR_REACH = 1.0
+#: m: closer to the goal than this, no more keeping right (it only pushed arriving robots off
+#: their goal, to come back to it from the side and turn there); circle of 16, seeds 0-4: 1.5 m
+#: 21.0 / 24.0 s mean / max makespan, 1.0 m 20.3 / 23.6 s, 2.5 m 24.7 / 28.4 s
+KEEP_RIGHT_UNTIL = 1.0
+
+
+class CollvoidPreference:
+    """The preferred velocity's rules around other robots (see the module doc)."""
+
+    def _yield_velocity(self, xy, to_goal, other, own_r, other_r, remaining, pref):
+        """Yielding (`fleetsim.nav.multirobot.yielding`): to the refuge back along the plan,
+        then wait there; the yield ends (``pref`` again) as soon as the other robot is level
+        with us (beside us in the refuge, out of the passage; ORCA keeps us apart from there)."""
+        p, now = self.params, self.node.now()
+        if has_passed(other - xy, to_goal, 0.0):
+            self.deadlock.release(now, remaining)
+            self.yielding_to = None
+            return pref
+        decel = DECELERATION * p.acc_lim_x
+        return self.retreat.velocity(self.costmap, xy, own_r, other_r, p.max_vel_x, decel)
+
+    def _around_still(self, pref, xy, vel, rel, nvel, radii, controlled, ids) -> np.ndarray:
+        """``pref`` turned round the nearest robot standing in its way (`detour_velocity`) on a
+        side a wall leaves room on (`gaps_closed`), unless that robot stands on the goal (then
+        ORCA stops us short of it); a robot once gone round on one side is kept on that side
+        while it is within reach (`detour_sides`)."""
+        still = (np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED) | ~controlled
+        if not still.any():
+            return pref
+        r = radii[still] + DETOUR_MARGIN
+        to_goal = self.plan[-1, :2] - xy
+        free = np.hypot(*(rel[still] - to_goal).T) > r
+        idx = np.flatnonzero(still)[free]
+        r = radii[idx] + DETOUR_MARGIN
+        cm = self.costmap
+        grid = (cm.costs, (cm.origin_x, cm.origin_y), cm.resolution)
+        closed = gaps_closed(grid, xy, rel[idx], r, self.body_radius + cm.resolution * 0.71)
+        near = [ids[k] for k in idx]
+        sides = self.detour_sides
+        for k in [k for k in sides if k not in near]:
+            del sides[k]
+        keep = np.array([sides.get(k, -1) for k in near], dtype=int)
+        out, k = detour_velocity(pref, rel[idx], r, DETOUR_REACH, closed, keep, vel)
+        if k >= 0:
+            bearing = rel[idx[k]]
+            sides[near[k]] = int(bearing[0] * out[1] - bearing[1] * out[0] > 0.0)
+        return out
+
+    @staticmethod
+    def _oncoming(rel, nvel, vel, pref, dist, reach) -> np.ndarray:
+        """(N,) robots ahead (along ``pref``), nearer than ``reach`` m, moving and closing in:
+        the meetings keeping right resolves (a robot standing still ahead is gone round,
+        `_around_still`)."""
+        rel_vel = nvel - vel
+        moving = np.hypot(nvel[:, 0], nvel[:, 1]) >= STILL_SPEED
+        closing = np.einsum("ij,ij->i", rel, rel_vel) < 0.0
+        return (rel @ pref > 0) & (dist < reach) & moving & closing

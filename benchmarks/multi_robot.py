@@ -14,9 +14,7 @@ the lesson's 3 lizis in the Willow Garage map sent through each other's paths), 
 - makespan: from the goals going out to the last robot's arrival (move_base's SUCCEEDED, ground
   truth within tolerance), and its ratio to the slowest robot's time alone (``solo:=lizik``, each
   robot alone in the same world with the same planner's settings);
-- extra path: the robots' summed path over the summed paths alone (1.0: no detour);
-- off goal: ``SETTLE`` s after the last arrival (contacts still counted), the farthest any
-  robot stands from its goal (a parked robot that made room for another must be back).
+- extra path: the robots' summed path over the summed paths alone (1.0: no detour).
 
 Then the plugin's cycle: ``compute_velocity_commands`` with 16 neighbours on /position_share and a
 4 x 4 m local costmap with walls (median and 95th percentile, wall clock).
@@ -59,8 +57,6 @@ START_DELAY = 2.0  # s, the scenarios' default
 SAMPLE = 0.1  # s
 DEADLOCK_TIME, DEADLOCK_NEAR, DEADLOCK_PROGRESS = 20.0, 0.5, 0.2
 SAME_CONTACT = 1.0  # s
-#: s run on after the last arrival: parked robots that made room must be back at their goals
-SETTLE = 5.0
 
 
 @dataclass
@@ -78,7 +74,6 @@ class Run:
     arrival: dict[str, float] = field(default_factory=dict)
     wall: float = 0.0
     crashed: str = ""  # the simulator's error, when the run ended in one
-    off_goal: float = math.nan  # m, the farthest robot from its goal SETTLE s after the last
 
 
 def jittered_plan(path: Path, args: dict[str, str], seed: int, jitter: float):
@@ -156,13 +151,6 @@ def run_once(name: str, robots: int, planner: str, seed: int, limit: float, jitt
 
         try:
             rt.run(duration=limit, until=finished)
-            if finished():
-                rt.run(duration=SETTLE)
-                out.off_goal = max(
-                    math.dist(engine.model_pose(r.model)[0][:2], r.goal)
-                    for r in mon.robots.values()
-                    if r.model and r.goal is not None
-                )
         except PhysicsInstability as err:  # a pile-up flung a robot: the run ends there
             out.crashed = str(err).split(";")[0]
         for r in mon.results():
@@ -275,10 +263,6 @@ def main() -> None:
             )
             print(f"    alone: slowest {alone_time:.1f} s; per seed makespan "
                   + " ".join("-" if math.isnan(s) else f"{s:.1f}" for s in spans))  # fmt: skip
-            off = [r.off_goal for r in runs if not math.isnan(r.off_goal)]
-            if off:
-                print(f"    {SETTLE:.0f} s after the last arrival: farthest robot "
-                      f"{max(off):.2f} m from its goal")  # fmt: skip
             for r in runs:
                 if r.crashed:
                     print(f"    seed {r.seed}: the simulation failed: {r.crashed}")

@@ -84,11 +84,6 @@ class CollvoidParams:
         0.05, unit="m", range=(0.0, None), help="added to the robot radius against neighbours"
     )
     robot_id: str = param("", help="this robot's id on /position_share (empty: tf_prefix)")
-    active_collision_avoidance: bool = param(
-        False,
-        help="at its goal, keep avoiding robots that come at it along its heading and return "
-        "(collvoid's active_collision_avoidance node)",
-    )
     carrot_distance: float = param(
         0.8, unit="m", range=(1e-3, None), help="look-ahead along the plan for the heading"
     )

@@ -33,8 +33,6 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    footprint, base_local_planner-style, and keeps its velocity obstacles for the robots);
 6. within ``xy_goal_tolerance`` the robot stops and turns in place to the goal yaw, as
    base_local_planner does (at ``max_vel_theta``, slowed only to stop on the yaw);
-7. with ``active_collision_avoidance``, once the goal is reached the robot keeps running ORCA
-   towards where it stopped, along its heading (`collvoid_hold`, collvoid's standalone mode).
 
 The rules that shape the preferred velocity around other robots (keeping right, going round
 robots standing in the way on the side the robot heads for and keeping that side, yielding)
@@ -57,7 +55,6 @@ from fleetsim.errors import ParameterError, TransformError
 from fleetsim.msgs import geometry_msgs
 from fleetsim.nav.controllers.base import EmptyPlan, LocalPlanner, VelocityCommand
 from fleetsim.nav.controllers.collvoid_drive import UNTRUNCATED, CollvoidDrive
-from fleetsim.nav.controllers.collvoid_hold import CollvoidHold
 from fleetsim.nav.controllers.collvoid_params import CollvoidParams
 from fleetsim.nav.controllers.collvoid_preference import (
     DECELERATION,
@@ -93,7 +90,7 @@ WALLS_BLOCK = 0.25
 SAME_GOAL_SHIFT = 0.5
 
 
-class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, CollvoidHold, LocalPlanner):
+class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
     """ORCA among the robots on /position_share, for one move_base (see the module doc)."""
 
     Params = CollvoidParams
@@ -158,7 +155,6 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, CollvoidHold, Loca
         self.feasible = True
         #: robot id -> the side (0 right, 1 left) a robot standing in the way is gone round on
         self.detour_sides: dict[str, int] = {}
-        self._start_hold()
 
     @classmethod
     def from_namespace(cls, node: Any, costmap_ros: Any, ns: dict | None, where: str):
@@ -194,7 +190,6 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, CollvoidHold, Loca
     def compute_velocity_commands(self, pose, velocity) -> VelocityCommand:
         p = self.params
         x, y, yaw = (float(v) for v in pose)
-        self.last_cycle = self.node.now()
         if self.plan.shape[0] == 0:
             raise EmptyPlan("CollvoidLocalPlanner: no plan; call set_plan first")
         xy = np.array([x, y])

@@ -305,25 +305,3 @@ def speed_nearest_still(
     if lo <= hi:
         options.append(-lo)
     return min(options, key=abs) if options else None
-
-
-def speed_on_line(
-    points: np.ndarray,
-    directions: np.ndarray,
-    yaw: float,
-    wanted: float,
-    max_forward: float,
-    max_backward: float,
-) -> float:
-    """The speed along ``yaw`` (m/s, negative: backwards) nearest ``wanted`` that every
-    half-plane admits (forwards up to ``max_forward``, backwards up to ``max_backward``);
-    0 when none along that line does."""
-    u = np.array([math.cos(yaw), math.sin(yaw)])
-    options = []
-    lo, hi = speed_interval(points, directions, u, max_forward)
-    if lo <= hi:
-        options.append(min(max(wanted, lo), hi))
-    lo, hi = speed_interval(points, directions, -u, max_backward)
-    if lo <= hi:
-        options.append(-min(max(-wanted, lo), hi))
-    return min(options, key=lambda v: abs(v - wanted)) if options else 0.0

@@ -159,3 +159,42 @@ def test_a_robot_pose_older_than_transform_tolerance_is_not_used(caplog):
     world.send_pose()  # tf is back
     rt.run(duration=1.0)
     assert len(mb.goals) == 1
+
+
+def wall_between() -> np.ndarray:
+    """Known 0.1 m cells, a wall along x 1.0 m from the south edge to y 1.5 m, and an unknown
+    pocket east of it (x 1.1-1.6 m, y < 0.5 m): its frontier is 0.3 m from a robot west of the
+    wall in a straight line, 3 m round the wall's north end."""
+    data = np.zeros((20, 30), dtype=np.int8)
+    data[:15, 10] = 100
+    data[:5, 11:16] = -1
+    return data
+
+
+def drive_north(progress_on_path: bool) -> tuple[Explore, MoveBase]:
+    """The robot, west of the wall, drives north towards its end at 0.2 m/s for 5 s (the way
+    round to the pocket); progress_timeout 2 s."""
+    rt = Runtime(seed=0)
+    rt.params.set("/explore/progress_timeout", 2.0)
+    rt.params.set("/explore/progress_on_path", progress_on_path)
+    world = World(rt, wall_between(), dynamic=True)
+    mb = MoveBase(rt, lambda g: None)  # accepted, never reached
+    ex = Explore(rt)
+    x, y = 0.85, 0.25
+    for _ in range(50):
+        world.tf.send_transform(make_transform_stamped("map", "base_link", rt.now(), (x, y, 0.0)))
+        rt.run(duration=0.1)
+        y += 0.02
+    return ex, mb
+
+
+def test_progress_on_path_keeps_a_goal_the_robot_drives_round_a_wall_to():
+    (pocket,) = frontiers_from_grid(wall_between(), 0.1, (0.0, 0.0), (0.85, 0.25))
+    # explore_lite's straight line grows as the robot heads for the wall's end: blacklisted
+    ex, mb = drive_north(progress_on_path=False)
+    assert [tuple(round(v, 2) for v in b) for b in ex.blacklist] == [
+        tuple(round(v, 2) for v in pocket.centroid)
+    ]
+    # along the drivable cells the way there shrinks: kept, sent once
+    ex, mb = drive_north(progress_on_path=True)
+    assert not ex.blacklist and len(mb.goals) == 1 and ex.goal is not None

@@ -131,7 +131,8 @@ def test_me_publisher_shares_pose_velocity_and_footprint_at_10_hz():
     assert (m.holonomic_velocity.x, m.holonomic_velocity.y) == pytest.approx((0.0, 0.4), abs=1e-9)
     assert m.radius == pytest.approx(math.hypot(0.2, 0.2))  # fake localization: no inflation
     assert len(m.footprint.polygon.points) == 4
-    assert me.uncertainty(2.0, 3.0) == 0.0
+    assert me.uncertainty() == 0.0
+    assert not any(m.pose.covariance)
 
 
 def test_me_publisher_inflates_the_footprint_by_amcl_spread():
@@ -145,9 +146,14 @@ def test_me_publisher_inflates_the_footprint_by_amcl_spread():
     robot.cloud.publish(geometry_msgs.PoseArray(poses=ring))
     rt.run(duration=0.5)
     m = robot.got[-1]
-    assert m.radius == pytest.approx(math.hypot(0.3, 0.3), abs=1e-6)  # 0.2 + 0.1 per side
+    # a ring of 0.1 m: variance 0.005 m^2 (sample: x 50/49) per axis, shared in pose.covariance;
+    # the footprint is padded by its widest 90 % spread, sqrt(-2 ln 0.1) standard deviations
+    var = 0.005 * 50 / 49
+    assert [m.pose.covariance[i] for i in (0, 1, 6, 7)] == pytest.approx([var, 0, 0, var], abs=1e-9)
+    pad = math.sqrt(-2 * math.log(0.1)) * math.sqrt(var)
+    assert m.radius == pytest.approx(math.hypot(0.2 + pad, 0.2 + pad), abs=1e-6)
     xs = sorted({round(p.x, 6) for p in m.footprint.polygon.points})
-    assert xs == [-0.3, 0.3]
+    assert xs == pytest.approx([-0.2 - pad, 0.2 + pad], abs=1e-6)
 
 
 def test_me_publisher_rejects_a_bad_footprint_parameter():
@@ -207,7 +213,8 @@ def test_me_publisher_takes_a_cloud_of_one_pose_as_no_uncertainty():
     one = geometry_msgs.Pose(position=geometry_msgs.Point(x=0.03, y=0.0))
     robot.cloud.publish(geometry_msgs.PoseArray(poses=[one]))
     rt.run(duration=0.3)
-    assert me.uncertainty(0.0, 0.0) == 0.0
+    assert me.uncertainty() == 0.0
+    assert not any(robot.got[-1].pose.covariance)
     assert robot.got[-1].radius == pytest.approx(math.hypot(0.2, 0.2))
 
 

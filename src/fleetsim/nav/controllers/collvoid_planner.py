@@ -3,9 +3,13 @@
 After collvoid (Claes, Hennes, Tuyls), each control cycle:
 
 1. the robot's own radius is its footprint's circumscribed radius (or ``footprint_radius``),
-   plus its localization uncertainty (amcl's ``particlecloud``, ``eps``), ``safety_margin`` and
-   the tracking error allowed for a differential drive (``min_error_holo`` growing to
-   ``max_error_holo`` at full speed);
+   plus ``safety_margin`` and the tracking error allowed for a differential drive
+   (``min_error_holo`` growing to ``max_error_holo`` at full speed); each pair's combined
+   radius grows by both robots' localization spreads (its own amcl ``particlecloud``'s
+   covariance, the other's from /position_share; ``eps``) across the legs of the pair's
+   velocity obstacle (`uncertainty.pair_padding`): two robots uncertain along a corridor are
+   not kept apart across it. A robot that shares no covariance counts with its radius as sent
+   (collvoid's, padded in every direction);
 2. the preferred velocity points at a carrot ``carrot_distance`` m along the global plan, at
    ``max_vel_x``, slowing at a quarter of ``acc_lim_x`` (not below ``min_vel_x``) to stop at
    the goal; while another robot ahead, nearer than the goal, is closing in, it is turned by
@@ -72,7 +76,7 @@ from fleetsim.nav.multirobot.holonomic import (
 )
 from fleetsim.nav.multirobot.orca import orca_halfplanes, orca_velocity
 from fleetsim.nav.multirobot.position_share import PositionShare
-from fleetsim.nav.multirobot.uncertainty import uncertainty_radius
+from fleetsim.nav.multirobot.uncertainty import cloud_covariance, pair_padding
 from fleetsim.nav.multirobot.yielding import Retreat, narrow_meetings
 from fleetsim.runtime import load_params
 
@@ -123,7 +127,7 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
         self.walls_blocked = False  # this cycle the walls left the circumscribed disc no way
         self.escape_from: np.ndarray | None = None  # where a wedged robot began backing out
         self.escapes = 0  # how often it did
-        self.share = PositionShare(node)
+        self.share = PositionShare(node, eps=p.eps)
         self.deadlock = DeadlockRule(
             self.robot_id,
             p.deadlock_time,
@@ -132,7 +136,7 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
             p.yield_time,
             p.narrow_deadlock_time,
         )
-        self._particles: np.ndarray | None = None
+        self._covariance: np.ndarray | None = None  # own localization's, map frame
         node.create_subscription(geometry_msgs.PoseArray, "particlecloud", self._on_cloud, 1)
         self.dt = 1.0 / p.controller_frequency
         self.horizon = p.time_horizon if p.use_truncation else UNTRUNCATED
@@ -161,9 +165,9 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
         return cls(node, costmap_ros, load_params(CollvoidParams, ns, where, logger=_log), where)
 
     def _on_cloud(self, msg: Any) -> None:
-        self._particles = np.array(
-            [[q.position.x, q.position.y] for q in msg.poses], dtype=np.float64
-        ).reshape(-1, 2)
+        self._covariance = cloud_covariance(
+            np.array([[q.position.x, q.position.y] for q in msg.poses], dtype=np.float64)
+        )
 
     # -- the plugin interface ------------------------------------------------------------------
     def set_plan(self, plan: Any) -> None:
@@ -208,27 +212,47 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
         return self._track(holo, (x, y, yaw), velocity)
 
     # -- the cycle -----------------------------------------------------------------------------
-    def own_radius(self, speed: float, map_xy: np.ndarray) -> float:
-        """Own safety radius: body + uncertainty + margin + allowed tracking error, m."""
+    def own_radius(self, speed: float) -> float:
+        """Own safety radius: body + margin + allowed tracking error, m (the localization
+        spread is the pair's, `pair_padding`)."""
         p = self.params
-        unc = 0.0
-        if self._particles is not None and self._particles.shape[0] > 1:
-            unc = uncertainty_radius(self._particles, map_xy, p.eps, 2.0 * self.body_radius)
         err = p.min_error_holo
         if not p.holonomic_robot:
             err += (p.max_error_holo - p.min_error_holo) * min(1.0, speed / p.max_vel_x)
-        return self.body_radius + unc + p.safety_margin + err
+        return self.body_radius + p.safety_margin + err
+
+    def neighbour_radii(self, own_r: float, map_xy: np.ndarray, near: Any) -> np.ndarray:
+        """The others' radii (N,) m for ORCA against this robot (``own_r`` m, at ``map_xy``):
+        each one's body grown by both robots' localization spreads across the legs of the
+        pair's velocity obstacle; the radius as sent for a robot that shares no covariance.
+        With no spread anywhere (fake_localization) the radii as sent, exactly."""
+        covs = near.covariances
+        if self._covariance is None and not covs.any():
+            return near.radii
+        shared = covs.reshape(-1, 4).any(axis=1)
+        body = np.where(shared, near.body_radii, near.radii)
+        pad = pair_padding(
+            near.positions - map_xy,
+            own_r + body,
+            self._covariance,
+            2.0 * self.body_radius,
+            covs,
+            2.0 * body,
+            self.params.eps,
+        )
+        return body + pad
 
     def _map_to_local(self) -> tuple[float, float, float]:
         if self.frame == MAP_FRAME:
             return 0.0, 0.0, 0.0
         return self.node.tf_buffer.lookup_pose2d(self.frame, MAP_FRAME, 0.0)
 
-    def _neighbours(self, xy: np.ndarray) -> tuple:
+    def _neighbours(self, xy: np.ndarray, own_r: float) -> tuple:
         """The robots around ``xy`` (m, local costmap frame) on /position_share, in that frame:
-        (own position in map (2,), ids, positions (N, 2), velocities (N, 2), radii (N,),
-        ORCA responsibilities (N,): all of it for a robot not ``controlled`` or standing
-        still, half otherwise; controlled (N,) bool, yaws (N,)). None around without tf."""
+        (own position in map (2,), ids, positions (N, 2), velocities (N, 2), radii (N,) against
+        this robot of radius ``own_r`` (`neighbour_radii`), ORCA responsibilities (N,): all of
+        it for a robot not ``controlled`` or standing still, half otherwise; controlled (N,)
+        bool, yaws (N,)). None around without tf."""
         p, now = self.params, self.node.now()
         ids: list[str] = []
         pos, nvel, radii = np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0)
@@ -248,7 +272,8 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
         still = np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED
         resp = np.where(~near.controlled | still, 1.0, 0.5)
         yaws = np.array([r.yaw for r in near.robots]) + tyaw
-        return map_xy, near.ids, pos, nvel, near.radii, resp, near.controlled, yaws
+        radii = self.neighbour_radii(own_r, map_xy, near)
+        return map_xy, near.ids, pos, nvel, radii, resp, near.controlled, yaws
 
     def holonomic_velocity(self, xy, yaw, vel, carrot, remaining) -> np.ndarray:
         """The ORCA velocity for this cycle, (2,) m/s in the local costmap's frame."""
@@ -256,8 +281,8 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
         pref = preferred_velocity(
             carrot, xy, remaining, p.max_vel_x, p.min_vel_x, DECELERATION * p.acc_lim_x
         )
-        map_xy, ids, pos, nvel, radii, resp, controlled, yaws = self._neighbours(xy)
-        own_r = self.own_radius(float(np.hypot(*vel)), map_xy)
+        own_r = self.own_radius(float(np.hypot(*vel)))
+        map_xy, ids, pos, nvel, radii, resp, controlled, yaws = self._neighbours(xy, own_r)
         dist = np.hypot(pos[:, 0] - xy[0], pos[:, 1] - xy[1])
         active = {k: d for k, d, c in zip(ids, dist.tolist(), controlled) if c}
         narrow: list[str] = []

@@ -7,13 +7,16 @@ and publishes a `collvoid_msgs.PoseTwistWithCovariance`:
 * ``footprint``: ``~footprint`` (``[[x, y], ...]``, robot frame; else the footprint of the
   costmap ``~costmap`` names, a fleetsim addition; else a ``~robot_radius`` circle) padded by
   the localization uncertainty, ``radius`` its circumscribed radius;
-* the uncertainty: from the latest ``particlecloud`` (amcl's PoseArray, relative name, so it is
-  ``/lizi1/particlecloud``): the distance from the estimate within which ``1 - eps`` of the
-  particles lie, capped at twice the robot radius (`uncertainty_radius`). fake_localization's
-  cloud is the one true pose: a cloud of one pose (or none) counts as zero uncertainty, as it
-  does before any cloud arrives;
-* ``pose`` (map frame, with the particle spread's x/y covariance), ``twist`` (``odom``'s
-  twist, base frame) and ``holonomic_velocity`` (that velocity turned into the map frame);
+* the uncertainty: the x/y covariance of the latest ``particlecloud`` (amcl's PoseArray,
+  relative name, so it is ``/lizi1/particlecloud``), shared in ``pose.covariance``; the
+  footprint is padded by its widest 1 - ``eps`` spread (a 2-D Gaussian's, along the major
+  axis: `widest_spread`), capped at twice the robot radius, so a consumer that ignores the
+  covariance keeps clear of the robot in every direction, and one that reads it takes the
+  padding off again (`uncertainty.shared_padding`) and pads by the spread in the direction
+  that matters (issue 18). fake_localization's cloud is the one true pose: a cloud of one pose
+  (or none) counts as zero uncertainty and a zero covariance, as before any cloud arrives;
+* ``pose`` (map frame), ``twist`` (``odom``'s twist, base frame) and ``holonomic_velocity``
+  (that velocity turned into the map frame);
 * ``controlled``: ``~controlled``, and - once ``move_base/status`` has been heard - only while
   move_base has a goal pending or active. A robot parked at its goal does not avoid anyone, so
   the others take the whole avoidance on themselves and do not wait for it to yield.
@@ -35,8 +38,8 @@ from fleetsim.nav.costmap.footprint import (
     footprint_radii,
     padded_footprint,
 )
-from fleetsim.nav.multirobot.position_share import TOPIC
-from fleetsim.nav.multirobot.uncertainty import uncertainty_radius
+from fleetsim.nav.multirobot.position_share import TOPIC, XY_COVARIANCE
+from fleetsim.nav.multirobot.uncertainty import cloud_covariance, widest_spread
 from fleetsim.runtime import Node, param
 from fleetsim.tf import resolve_frame_once
 from fleetsim.tf.names import normalize_frame
@@ -54,7 +57,10 @@ class MePublisherParams:
         10.0, unit="Hz", range=(1e-6, None), help="rate of the /position_share messages"
     )
     eps: float = param(
-        0.1, range=(0.0, 0.999), help="particle weight allowed outside the uncertainty radius"
+        0.1,
+        range=(0.0, 0.999),
+        help="share of the position spread allowed outside the padding (the fleet's: the "
+        "planners take the padding off with theirs)",
     )
     holo_robot: bool = param(False, help="the robot is holonomic")
     controlled: bool = param(True, help="the robot avoids others (else they avoid it fully)")
@@ -86,7 +92,7 @@ class MePublisher(Node):
         self.robot_id = p.name or self.tf_prefix or self.namespace.strip("/").replace("/", "_")
         self.base_frame = resolve_frame_once(self.tf_prefix, p.base_frame)
         self.global_frame = normalize_frame(p.global_frame)
-        self._particles: np.ndarray | None = None
+        self._covariance: np.ndarray | None = None
         self._body_vel = (0.0, 0.0, 0.0)
         self._navigating: bool | None = None  # None until move_base/status is heard
         self._started = self.now()
@@ -122,9 +128,9 @@ class MePublisher(Node):
         return footprint_from_radius(p.robot_radius)
 
     def on_cloud(self, msg: Any) -> None:
-        self._particles = np.array(
-            [[q.position.x, q.position.y] for q in msg.poses], dtype=np.float64
-        ).reshape(-1, 2)
+        self._covariance = cloud_covariance(
+            np.array([[q.position.x, q.position.y] for q in msg.poses], dtype=np.float64)
+        )
 
     def on_odom(self, msg: Any) -> None:
         t = msg.twist.twist
@@ -139,16 +145,14 @@ class MePublisher(Node):
         """Whether the robot avoids others now (see the module doc)."""
         return self.params.controlled and self._navigating is not False
 
-    def uncertainty(self, x: float, y: float) -> float:
-        """The localization uncertainty radius at estimate (x, y), m: 0 without a cloud or with
-        a cloud of one pose (fake_localization's: the true pose, published a moment apart from
-        the tf the estimate comes from, so a moving robot would be padded by the distance it
-        drove in between), as the planner's ``own_radius`` takes it."""
-        if self._particles is None or self._particles.shape[0] <= 1:
+    def uncertainty(self) -> float:
+        """The footprint's padding, m: the cloud's widest 1 - eps spread, capped at twice the
+        robot radius; 0 without a cloud or with a cloud of one pose (fake_localization's: the
+        true pose, published a moment apart from the tf the estimate comes from, so a moving
+        robot would be padded by the distance it drove in between), as the planner takes it."""
+        if self._covariance is None:
             return 0.0
-        return uncertainty_radius(
-            self._particles, np.array([x, y]), self.params.eps, 2.0 * self.robot_radius
-        )
+        return widest_spread(self._covariance, self.params.eps, 2.0 * self.robot_radius)
 
     def publish_me(self) -> None:
         try:
@@ -157,7 +161,7 @@ class MePublisher(Node):
             if self.now() - self._started > TF_GRACE:
                 self._warn_once("tf", f"cannot share the robot's position yet: {err}")
             return
-        unc = self.uncertainty(x, y)
+        unc = self.uncertainty()
         fp = padded_footprint(self.footprint, unc) if unc > 0 else self.footprint
         c, s = math.cos(yaw), math.sin(yaw)
         bvx, bvy, bw = self._body_vel
@@ -176,9 +180,8 @@ class MePublisher(Node):
             position=geometry_msgs.Point(x=x, y=y),
             orientation=geometry_msgs.Quaternion(x=q[0], y=q[1], z=q[2], w=q[3]),
         )
-        if self._particles is not None and self._particles.shape[0] > 1:
-            cov = np.cov(self._particles.T)
-            msg.pose.covariance[[0, 1, 6, 7]] = cov.reshape(-1)
+        if self._covariance is not None:
+            msg.pose.covariance[XY_COVARIANCE] = self._covariance.reshape(-1)
         msg.twist.twist.linear = geometry_msgs.Vector3(x=bvx, y=bvy)
         msg.twist.twist.angular = geometry_msgs.Vector3(z=bw)
         msg.footprint.header = msg.header

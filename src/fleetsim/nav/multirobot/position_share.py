@@ -15,6 +15,14 @@ local planner, the robots costmap layer) keeps the newest message per ``robot_id
   why); `PositionShare` keeps the others and warns once per robot and reason in a process (a
   runtime), whichever of its listening nodes hears it first (the warning names that node):
   ten robots' move_bases hearing one broken robot give one warning, not ten;
+* the pose's x/y covariance (``pose.covariance`` entries 0, 1, 6, 7; me_publisher's amcl
+  particle spread) is kept with the robot's body: ``footprint`` and ``radius`` are padded by
+  the widest spread (`uncertainty.widest_spread`, at the consumer's ``eps``, which must be the
+  fleet's), so the body is that padding taken off again (`uncertainty.shared_padding`); a
+  consumer pads a pair by the spreads in the direction that matters
+  (`uncertainty.pair_padding`). An all-zero covariance (fake_localization, or a publisher that
+  shares none) leaves the radius as sent; a non-finite, asymmetric or not positive
+  semi-definite one is ignored (the radius as sent) with one warning naming the robot;
 * `NeighbourTable.near` gives the robots within a radius, nearest first, at most
   ``max_neighbors``, as arrays in the map frame.
 
@@ -33,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from fleetsim.msgs import collvoid_msgs
+from fleetsim.nav.multirobot.uncertainty import shared_padding, widest_spread
 from fleetsim.tf.names import normalize_frame
 from fleetsim.tf.quaternions import yaw_from_quaternion
 
@@ -43,6 +52,10 @@ LAST_SEEN_THRESHOLD = 2.0
 FUTURE_TOLERANCE = 2.0
 #: the frame every robot shares its pose in
 SHARED_FRAME = "map"
+#: collvoid's ``eps`` (me_publisher's and the planner's default)
+EPS = 0.1
+#: pose.covariance entries of the x/y block (row-major 6 x 6)
+XY_COVARIANCE = [0, 1, 6, 7]
 
 
 class Rejection(str):
@@ -72,6 +85,12 @@ class Neighbour:
     footprint: np.ndarray  # (K, 2) in the robot's frame, inflated by its uncertainty
     controlled: bool
     stamp: float  # s of sim time
+    #: (2, 2) x/y covariance of its localization, m^2; None: the radius as sent is the robot
+    covariance: np.ndarray | None = None
+    #: m, the radius without the localization padding (``radius`` without a covariance)
+    body_radius: float = 0.0
+    #: why a covariance it sent was ignored (warned about once), else None
+    covariance_fault: Rejection | None = None
 
     def polygon(self) -> np.ndarray:
         """The footprint at the robot's pose: (K, 2) map frame, m."""
@@ -82,9 +101,31 @@ class Neighbour:
         )
 
 
-def neighbour_from_msg(msg: Any, frame: str = SHARED_FRAME) -> Neighbour | Rejection:
+def shared_covariance(msg: Any, rid: str) -> np.ndarray | Rejection | None:
+    """The message's (2, 2) x/y pose covariance; None when it is all zero (none shared); the
+    reason when it is unusable."""
+    c = np.array([float(msg.pose.covariance[i]) for i in XY_COVARIANCE]).reshape(2, 2)
+    if not c.any():
+        return None
+    if not np.isfinite(c).all():
+        return Rejection(rid, "covariance", f"robot '{rid}' shared a non-finite covariance {c}")
+    scale = float(np.abs(c).max())
+    if abs(c[0, 1] - c[1, 0]) > 1e-9 * scale or np.linalg.eigvalsh(c)[0] < -1e-12 * scale:
+        return Rejection(
+            rid,
+            "covariance",
+            f"robot '{rid}' shared a covariance that is not symmetric positive semi-definite "
+            f"(x/y block {c.tolist()})",
+        )
+    return c
+
+
+def neighbour_from_msg(
+    msg: Any, frame: str = SHARED_FRAME, eps: float = EPS
+) -> Neighbour | Rejection:
     """The `Neighbour` a position_share message describes, or the reason it is unusable
-    (``frame``: the shared frame its pose must be in)."""
+    (``frame``: the shared frame its pose must be in; ``eps``: the fleet's, with which the
+    publisher padded its footprint by its covariance)."""
     rid = str(msg.robot_id or "")
     if not rid:
         return Rejection("", "robot_id", "a message without robot_id")
@@ -123,7 +164,19 @@ def neighbour_from_msg(msg: Any, frame: str = SHARED_FRAME) -> Neighbour | Rejec
         )
     stamp = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
     yaw = yaw_from_quaternion((q.x, q.y, q.z, q.w))
-    return Neighbour(rid, *pose, yaw, v.x, v.y, float(msg.radius), fp, bool(msg.controlled), stamp)
+    radius = float(msg.radius)
+    cov = shared_covariance(msg, rid)
+    fault = cov if isinstance(cov, Rejection) else None
+    body = radius
+    if isinstance(cov, np.ndarray):
+        pad = shared_padding(fp, widest_spread(cov, eps, math.inf))
+        unpadded = fp - np.sign(fp) * pad
+        body = float(np.max(np.hypot(unpadded[:, 0], unpadded[:, 1])))
+    else:
+        cov = None
+    return Neighbour(
+        rid, *pose, yaw, v.x, v.y, radius, fp, bool(msg.controlled), stamp, cov, body, fault
+    )
 
 
 @dataclass(frozen=True)
@@ -136,6 +189,10 @@ class NeighbourArrays:
     radii: np.ndarray  # (N,) m
     controlled: np.ndarray  # (N,) bool
     robots: list[Neighbour]
+    #: (N,) m: without the localization padding where a covariance came, else ``radii``
+    body_radii: np.ndarray | None = None
+    #: (N, 2, 2) m^2, zeros where none came
+    covariances: np.ndarray | None = None
 
 
 class NeighbourTable:
@@ -149,18 +206,22 @@ class NeighbourTable:
         last_seen_threshold: float = LAST_SEEN_THRESHOLD,
         frame: str = SHARED_FRAME,
         on_bad: Callable[[Rejection], None] | None = None,
+        eps: float = EPS,
     ) -> None:
         self.last_seen_threshold = last_seen_threshold
         self.frame = frame
+        self.eps = eps
         self.on_bad = on_bad
         self.robots: dict[str, Neighbour] = {}
 
     def update(self, msg: Any) -> Rejection | None:
         """Store a message; returns the reason when it was rejected."""
-        got = neighbour_from_msg(msg, self.frame)
+        got = neighbour_from_msg(msg, self.frame, self.eps)
         if isinstance(got, str):
             return got
         self.robots[got.robot_id] = got
+        if got.covariance_fault is not None and self.on_bad is not None:
+            self.on_bad(got.covariance_fault)
         return None
 
     def _usable(self, r: Neighbour, now: float) -> bool:
@@ -210,6 +271,11 @@ class NeighbourTable:
             radii=np.array([r.radius for r in rs], dtype=np.float64),
             controlled=np.array([r.controlled for r in rs], dtype=bool),
             robots=rs,
+            body_radii=np.array([r.body_radius for r in rs], dtype=np.float64),
+            covariances=np.array(
+                [np.zeros((2, 2)) if r.covariance is None else r.covariance for r in rs],
+                dtype=np.float64,
+            ).reshape(-1, 2, 2),
         )
 
 
@@ -222,9 +288,11 @@ class PositionShare:
     message is rejected is ignored, and warned about once per robot and kind of fault in the
     node's runtime (not once per listening node)."""
 
-    def __init__(self, node: Any, last_seen_threshold: float = LAST_SEEN_THRESHOLD) -> None:
+    def __init__(
+        self, node: Any, last_seen_threshold: float = LAST_SEEN_THRESHOLD, eps: float = EPS
+    ) -> None:
         self.node = node
-        self.table = NeighbourTable(last_seen_threshold, on_bad=self.warn)
+        self.table = NeighbourTable(last_seen_threshold, on_bad=self.warn, eps=eps)
         self.rejected = 0
         self.sub = node.create_subscription(
             collvoid_msgs.PoseTwistWithCovariance, TOPIC, self.on_message, queue_size=0

@@ -8,6 +8,8 @@ advertised that much larger, so that neighbours keep clear of wherever it probab
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 
@@ -44,3 +46,118 @@ def uncertainty_radius(
     k = int(np.searchsorted(acc, 1.0 - eps, side="right"))
     k = min(k, pts.shape[0] - 1)
     return float(min(d[order][k], cap))
+
+
+# -- the spread as a covariance (issue 18) --------------------------------------------------------
+# A robot's uncertainty padded as a disc (`uncertainty_radius`) keeps two amcl robots in a 2 m
+# corridor 1.6-1.8 m apart: amcl's particles spread 0.3-0.5 m *along* a featureless corridor.
+# What keeps two robots apart is their extent across the velocity obstacle's legs, so the spread
+# is shared as the cloud's 2x2 position covariance and each pair is padded by it in the
+# direction that matters (`pair_padding`).
+
+
+def gaussian_scale(eps: float) -> float:
+    """The 1 - ``eps`` quantile of a 2-D Gaussian in standard deviations (its Mahalanobis
+    radius: P(outside) = exp(-k^2 / 2) = eps): 2.15 for eps 0.1; inf for eps 0."""
+    return math.inf if eps <= 0.0 else math.sqrt(-2.0 * math.log(eps))
+
+
+def cloud_covariance(particles: np.ndarray) -> np.ndarray | None:
+    """The particles' (P, 2) 2x2 position covariance, m^2; None for fewer than two particles
+    (fake_localization's cloud is the true pose: no uncertainty)."""
+    pts = np.asarray(particles, dtype=np.float64).reshape(-1, 2)
+    if pts.shape[0] <= 1:
+        return None
+    return np.cov(pts.T)
+
+
+def spread_along(cov: np.ndarray, directions: np.ndarray, eps: float, cap) -> np.ndarray:
+    """The 1 - ``eps`` spread of positions with covariance ``cov`` ((2, 2) or (N, 2, 2), m^2)
+    along unit ``directions`` (N, 2): k sqrt(n' cov n) (k: `gaussian_scale`), at most ``cap``
+    (m, scalar or (N,)). Exactly 0.0 where the variance along n is 0."""
+    n = np.asarray(directions, dtype=np.float64).reshape(-1, 2)
+    cov = np.asarray(cov, dtype=np.float64)
+    var = np.einsum("ni,ij,nj->n" if cov.ndim == 2 else "ni,nij,nj->n", n, cov, n)
+    sd = np.sqrt(np.maximum(var, 0.0))
+    k = gaussian_scale(eps)
+    spread = np.where(sd > 0.0, sd * k if math.isfinite(k) else np.inf, 0.0)
+    return np.minimum(spread, cap)
+
+
+def widest_spread(cov: np.ndarray, eps: float, cap: float) -> float:
+    """The largest `spread_along` over all directions (the major axis), m: the radius of a disc
+    holding at least 1 - ``eps`` of the Gaussian, at most ``cap``."""
+    lam, axes = np.linalg.eigh(np.asarray(cov, dtype=np.float64))
+    return float(spread_along(cov, axes[:, -1:].T, eps, cap)[0]) if lam[-1] > 0.0 else 0.0
+
+
+def pair_padding(
+    rel: np.ndarray,
+    base: np.ndarray,
+    own_cov: np.ndarray | None,
+    own_cap: float,
+    covs: np.ndarray,
+    caps: np.ndarray,
+    eps: float,
+    iterations: int = 8,
+) -> np.ndarray:
+    """What each pair's combined radius grows by for the two robots' localization spreads, m.
+
+    The pair's shape in the velocity obstacle is the disc of radius ``base`` (both bodies and
+    margins) grown by both spread ellipses; its support along a unit normal n is ``base`` +
+    spread_own(n) + spread_other(n) (`spread_along`, each capped). A velocity obstacle is the
+    cone of the shape's tangents from the robot, and a disc of radius R at distance d has its
+    tangents' normals at acos(R / d) from the line between the two. So the padding is the
+    support along those normals (the larger of the two sides), found by a fixed-point
+    iteration: the disc then shares the true shape's tangent on that side (and covers it on the
+    other). Far apart that is the spread *across* the line between them (a robot uncertain only
+    along a corridor is padded by almost nothing against one ahead of it in the corridor); in
+    contact (d <= R) it is the spread along the line.
+
+    rel : (N, 2) the others relative to this robot, m, the frame of the covariances;
+    base : (N,) combined radii without localization, m; own_cov : (2, 2) or None (exact);
+    own_cap : m; covs : (N, 2, 2) the others' covariances (zeros: exact); caps : (N,) m.
+    Returns (N,) m, exactly 0.0 where neither robot is uncertain.
+    """
+    rel = np.asarray(rel, dtype=np.float64).reshape(-1, 2)
+    n = rel.shape[0]
+    cov = np.zeros((2, 2)) if own_cov is None else np.asarray(own_cov, dtype=np.float64)
+    covs = np.asarray(covs, dtype=np.float64).reshape(n, 2, 2)
+    if n == 0 or (not cov.any() and not covs.any()):
+        return np.zeros(n)
+    d = np.hypot(rel[:, 0], rel[:, 1])
+    u = np.where(d[:, None] > 0.0, rel / np.maximum(d, 1e-12)[:, None], [1.0, 0.0])
+    perp = np.stack((-u[:, 1], u[:, 0]), axis=1)
+
+    def support(normals: np.ndarray) -> np.ndarray:
+        return spread_along(cov, normals, eps, own_cap) + spread_along(covs, normals, eps, caps)
+
+    pad = support(perp)
+    for _ in range(iterations):
+        s = np.clip((base + pad) / np.maximum(d, 1e-12), 0.0, 1.0)[:, None]
+        c = np.sqrt(1.0 - s * s)
+        pad = np.maximum(support(s * u + c * perp), support(s * u - c * perp))
+    return pad
+
+
+def shared_padding(footprint: np.ndarray, widest: float) -> float:
+    """The padding a publisher gave ``footprint`` (costmap_2d's padFootprint, each coordinate
+    moved away from 0 by its sign) when it padded its body by its widest spread ``widest`` (m,
+    uncapped), capped at twice the body's circumscribed radius (`me_publisher`): the p with
+    p = min(widest, 2 R(footprint - sign(footprint) p)), m. The result is exact for a message
+    padded that way (the right side falls as p grows, so the solution is unique)."""
+    fp = np.asarray(footprint, dtype=np.float64)
+    nonzero = np.abs(fp[fp != 0.0])
+    hi = min(float(widest), float(nonzero.min()) if nonzero.size else 0.0)
+
+    def excess(p: float) -> float:
+        body = fp - np.sign(fp) * p
+        return p - 2.0 * float(np.max(np.hypot(body[:, 0], body[:, 1])))
+
+    if hi <= 0.0 or excess(hi) <= 0.0:
+        return max(hi, 0.0)
+    lo = 0.0
+    for _ in range(60):  # bisection: the cap's equation has no closed form for a polygon
+        mid = 0.5 * (lo + hi)
+        lo, hi = (mid, hi) if excess(mid) <= 0.0 else (lo, mid)
+    return lo

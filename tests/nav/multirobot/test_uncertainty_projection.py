@@ -1,0 +1,203 @@
+"""Issue 18: localization spread shared as a covariance and padded in the direction that
+matters (across the legs of a pair's velocity obstacle), with today's radius rule for robots
+that share no covariance and one warning for a bad one."""
+
+import logging
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from fleetsim.msgs import collvoid_msgs, geometry_msgs
+from fleetsim.msgs.builtin_interfaces import Time
+from fleetsim.nav.controllers.collvoid_planner import CollvoidLocalPlanner
+from fleetsim.nav.costmap.footprint import padded_footprint
+from fleetsim.nav.multirobot.me_publisher import MePublisher
+from fleetsim.nav.multirobot.position_share import NeighbourTable, PositionShare
+from fleetsim.nav.multirobot.uncertainty import (
+    gaussian_scale,
+    pair_padding,
+    shared_padding,
+    spread_along,
+    widest_spread,
+)
+from fleetsim.runtime import Node, Runtime
+from fleetsim.tf import StaticTransformBroadcaster, make_transform_stamped
+
+LIZI = np.array([[-0.19, -0.16], [-0.19, 0.16], [0.19, 0.16], [0.19, -0.16]])
+K = gaussian_scale(0.1)  # 2.146 standard deviations
+ALONG_X = np.diag([0.15**2, 0.005**2])  # amcl in a corridor along x: 0.32 m of 90 % spread
+ALONG_Y = np.diag([0.005**2, 0.15**2])
+NONE = np.zeros((1, 2, 2))
+
+
+def test_gaussian_scale_is_the_2d_quantile():
+    assert pytest.approx(2.1460, abs=1e-4) == K
+    # P(Mahalanobis radius > k) = exp(-k^2 / 2) for a 2-D Gaussian
+    rng = np.random.default_rng(0)
+    r = np.hypot(*rng.standard_normal((2, 200_000)))
+    assert np.mean(r > K) == pytest.approx(0.1, abs=0.003)
+    assert gaussian_scale(0.0) == math.inf
+
+
+def test_spread_along_a_direction_is_the_projected_standard_deviation():
+    dirs = np.array([[1.0, 0.0], [0.0, 1.0], [math.sqrt(0.5), math.sqrt(0.5)]])
+    got = spread_along(ALONG_X, dirs, 0.1, cap=10.0)
+    assert got[0] == pytest.approx(K * 0.15)
+    assert got[1] == pytest.approx(K * 0.005)
+    assert got[2] == pytest.approx(K * math.sqrt((0.15**2 + 0.005**2) / 2))
+    assert spread_along(ALONG_X, dirs, 0.1, cap=0.1)[0] == 0.1  # capped as the radius rule
+    assert widest_spread(ALONG_Y, 0.1, 10.0) == pytest.approx(K * 0.15)
+
+
+def test_a_robot_touching_along_x_is_padded_by_the_spread_along_x_only():
+    """In contact (distance <= combined radius) the line between the two is what matters."""
+    rel, base = np.array([[0.6, 0.0]]), np.array([0.7])
+    x = pair_padding(rel, base, ALONG_X, 0.5, NONE, np.array([0.5]), 0.1)
+    y = pair_padding(rel, base, ALONG_Y, 0.5, NONE, np.array([0.5]), 0.1)
+    assert x[0] == pytest.approx(K * 0.15)
+    assert y[0] == pytest.approx(K * 0.005)  # almost nothing
+    # the same for the other's spread instead of this robot's
+    other = pair_padding(rel, base, None, 0.5, ALONG_X[None], np.array([0.5]), 0.1)
+    assert other[0] == pytest.approx(x[0])
+
+
+def test_a_robot_ahead_in_a_corridor_is_padded_by_the_spread_across_the_line():
+    """Two robots 4 m apart along x, both uncertain along x (amcl in a featureless corridor):
+    the legs of their velocity obstacle are nearly parallel to x, so the spread along x barely
+    widens it; a spread across (along y) does, fully."""
+    rel, base = np.array([[4.0, 0.3]]), np.array([0.7])
+    along = pair_padding(rel, base, ALONG_X, 0.5, ALONG_X[None], np.array([0.5]), 0.1)[0]
+    across = pair_padding(rel, base, ALONG_Y, 0.5, ALONG_Y[None], np.array([0.5]), 0.1)[0]
+    assert along < 0.3 * 2 * K * 0.15  # 0.19 m of 0.64 m
+    assert across == pytest.approx(2 * K * 0.15, rel=0.05)
+    # the disc of radius base + pad shares a tangent with the true shape (the disc of radius
+    # base grown by both ellipses; support along n: base + both spreads along n)
+    for cov, pad in ((ALONG_X, along), (ALONG_Y, across)):
+        d = float(np.hypot(*rel[0]))
+        r = base[0] + pad
+        u = rel[0] / d
+        perp = np.array([-u[1], u[0]])
+        s = r / d
+        tangents = [s * u + sign * math.sqrt(1 - s * s) * perp for sign in (1, -1)]
+        support = [base[0] + 2 * spread_along(cov, n[None], 0.1, 0.5)[0] for n in tangents]
+        assert max(support) == pytest.approx(r, abs=1e-3)
+
+
+def test_no_spread_anywhere_pads_exactly_nothing():
+    rel = np.array([[1.0, 0.0], [0.0, 2.0]])
+    pads = pair_padding(rel, np.array([0.6, 0.6]), None, 0.5, np.zeros((2, 2, 2)), [0.5, 0.5], 0.1)
+    assert pads.tolist() == [0.0, 0.0]
+
+
+@pytest.mark.parametrize("widest", [0.05, 0.3, 0.49, 2.0])
+def test_the_padding_a_publisher_applied_is_recovered_from_its_footprint(widest):
+    body_r = float(np.hypot(0.19, 0.16))
+    pad = min(widest, 2 * body_r)  # me_publisher: capped at twice the robot radius
+    assert shared_padding(padded_footprint(LIZI, pad), widest) == pytest.approx(pad, abs=1e-9)
+
+
+class Robot(Node):
+    def __init__(self, rt):
+        super().__init__(rt, "robot", "/lizi1")
+        rt.params.set("/lizi1/tf_prefix", "lizi1")
+        StaticTransformBroadcaster(self).send_transform(
+            make_transform_stamped("map", "lizi1/base_link", 0.0, (1.0, 2.0, 0), (0, 0, 0, 1))
+        )
+        self.cloud = self.create_publisher(geometry_msgs.PoseArray, "particlecloud", latch=True)
+        self.got = []
+        self.create_subscription(
+            collvoid_msgs.PoseTwistWithCovariance, "/position_share", self.got.append
+        )
+
+
+def test_me_publisher_to_the_table_the_body_and_the_covariance_come_through():
+    rt = Runtime()
+    robot = Robot(rt)
+    MePublisher(rt, "me_publisher", "/lizi1", params={"footprint": LIZI.tolist()})
+    rng = np.random.default_rng(1)
+    xy = rng.standard_normal((300, 2)) * [0.15, 0.01] + [1.0, 2.0]
+    robot.cloud.publish(
+        geometry_msgs.PoseArray(
+            poses=[geometry_msgs.Pose(position=geometry_msgs.Point(x=a, y=b)) for a, b in xy]
+        )
+    )
+    rt.run(duration=0.3)
+    msg = robot.got[-1]
+    table = NeighbourTable()
+    assert table.update(msg) is None
+    r = table.robots["lizi1"]
+    assert r.covariance == pytest.approx(np.cov(xy.T))
+    assert r.body_radius == pytest.approx(math.hypot(0.19, 0.16), abs=1e-9)
+    assert r.radius > r.body_radius + 0.3  # padded for consumers that ignore the covariance
+    near = table.near(0.3, (0.0, 0.0), 10.0, 5)
+    assert near.body_radii.tolist() == [r.body_radius]
+    assert near.covariances[0] == pytest.approx(r.covariance)
+
+
+def message(rid, cov=None, radius=0.4, x=1.0):
+    msg = collvoid_msgs.PoseTwistWithCovariance(robot_id=rid, radius=radius)
+    msg.header.stamp = Time.from_sec(1.0)
+    msg.pose.pose.position = geometry_msgs.Point(x=x, y=0.0)
+    msg.footprint.polygon.points = [geometry_msgs.Point32(x=a, y=b) for a, b in LIZI]
+    if cov is not None:
+        msg.pose.covariance[[0, 1, 6, 7]] = np.asarray(cov, dtype=float).reshape(-1)
+    return msg
+
+
+def planner_stub(own_cov=None):
+    """What `CollvoidLocalPlanner.neighbour_radii` reads of the planner."""
+    return SimpleNamespace(_covariance=own_cov, body_radius=0.25, params=SimpleNamespace(eps=0.1))
+
+
+def test_a_robot_without_covariance_keeps_todays_radius_rule():
+    table = NeighbourTable()
+    table.update(message("old", radius=0.4))
+    r = table.robots["old"]
+    assert r.covariance is None and r.body_radius == 0.4
+    near = table.near(1.0, (0.0, 0.0), 10.0, 5)
+    # fake localization here too: the radii as sent, the very array
+    assert CollvoidLocalPlanner.neighbour_radii(planner_stub(), 0.4, np.zeros(2), near) is (
+        near.radii
+    )
+    # this robot uncertain, the other as sent plus this robot's spread (in contact: along x)
+    got = CollvoidLocalPlanner.neighbour_radii(planner_stub(ALONG_X), 0.7, np.zeros(2), near)
+    assert got[0] == pytest.approx(0.4 + K * 0.15)
+
+
+def test_a_robot_sharing_a_covariance_is_its_body_padded_in_the_direction_that_matters():
+    table = NeighbourTable()
+    pad = widest_spread(ALONG_X, 0.1, 2 * math.hypot(0.19, 0.16))
+    msg = message("amcl", cov=ALONG_X, x=4.0)
+    msg.footprint.polygon.points = [
+        geometry_msgs.Point32(x=a, y=b) for a, b in padded_footprint(LIZI, pad)
+    ]
+    msg.radius = float(np.hypot(0.19 + pad, 0.16 + pad))
+    table.update(msg)
+    near = table.near(1.0, (0.0, 0.0), 10.0, 5)
+    got = CollvoidLocalPlanner.neighbour_radii(planner_stub(), 0.35, np.zeros(2), near)[0]
+    body = math.hypot(0.19, 0.16)
+    # ahead along the corridor: padded by 0.05 m, not the 0.32 m of its widest spread
+    assert body + 0.03 < got < body + 0.08 < msg.radius - 0.3
+
+
+@pytest.mark.parametrize(
+    "cov, words",
+    [
+        ([[math.nan, 0.0], [0.0, 0.01]], "non-finite covariance"),
+        ([[0.01, 0.0], [0.0, -0.01]], "not symmetric positive semi-definite"),
+        ([[0.01, 0.005], [0.0, 0.01]], "not symmetric positive semi-definite"),
+    ],
+)
+def test_a_bad_covariance_is_ignored_with_one_warning_naming_the_robot(cov, words, caplog):
+    rt = Runtime()
+    node = Node(rt, "listener", "/lizi2")
+    share = PositionShare(node)
+    with caplog.at_level(logging.WARNING):
+        for _ in range(3):
+            share.on_message(message("lizi7", cov=cov, radius=0.4))
+    warned = [r.getMessage() for r in caplog.records if "lizi7" in r.getMessage()]
+    assert len(warned) == 1 and words in warned[0]
+    r = share.table.robots["lizi7"]  # the robot is kept, with the radius as sent
+    assert r.covariance is None and r.body_radius == 0.4 and share.rejected == 0

@@ -158,12 +158,13 @@ def test_a_robot_without_covariance_keeps_todays_radius_rule():
     assert r.covariance is None and r.body_radius == 0.4
     near = table.near(1.0, (0.0, 0.0), 10.0, 5)
     # fake localization here too: the radii as sent, the very array
-    assert CollvoidLocalPlanner.neighbour_radii(planner_stub(), 0.4, np.zeros(2), near) is (
-        near.radii
-    )
+    orca, wide = CollvoidLocalPlanner.neighbour_radii(planner_stub(), 0.4, np.zeros(2), near)
+    assert orca is near.radii and wide is near.radii
     # this robot uncertain, the other as sent plus this robot's spread (in contact: along x)
-    got = CollvoidLocalPlanner.neighbour_radii(planner_stub(ALONG_X), 0.7, np.zeros(2), near)
+    got, wide = CollvoidLocalPlanner.neighbour_radii(planner_stub(ALONG_X), 0.7, np.zeros(2), near)
     assert got[0] == pytest.approx(0.4 + K * 0.15)
+    # side by side (the line between them across x) only the spread across x counts, halved
+    assert wide[0] == pytest.approx(0.4 + 0.5 * K * 0.005)
 
 
 def test_a_robot_sharing_a_covariance_is_its_body_padded_in_the_direction_that_matters():
@@ -176,7 +177,7 @@ def test_a_robot_sharing_a_covariance_is_its_body_padded_in_the_direction_that_m
     msg.radius = float(np.hypot(0.19 + pad, 0.16 + pad))
     table.update(msg)
     near = table.near(1.0, (0.0, 0.0), 10.0, 5)
-    got = CollvoidLocalPlanner.neighbour_radii(planner_stub(), 0.35, np.zeros(2), near)[0]
+    got = CollvoidLocalPlanner.neighbour_radii(planner_stub(), 0.35, np.zeros(2), near)[0][0]
     body = math.hypot(0.19, 0.16)
     # ahead along the corridor: padded by 0.05 m, not the 0.32 m of its widest spread
     assert body + 0.03 < got < body + 0.08 < msg.radius - 0.3

@@ -76,7 +76,11 @@ from fleetsim.nav.multirobot.holonomic import (
 )
 from fleetsim.nav.multirobot.orca import orca_halfplanes, orca_velocity
 from fleetsim.nav.multirobot.position_share import PositionShare
-from fleetsim.nav.multirobot.uncertainty import cloud_covariance, pair_padding
+from fleetsim.nav.multirobot.uncertainty import (
+    cloud_covariance,
+    pair_padding,
+    side_by_side_padding,
+)
 from fleetsim.nav.multirobot.yielding import Retreat, narrow_meetings
 from fleetsim.runtime import load_params
 
@@ -221,38 +225,40 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
             err += (p.max_error_holo - p.min_error_holo) * min(1.0, speed / p.max_vel_x)
         return self.body_radius + p.safety_margin + err
 
-    def neighbour_radii(self, own_r: float, map_xy: np.ndarray, near: Any) -> np.ndarray:
-        """The others' radii (N,) m for ORCA against this robot (``own_r`` m, at ``map_xy``):
-        each one's body grown by both robots' localization spreads across the legs of the
-        pair's velocity obstacle; the radius as sent for a robot that shares no covariance.
-        With no spread anywhere (fake_localization) the radii as sent, exactly."""
+    def neighbour_radii(
+        self, own_r: float, map_xy: np.ndarray, near: Any, map_vel: Any = (0.0, 0.0)
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """The others' radii (N,) m against this robot (``own_r`` m, at ``map_xy``, moving at
+        ``map_vel`` m/s): for ORCA, each one's body grown by both robots' localization spreads
+        across the leg of the pair's velocity obstacle the relative velocity passes
+        (`pair_padding`); for the width of a passage, by half the
+        spreads across the line between the two (`side_by_side_padding`: the spreads part the
+        two robots, not a robot from its walls, which it sees itself). The radius as sent for
+        a robot that shares no covariance; with no spread anywhere (fake_localization) the
+        radii as sent, exactly."""
         covs = near.covariances
         if self._covariance is None and not covs.any():
-            return near.radii
+            return near.radii, near.radii
         shared = covs.reshape(-1, 4).any(axis=1)
         body = np.where(shared, near.body_radii, near.radii)
-        pad = pair_padding(
-            near.positions - map_xy,
-            own_r + body,
-            self._covariance,
-            2.0 * self.body_radius,
-            covs,
-            2.0 * body,
-            self.params.eps,
-        )
-        return body + pad
+        rel, cap, eps = near.positions - map_xy, 2.0 * self.body_radius, self.params.eps
+        vrel = np.asarray(map_vel, dtype=np.float64) - near.velocities
+        pad = pair_padding(rel, own_r + body, self._covariance, cap, covs, 2.0 * body, eps, vrel)
+        across = side_by_side_padding(rel, self._covariance, cap, covs, 2.0 * body, eps)
+        return body + pad, body + 0.5 * across
 
     def _map_to_local(self) -> tuple[float, float, float]:
         if self.frame == MAP_FRAME:
             return 0.0, 0.0, 0.0
         return self.node.tf_buffer.lookup_pose2d(self.frame, MAP_FRAME, 0.0)
 
-    def _neighbours(self, xy: np.ndarray, own_r: float) -> tuple:
+    def _neighbours(self, xy: np.ndarray, own_r: float, vel: np.ndarray) -> tuple:
         """The robots around ``xy`` (m, local costmap frame) on /position_share, in that frame:
         (own position in map (2,), ids, positions (N, 2), velocities (N, 2), radii (N,) against
-        this robot of radius ``own_r`` (`neighbour_radii`), ORCA responsibilities (N,): all of
-        it for a robot not ``controlled`` or standing still, half otherwise; controlled (N,)
-        bool, yaws (N,)). None around without tf."""
+        this robot of radius ``own_r`` moving at ``vel`` (`neighbour_radii`), ORCA
+        responsibilities (N,): all of it for a robot not ``controlled`` or standing still, half
+        otherwise; controlled (N,) bool, yaws (N,), radii (N,) for the width of a passage).
+        None around without tf."""
         p, now = self.params, self.node.now()
         ids: list[str] = []
         pos, nvel, radii = np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0)
@@ -260,7 +266,7 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
         try:
             tx, ty, tyaw = self._map_to_local()
         except TransformError:
-            return xy, ids, pos, nvel, radii, resp, controlled, yaws
+            return xy, ids, pos, nvel, radii, resp, controlled, yaws, radii
         map_xy = rotated(xy - [tx, ty], -tyaw)
         near = self.share.table.near(
             now, (map_xy[0], map_xy[1]), p.neighbor_dist, p.max_neighbors, self.robot_id
@@ -272,8 +278,8 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
         still = np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED
         resp = np.where(~near.controlled | still, 1.0, 0.5)
         yaws = np.array([r.yaw for r in near.robots]) + tyaw
-        radii = self.neighbour_radii(own_r, map_xy, near)
-        return map_xy, near.ids, pos, nvel, radii, resp, near.controlled, yaws
+        radii, wide = self.neighbour_radii(own_r, map_xy, near, rotated(vel, -tyaw))
+        return map_xy, near.ids, pos, nvel, radii, resp, near.controlled, yaws, wide
 
     def holonomic_velocity(self, xy, yaw, vel, carrot, remaining) -> np.ndarray:
         """The ORCA velocity for this cycle, (2,) m/s in the local costmap's frame."""
@@ -282,7 +288,9 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
             carrot, xy, remaining, p.max_vel_x, p.min_vel_x, DECELERATION * p.acc_lim_x
         )
         own_r = self.own_radius(float(np.hypot(*vel)))
-        map_xy, ids, pos, nvel, radii, resp, controlled, yaws = self._neighbours(xy, own_r)
+        map_xy, ids, pos, nvel, radii, resp, controlled, yaws, wide = self._neighbours(
+            xy, own_r, vel
+        )
         dist = np.hypot(pos[:, 0] - xy[0], pos[:, 1] - xy[1])
         active = {k: d for k, d, c in zip(ids, dist.tolist(), controlled) if c}
         narrow: list[str] = []
@@ -295,7 +303,7 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
                 pos - xy,
                 nvel,
                 yaws,
-                radii,
+                wide,
                 controlled,
                 own_r,
             )
@@ -305,7 +313,7 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
         if self.yielding_to is not None:
             k = ids.index(self.yielding_to)
             along = carrot - self.plan[self.plan_index, :2]  # the plan's way here
-            pref = self._yield_velocity(xy, along, pos[k], own_r, radii[k], remaining, pref)
+            pref = self._yield_velocity(xy, along, pos[k], own_r, wide[k], remaining, pref)
             if self.yielding_to is not None:
                 resp[k] = 1.0
                 self.waiting = not pref.any()

@@ -99,7 +99,8 @@ def pair_padding(
     covs: np.ndarray,
     caps: np.ndarray,
     eps: float,
-    iterations: int = 8,
+    vrel: np.ndarray | None = None,
+    iterations: int = 24,
 ) -> np.ndarray:
     """What each pair's combined radius grows by for the two robots' localization spreads, m.
 
@@ -108,11 +109,16 @@ def pair_padding(
     spread_own(n) + spread_other(n) (`spread_along`, each capped). A velocity obstacle is the
     cone of the shape's tangents from the robot, and a disc of radius R at distance d has its
     tangents' normals at acos(R / d) from the line between the two. So the padding is the
-    support along those normals (the larger of the two sides), found by a fixed-point
-    iteration: the disc then shares the true shape's tangent on that side (and covers it on the
-    other). Far apart that is the spread *across* the line between them (a robot uncertain only
-    along a corridor is padded by almost nothing against one ahead of it in the corridor); in
-    contact (d <= R) it is the spread along the line.
+    support along the normal of the leg on the side the relative velocity ``vrel`` (N, 2) passes
+    on (ORCA's half-plane comes from the leg nearest the relative velocity; both legs' larger
+    when ``vrel`` is None or points at the other robot): the R with R = base + support(n(R)),
+    found by bisection (the support may fall as R grows: a plain fixed-point iteration
+    oscillated), so the disc shares the true shape's tangent on that side. Taking the larger
+    side always would stall two robots uncertain along a corridor as soon as they stand
+    diagonally: the leg behind the other robot runs along the corridor, across their whole
+    spread. Far apart the padding is the spread *across* the line between them (a robot
+    uncertain only along a corridor is padded by almost nothing against one ahead of it in the
+    corridor); in contact (d <= R) it is the spread along the line.
 
     rel : (N, 2) the others relative to this robot, m, the frame of the covariances;
     base : (N,) combined radii without localization, m; own_cov : (2, 2) or None (exact);
@@ -120,24 +126,67 @@ def pair_padding(
     Returns (N,) m, exactly 0.0 where neither robot is uncertain.
     """
     rel = np.asarray(rel, dtype=np.float64).reshape(-1, 2)
+    support, d, u, perp = _pair_support(rel, own_cov, own_cap, covs, caps, eps)
+    if support is None:
+        return np.zeros(rel.shape[0])
+    # +1: the right leg (the relative velocity passes clockwise of the other robot), -1 the
+    # left, 0: both
+    side = np.zeros(rel.shape[0])
+    if vrel is not None:
+        v = np.asarray(vrel, dtype=np.float64).reshape(-1, 2)
+        cross = rel[:, 0] * v[:, 1] - rel[:, 1] * v[:, 0]
+        side = np.where(np.abs(cross) > 1e-3 * d * np.hypot(v[:, 0], v[:, 1]), -np.sign(cross), 0.0)
+    base = np.asarray(base, dtype=np.float64).reshape(-1)
+
+    def excess(pad: np.ndarray) -> np.ndarray:
+        """support(n(base + pad)) - pad: >= 0 at pad 0, <= 0 at pad = the largest support."""
+        s = np.clip((base + pad) / np.maximum(d, 1e-12), 0.0, 1.0)[:, None]
+        c = np.sqrt(1.0 - s * s)
+        right, left = support(s * u + c * perp), support(s * u - c * perp)
+        return np.where(side > 0, right, np.where(side < 0, left, np.maximum(right, left))) - pad
+
+    lo = np.zeros(rel.shape[0])
+    # sqrt(n' cov n) is a norm of n, so no support exceeds the sum of two orthogonal ones
+    hi = support(u) + support(perp)
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        up = excess(mid) >= 0.0
+        lo, hi = np.where(up, mid, lo), np.where(up, hi, mid)
+    return lo
+
+
+def side_by_side_padding(
+    rel: np.ndarray,
+    own_cov: np.ndarray | None,
+    own_cap: float,
+    covs: np.ndarray,
+    caps: np.ndarray,
+    eps: float,
+) -> np.ndarray:
+    """What each pair's distance must grow by to pass side by side, m: both spreads across the
+    line between the two now (side by side, that line will be the one between them). The
+    question of a passage wide enough for two; arguments as `pair_padding`'s."""
+    rel = np.asarray(rel, dtype=np.float64).reshape(-1, 2)
+    support, _, _, perp = _pair_support(rel, own_cov, own_cap, covs, caps, eps)
+    return np.zeros(rel.shape[0]) if support is None else support(perp)
+
+
+def _pair_support(rel, own_cov, own_cap, covs, caps, eps):
+    """(support along unit normals (N, 2) -> (N,) m, or None with no spread anywhere;
+    distances (N,); unit directions to the others (N, 2); their left normals (N, 2))."""
     n = rel.shape[0]
     cov = np.zeros((2, 2)) if own_cov is None else np.asarray(own_cov, dtype=np.float64)
     covs = np.asarray(covs, dtype=np.float64).reshape(n, 2, 2)
-    if n == 0 or (not cov.any() and not covs.any()):
-        return np.zeros(n)
     d = np.hypot(rel[:, 0], rel[:, 1])
     u = np.where(d[:, None] > 0.0, rel / np.maximum(d, 1e-12)[:, None], [1.0, 0.0])
     perp = np.stack((-u[:, 1], u[:, 0]), axis=1)
+    if n == 0 or (not cov.any() and not covs.any()):
+        return None, d, u, perp
 
     def support(normals: np.ndarray) -> np.ndarray:
         return spread_along(cov, normals, eps, own_cap) + spread_along(covs, normals, eps, caps)
 
-    pad = support(perp)
-    for _ in range(iterations):
-        s = np.clip((base + pad) / np.maximum(d, 1e-12), 0.0, 1.0)[:, None]
-        c = np.sqrt(1.0 - s * s)
-        pad = np.maximum(support(s * u + c * perp), support(s * u - c * perp))
-    return pad
+    return support, d, u, perp
 
 
 def shared_padding(footprint: np.ndarray, widest: float) -> float:

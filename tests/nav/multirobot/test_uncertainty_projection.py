@@ -70,10 +70,12 @@ def test_a_robot_ahead_in_a_corridor_is_padded_by_the_spread_across_the_line():
     rel, base = np.array([[4.0, 0.3]]), np.array([0.7])
     along = pair_padding(rel, base, ALONG_X, 0.5, ALONG_X[None], np.array([0.5]), 0.1)[0]
     across = pair_padding(rel, base, ALONG_Y, 0.5, ALONG_Y[None], np.array([0.5]), 0.1)[0]
-    assert along < 0.3 * 2 * K * 0.15  # 0.19 m of 0.64 m
-    assert across == pytest.approx(2 * K * 0.15, rel=0.05)
+    assert along < 0.3 * math.sqrt(2) * K * 0.15
+    # two independent spreads of 0.32 m: the relative position's is sqrt(2) x 0.32 m
+    assert across == pytest.approx(math.sqrt(2) * K * 0.15, rel=0.05)
     # the disc of radius base + pad shares a tangent with the true shape (the disc of radius
-    # base grown by both ellipses; support along n: base + both spreads along n)
+    # base grown by the relative position's spread; support along n: base + sqrt(2) x the
+    # spread of one along n)
     for cov, pad in ((ALONG_X, along), (ALONG_Y, across)):
         d = float(np.hypot(*rel[0]))
         r = base[0] + pad
@@ -81,7 +83,9 @@ def test_a_robot_ahead_in_a_corridor_is_padded_by_the_spread_across_the_line():
         perp = np.array([-u[1], u[0]])
         s = r / d
         tangents = [s * u + sign * math.sqrt(1 - s * s) * perp for sign in (1, -1)]
-        support = [base[0] + 2 * spread_along(cov, n[None], 0.1, 0.5)[0] for n in tangents]
+        support = [
+            base[0] + math.sqrt(2) * spread_along(cov, n[None], 0.1, 0.5)[0] for n in tangents
+        ]
         assert max(support) == pytest.approx(r, abs=1e-3)
 
 
@@ -202,3 +206,18 @@ def test_a_bad_covariance_is_ignored_with_one_warning_naming_the_robot(cov, word
     assert len(warned) == 1 and words in warned[0]
     r = share.table.robots["lizi7"]  # the robot is kept, with the radius as sent
     assert r.covariance is None and r.body_radius == 0.4 and share.rejected == 0
+
+
+def test_the_leg_the_relative_velocity_passes_sets_the_padding():
+    """Two robots uncertain along x, standing diagonally (0.4 m apart along x, 1.3 m across):
+    passing each other along x, the leg that matters is the near one, nearly across x; the far
+    leg runs much more along x, over the spread (both legs' larger without a velocity, or
+    drawing apart, where the far leg is the near one)."""
+    rel, base = np.array([[0.4, 1.3]]), np.array([0.57])
+    covs, caps = ALONG_X[None], np.array([0.5])
+    passing = pair_padding(rel, base, ALONG_X, 0.5, covs, caps, 0.1, vrel=[[0.6, 0.0]])[0]
+    apart = pair_padding(rel, base, ALONG_X, 0.5, covs, caps, 0.1, vrel=[[-0.6, 0.0]])[0]
+    both = pair_padding(rel, base, ALONG_X, 0.5, covs, caps, 0.1)[0]
+    assert passing < 0.7 * both and apart == both
+    mirrored = pair_padding(-rel, base, ALONG_X, 0.5, covs, caps, 0.1, vrel=[[-0.6, 0.0]])[0]
+    assert mirrored == pytest.approx(passing)

@@ -105,8 +105,10 @@ def pair_padding(
     """What each pair's combined radius grows by for the two robots' localization spreads, m.
 
     The pair's shape in the velocity obstacle is the disc of radius ``base`` (both bodies and
-    margins) grown by both spread ellipses; its support along a unit normal n is ``base`` +
-    spread_own(n) + spread_other(n) (`spread_along`, each capped). A velocity obstacle is the
+    margins) grown by the spread of their relative position; its support along a unit normal
+    n is ``base`` + hypot(spread_own(n), spread_other(n)) (`spread_along`, each capped; two
+    independent localizations: the 1 - eps spread of the difference, where collvoid adds the
+    two radii). A velocity obstacle is the
     cone of the shape's tangents from the robot, and a disc of radius R at distance d has its
     tangents' normals at acos(R / d) from the line between the two. So the padding is the
     support along the normal of the leg on the side the relative velocity ``vrel`` (N, 2) passes
@@ -146,7 +148,7 @@ def pair_padding(
         return np.where(side > 0, right, np.where(side < 0, left, np.maximum(right, left))) - pad
 
     lo = np.zeros(rel.shape[0])
-    # sqrt(n' cov n) is a norm of n, so no support exceeds the sum of two orthogonal ones
+    # each spread is a norm of n (capped), so no support exceeds the sum of two orthogonal ones
     hi = support(u) + support(perp)
     for _ in range(iterations):
         mid = 0.5 * (lo + hi)
@@ -184,7 +186,11 @@ def _pair_support(rel, own_cov, own_cap, covs, caps, eps):
         return None, d, u, perp
 
     def support(normals: np.ndarray) -> np.ndarray:
-        return spread_along(cov, normals, eps, own_cap) + spread_along(covs, normals, eps, caps)
+        # the two localizations are independent: their relative position's spread along n is
+        # the root of the sum of squares (each robot's capped first), not the sum
+        return np.hypot(
+            spread_along(cov, normals, eps, own_cap), spread_along(covs, normals, eps, caps)
+        )
 
     return support, d, u, perp
 

@@ -84,6 +84,19 @@ def test_swap_corridor_two_robots_pass_despite_a_broken_robot_on_the_topic(
         assert len(said) == 1, said
 
 
+def test_swap_corridor_with_amcl_pads_by_the_spread_across_not_along(monkeypatch, tmp_path):
+    """localization:=amcl: the particles spread 0.3-0.5 m along the featureless corridor; padded
+    by that in every direction the pair never passed (0/2 goals in 60 s). Padded by the spread
+    across the velocity obstacle's legs (issue 18), both arrive without contact."""
+    monkeypatch.chdir(tmp_path)
+    with session("swap_corridor", robots="2", localization="amcl", gui="false") as s:
+        s.run(duration=45.0, until_goals=True)
+        assert_clean_success(s, tmp_path)
+        # the feature was at work: lizi1's planner holds lizi2's shared covariance
+        table = s.nodes["/lizi1/move_base"].controller.share.table
+        assert table.robots["lizi2"].covariance is not None
+
+
 def test_circle_of_eight_reaches_the_antipodes(monkeypatch, tmp_path):
     monkeypatch.chdir(tmp_path)
     with session("circle", robots="8", gui="false") as s:

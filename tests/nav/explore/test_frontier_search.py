@@ -59,28 +59,3 @@ def test_a_door_with_a_little_inflation_cost_does_not_hide_the_frontiers_beyond_
     assert fs[0].centroid == pytest.approx((2.05, 1.0))
     d[9:11, 10] = 99  # a door the robot does not fit through: nothing reachable beyond
     assert frontiers_from_grid(d, 0.1, (0.0, 0.0), (0.35, 1.05)) == []
-
-
-def test_path_distance_goes_round_walls_through_drivable_cells():
-    from fleetsim.nav.explore.frontier_search import path_distance
-
-    data = np.zeros((20, 30), dtype=np.int8)
-    data[:15, 10] = 100  # a wall along x 1.0-1.1 m up to y 1.5 m
-    data[:5, 11:16] = -1  # an unknown pocket east of it
-    robot = (0.85, 0.25)
-    (pocket,) = frontiers_from_grid(data, 0.1, (0.0, 0.0), robot)
-    straight = pocket.min_distance
-    d = path_distance(data, 0.1, (0.0, 0.0), robot, pocket.points)
-    # north 1.3 m to the wall's end, 0.3 m east past it, south 1.0 m to the pocket's edge
-    # (cell to cell, diagonal steps where it can): ~2.3-2.6 m against 0.36 m
-    assert straight == pytest.approx(0.36, abs=0.01)
-    assert 2.3 < d < 2.7
-    # nothing drivable reaches it: inf; without walls, about the straight line
-    closed = data.copy()
-    closed[14:, 10] = 100
-    assert path_distance(closed, 0.1, (0.0, 0.0), robot, pocket.points) == np.inf
-    open_ = data.copy()
-    open_[:, 10] = 0
-    assert path_distance(open_, 0.1, (0.0, 0.0), robot, pocket.points) == pytest.approx(
-        straight, abs=0.1
-    )

@@ -32,12 +32,6 @@ on ``~blacklist`` (geometry_msgs/PoseArray) and skips the frontiers its peers bl
 (``peer_blacklists``: two hunters each gave up on a corner of the office and then crossed the
 office to the corner the other had given up on). The rules: `fleetsim.nav.explore.peers`.
 
-explore_lite measures progress towards a frontier by the straight-line distance to its nearest
-cell, which grows while the robot drives out of one room and along a corridor into the next:
-it blacklisted the office's desk-corner frontiers in the next room while the hunter was on its
-way there (one hunter, seed 1: 110 s on goals later blacklisted). ``progress_on_path`` (a
-fleetsim addition, off by default) measures it through the cells the robot can drive on.
-
 ``costmap_updates_topic`` is accepted but fleetsim's costmaps publish whole grids only (see
 `fleetsim.nav.costmap.costmap_ros`), so it is not subscribed. ``orientation_scale`` is accepted
 and, as in explore_lite, unused.
@@ -58,7 +52,7 @@ from fleetsim.nav.move_base_support import pose_stamped
 from fleetsim.runtime import Node, param
 from fleetsim.tf.names import resolve_frame_once
 
-from .frontier_search import Frontier, frontiers_from_grid, path_distance
+from .frontier_search import Frontier, frontiers_from_grid
 from .peers import frontier_for_robot
 
 BLACKLIST_RADIUS_CELLS = 5  # explore_lite's goalOnBlacklist tolerance
@@ -104,11 +98,6 @@ class ExploreParams:
         unit="m",
         range=(0.0, None),
         help="keep the frontier it heads for unless another is cheaper by this much distance",
-    )
-    progress_on_path: bool = param(
-        False,
-        help="progress_timeout measures the distance to the frontier through drivable cells, "
-        "not the straight line (explore_lite's)",
     )
 
 
@@ -304,12 +293,8 @@ class Explore(Node):
         target = chosen.centroid
         same = self.goal is not None and math.dist(target, self.goal) < 1e-6
         # progress as explore_lite measures it: towards the frontier's nearest cell (its
-        # centroid may lie behind a wall the robot has to go round); with progress_on_path
-        # along the way there, which can lead away first (out of a room, along a corridor)
+        # centroid may lie behind a wall the robot has to go round)
         distance = chosen.min_distance
-        if p.progress_on_path:
-            origin = (info.origin.position.x, info.origin.position.y)
-            distance = path_distance(data, info.resolution, origin, robot, chosen.points)
         now = self.now()
         if not same or distance < self._best_distance:
             self._best_distance = distance

@@ -13,19 +13,14 @@ in that region. The region is the 4-connected component holding the robot's cell
 nearest such cell), found with `scipy.ndimage.label` instead of a queue, as are the frontiers.
 A frontier's ``cost = potential_scale * min_distance * res - gain_scale * size * res``; those
 smaller than ``min_frontier_size`` m are dropped, and the list is sorted by cost.
-
-`path_distance` is a fleetsim addition for explore's ``progress_on_path``: the distance from
-the robot to a frontier through the cells it can drive on, not the straight line.
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import ndimage, sparse
-from scipy.sparse.csgraph import dijkstra
+from scipy import ndimage
 
 FOUR = ndimage.generate_binary_structure(2, 1)
 EIGHT = ndimage.generate_binary_structure(2, 2)
@@ -61,10 +56,21 @@ def frontiers_from_grid(
     The robot reaches every cell of cost below `INSCRIBED` connected to it.
     """
     data = np.asarray(data)
-    region = _reachable(data, resolution, origin, robot)
-    if region is None:
+    h, w = data.shape
+    rx = int(np.floor((robot[0] - origin[0]) / resolution))
+    ry = int(np.floor((robot[1] - origin[1]) / resolution))
+    if not (0 <= rx < w and 0 <= ry < h):
         return []
-    reachable = region[0] & (data == 0)
+    free = data == 0
+    passable = (data >= 0) & (data < INSCRIBED)
+    if not free.any():
+        return []
+    labels, _ = ndimage.label(passable, structure=FOUR)
+    start = labels[ry, rx]
+    if start == 0:  # the robot stands on cost: start from the nearest free cell, as explore_lite
+        _, (iy, ix) = ndimage.distance_transform_edt(~free, return_indices=True)
+        start = labels[iy[ry, rx], ix[ry, rx]]
+    reachable = (labels == start) & free
     unknown = data < 0
     frontier = unknown & ndimage.binary_dilation(reachable, structure=FOUR)
     groups, count = ndimage.label(frontier, structure=EIGHT)
@@ -98,74 +104,3 @@ def frontiers_from_grid(
         )
     out.sort(key=lambda f: f.cost)
     return out
-
-
-def _reachable(
-    data: np.ndarray, resolution: float, origin: tuple[float, float], robot: tuple[float, float]
-) -> tuple[np.ndarray, tuple[int, int]] | None:
-    """The (H, W) bool cells the robot can drive through (known, cost below `INSCRIBED`,
-    4-connected to its cell, or to the nearest free cell when it stands on cost, as
-    explore_lite starts) and its cell (row, col); None when it is off the grid or nothing is
-    free."""
-    h, w = data.shape
-    rx = int(np.floor((robot[0] - origin[0]) / resolution))
-    ry = int(np.floor((robot[1] - origin[1]) / resolution))
-    free = data == 0
-    if not (0 <= rx < w and 0 <= ry < h) or not free.any():
-        return None
-    passable = (data >= 0) & (data < INSCRIBED)
-    labels, _ = ndimage.label(passable, structure=FOUR)
-    start = labels[ry, rx]
-    if start == 0:
-        _, (iy, ix) = ndimage.distance_transform_edt(~free, return_indices=True)
-        ry, rx = int(iy[ry, rx]), int(ix[ry, rx])
-        start = labels[ry, rx]
-    return labels == start, (ry, rx)
-
-
-def path_distance(
-    data: np.ndarray,
-    resolution: float,
-    origin: tuple[float, float],
-    robot: tuple[float, float],
-    points: np.ndarray,
-) -> float:
-    """Distance (m) from ``robot`` to the nearest of ``points`` (frontier cell centres, m)
-    through the cells it can drive on (8-connected, diagonal steps sqrt(2) cells; a frontier
-    cell is reached from a drivable 4-neighbour); inf when none is reachable.
-
-    Dijkstra over the robot's drivable region with scipy's ``csgraph`` (one run per call).
-    """
-    data = np.asarray(data)
-    region = _reachable(data, resolution, origin, robot)
-    if region is None:
-        return math.inf
-    ok, (ry, rx) = region
-    h, w = ok.shape
-    index = np.full((h, w), -1, dtype=np.int64)
-    ys, xs = np.nonzero(ok)
-    index[ys, xs] = np.arange(len(ys))
-    rows, cols, costs = [], [], []
-    for dy, dx in ((0, 1), (1, 0), (1, 1), (1, -1)):
-        y2, x2 = ys + dy, xs + dx
-        good = (y2 < h) & (x2 >= 0) & (x2 < w)
-        good[good] &= ok[y2[good], x2[good]]
-        rows.append(index[ys[good], xs[good]])
-        cols.append(index[y2[good], x2[good]])
-        costs.append(np.full(int(good.sum()), math.hypot(dx, dy) * resolution))
-    n = len(ys)
-    graph = sparse.csr_matrix(
-        (np.concatenate(costs), (np.concatenate(rows), np.concatenate(cols))), shape=(n, n)
-    )
-    dist = dijkstra(graph, directed=False, indices=int(index[ry, rx]))
-    px = np.floor((np.asarray(points)[:, 0] - origin[0]) / resolution).astype(int)
-    py = np.floor((np.asarray(points)[:, 1] - origin[1]) / resolution).astype(int)
-    best = math.inf
-    for dy, dx in ((0, 1), (0, -1), (1, 0), (-1, 0)):
-        ny, nx = py + dy, px + dx
-        inside = (ny >= 0) & (ny < h) & (nx >= 0) & (nx < w)
-        k = index[ny[inside], nx[inside]]
-        k = k[k >= 0]
-        if len(k):
-            best = min(best, float(dist[k].min()) + resolution)
-    return best

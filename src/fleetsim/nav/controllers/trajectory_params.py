@@ -79,7 +79,7 @@ class TrajectoryPlannerParams:
     forward_point_distance: float = param(
         0.325, unit="m", range=(0.0, None), help="how far ahead that point is (dwa_local_planner)"
     )
-    # base_local_planner reads "dwa" with default true (trajectory_planner_ros.cpp), as its wiki says
+    # base_local_planner reads "dwa" with default true (trajectory_planner_ros.cpp; its wiki too)
     dwa: bool = param(True, help="Dynamic Window Approach (velocity window of one cycle)")
     simple_attractor: bool = param(False, help="follow the goal blindly (testing)")
     publish_cost_grid_pc: bool = param(False, help="publish the scoring grid as a cloud")

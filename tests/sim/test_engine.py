@@ -1,4 +1,5 @@
 import warnings
+from pathlib import Path
 
 import mujoco
 import numpy as np
@@ -256,3 +257,19 @@ def test_ground_planes_sit_in_static_bodies_of_their_own(diffbot):
     assert not any(e.model.body(b).name.endswith(":plane") for b in range(e.model.nbody))
     e.advance(0.3)
     assert e.model_pose("r")[0][2] < -0.1  # falls without its floor
+
+
+def test_a_robot_off_the_map_of_a_map_world_is_refused_naming_pose_and_extent(tmp_path):
+    """A map world is the map's walls and an empty floor beyond: a start meant for another
+    world (slam_explore's office starts in open_room) is an error, not an endless drive."""
+    import fleetsim
+
+    room = Path(fleetsim.__file__).parent / "assets" / "maps" / "open_room.yaml"
+    robot = parse_urdf(robot_text("diffbot.urdf"))
+    e = Engine(room)
+    e.spawn_robot("inside", robot, (6.0, 6.0, 0, 0, 0, 0))
+    with pytest.raises(
+        SimulationError, match=r"'outside'.*\(26, 10\) is outside the map.*x 0\.\.14"
+    ):
+        e.spawn_robot("outside", robot, (26.0, 10.0, 0, 0, 0, 0))
+    assert "outside" not in e.models and "inside" in e.models

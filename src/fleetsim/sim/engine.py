@@ -7,6 +7,7 @@ with ``MjSpec.recompile``, which carries the state of everything else over by na
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -191,6 +192,29 @@ class Engine(StateQueries):
             raise
         return [entry for entry, _ in added]
 
+    def _check_on_map(self, name: str, pose) -> None:
+        """A map world is walls extruded over its map and an empty floor beyond: a robot placed
+        off the map (a start meant for another world) would drive, map and explore an endless
+        empty floor, so it is refused, naming the pose and the map's extent."""
+        grid = self.world.occupancy
+        if grid is None:
+            return
+        ox, oy, oyaw = grid.origin
+        dx, dy = pose[0] - ox, pose[1] - oy
+        u = math.cos(oyaw) * dx + math.sin(oyaw) * dy  # in the map's own frame
+        v = -math.sin(oyaw) * dx + math.cos(oyaw) * dy
+        h, w = grid.occupied.shape
+        width, height = w * grid.resolution, h * grid.resolution
+        if 0.0 <= u <= width and 0.0 <= v <= height:
+            return
+        where = f"x {ox:g}..{ox + width:g}, y {oy:g}..{oy + height:g}"
+        if oyaw:
+            where += f" before the origin's yaw {oyaw:g} rad"
+        raise SimulationError(
+            f"model '{name}': its spawn pose ({pose[0]:g}, {pose[1]:g}) is outside the map of "
+            f"world {grid.source} ({where}); a map world has nothing there but an empty floor"
+        )
+
     def _add_robot(self, name, robot, pose=(0, 0, 0, 0, 0, 0), namespace=None, tf_prefix=None):
         self._check_new_name(name)
         if isinstance(robot, str | Path):
@@ -200,6 +224,7 @@ class Engine(StateQueries):
         ns = namespace if namespace is not None else f"/{name}"
         prefix = tf_prefix if tf_prefix is not None else ns.strip("/")
         pose0 = tuple(float(v) for v in pose)
+        self._check_on_map(name, pose0)
         entry = ModelEntry(
             name, "robot", False, [], pose0, robot=robot, namespace=ns, tf_prefix=prefix
         )

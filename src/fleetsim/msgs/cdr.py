@@ -20,7 +20,7 @@ from rosbags.typesys import Stores, TypesysError, get_typestore
 
 from fleetsim.errors import MessageError
 from fleetsim.msgs.fields import Prim, SeqSpec
-from fleetsim.msgs.registry import get_type, is_message, type_name
+from fleetsim.msgs.registry import get_type, is_message, message_class, type_name
 
 _STORE = get_typestore(Stores.ROS2_HUMBLE)
 _READY: dict[str, type] = {}  # type name -> the class the store currently decodes into
@@ -177,7 +177,7 @@ def normalized(msg: Any, where: str = "") -> Any:
 def serialize(msg: Any) -> bytes:
     """Encode a message as CDR (little-endian, with the 4-byte encapsulation header)."""
     name = type_name(msg)
-    cls = getattr(type(msg), "__lazy_of__", type(msg))  # a lazily built message: its type
+    cls = message_class(msg)
     if _READY.get(name) is not cls:
         _prepare(cls)
     msg = normalized(msg)

@@ -151,6 +151,14 @@ def type_name(cls_or_msg: Any) -> str:
     return name
 
 
+def message_class(msg: Any) -> type:
+    """The registered class a message is: its own, or for a lazily built message (a scan whose
+    ranges are cast when read, ``fleetsim.sim.messages.LazyLaserScan``) the class it stands
+    for (``__lazy_of__``)."""
+    cls = type(msg)
+    return getattr(cls, "__lazy_of__", cls)
+
+
 def is_message(obj: Any) -> bool:
     """True for a message class or instance made by `message`."""
     return hasattr(obj, "__msgfields__")

@@ -23,6 +23,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from fleetsim.errors import GraphError, ServiceError, did_you_mean
+from fleetsim.msgs.registry import message_class
 
 if TYPE_CHECKING:
     from fleetsim.runtime.node import Node
@@ -103,7 +104,7 @@ class Publisher:
         return self.topic.name
 
     def publish(self, msg: Any) -> None:
-        if type(msg) is not self.msg_type and _lazy_of(msg) is not self.msg_type:
+        if type(msg) is not self.msg_type and message_class(msg) is not self.msg_type:
             raise GraphError(
                 f"topic {self.topic.name} carries {_type_name(self.msg_type)}, "
                 f"cannot publish {_type_name(type(msg))}"
@@ -283,9 +284,3 @@ class Graph:
     def _changed(self, event: str, name: str, obj: Any) -> None:
         for listener in self.listeners:
             listener(event, name, obj)
-
-
-def _lazy_of(msg: Any) -> type | None:
-    """The message type a lazily built message stands for (``__lazy_of__``; e.g. a scan whose
-    ranges are cast when read), or None."""
-    return getattr(type(msg), "__lazy_of__", None)

@@ -120,18 +120,13 @@ def _same(a, b) -> bool:
 
 def scan_msg(r: ScanReading) -> sensor_msgs.LaserScan:
     """The reading as a LaserScan; a lazy one (``LazyLaserScan``) while its ranges are not cast."""
-    if r.cast:
-        return _LaserScan(
-            _Header(stamp(r.stamp), r.frame_id),
-            r.angle_min, r.angle_max, r.angle_increment, r.time_increment, r.scan_time,
-            r.range_min, r.range_max, r.ranges, r.intensities,
-        )  # fmt: skip
-    msg = LazyLaserScan(
+    msg = (_LaserScan if r.cast else LazyLaserScan)(
         _Header(stamp(r.stamp), r.frame_id),
         r.angle_min, r.angle_max, r.angle_increment, r.time_increment, r.scan_time,
-        r.range_min, r.range_max, _NOT_CAST, r.intensities,
+        r.range_min, r.range_max, r.ranges if r.cast else _NOT_CAST, r.intensities,
     )  # fmt: skip
-    msg._reading = r
+    if not r.cast:
+        msg._reading = r
     return msg
 
 

@@ -97,10 +97,11 @@ class ToolPublisher:
 
     def publish(self, msg: Any) -> None:
         from fleetsim.msgs import serialize
+        from fleetsim.msgs.registry import message_class
 
         if self._pub is None:
             raise GraphError(f"publisher of {self.name} is closed")
-        if type(msg) is not self.type and getattr(type(msg), "__lazy_of__", None) is not self.type:
+        if message_class(msg) is not self.type:
             raise GraphError(f"{self.name} carries {self.type.__msgtype__}, not {type(msg)}")
         self._pub.put(serialize(msg), attachment=self._att)
 

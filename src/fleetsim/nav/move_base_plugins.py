@@ -29,8 +29,11 @@ import logging
 from dataclasses import dataclass
 from typing import Any
 
+import numpy as np
+
 from fleetsim.errors import ParameterError, did_you_mean
 from fleetsim.nav.controllers import TrajectoryPlanner
+from fleetsim.nav.costmap.inflation_layer import InflationLayer, costs_from_distances
 from fleetsim.nav.planners import NavFn, NavfnParams
 from fleetsim.nav.recovery import (
     ClearCostmapRecovery,
@@ -93,7 +96,30 @@ def global_planner(value: str, ns: dict, costmap_ros: Any, where: str) -> tuple[
     """(plugin name, planner) for ``base_global_planner``."""
     name = _plugin_key("base_global_planner", value, GLOBAL_PLANNERS, where)
     params = load_params(NavfnParams, ns.get(name) or {}, f"{where}/{name}", logger=_log)
-    return name, NavFn(costmap_ros.costmap, params, costmap_ros.global_frame)
+    planner = NavFn(costmap_ros.costmap, params, costmap_ros.global_frame)
+    if params.circumscribed_clearance:
+        cost, radius = circumscribed_cost(costmap_ros.layered)
+        if cost == 0:
+            _log.warning(
+                "%s/%s: circumscribed_clearance has no effect: the global costmap's inflation "
+                "does not reach the footprint's circumscribed radius (%.3f m)",
+                where, name, radius,
+            )  # fmt: skip
+        planner.set_circumscribed(cost, radius)
+    return name, planner
+
+
+def circumscribed_cost(layered: Any) -> tuple[int, float]:
+    """(cost, radius in m) of costmap_2d's circumscribed cost (LayeredCostmap's
+    getCircumscribedCost: the inflation layer's cost at the footprint's circumscribed radius);
+    cost 0 without an inflation layer or where its radius ends before the circumscribed one."""
+    radius = float(layered.circumscribed_radius)
+    for layer in layered.layers:
+        if isinstance(layer, InflationLayer) and layer.enabled:
+            ip, res = layer.params, layered.costmap.resolution
+            key = (res, layered.inscribed_radius, ip.inflation_radius, ip.cost_scaling_factor)
+            return int(costs_from_distances(np.float64(radius / res), *key)), radius
+    return 0, radius
 
 
 def dwa_namespace(ns: dict, where: str) -> dict:

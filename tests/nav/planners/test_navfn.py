@@ -150,3 +150,68 @@ def test_potential_is_navfns_bit_for_bit(seed):
     src = int(rng.choice(np.flatnonzero(costarr < 254)))
     pot, _ = navfn_potential(costarr, 20, src, 0, False, 10**6)
     assert np.array_equal(pot, navfn_reference(costarr, 20, src))
+
+
+def clutter_row(res=0.05):
+    """A 6 x 6 m room split by a row of clutter at y = 3 m with two gaps: 0.4 m at x = 2.5 m,
+    which a lizi (0.38 x 0.32 m, circumscribed 0.25 m) passes straight but cannot turn in, and
+    1.0 m at x = 4.5 m; inflated as the lizi's costmaps are (0.45 m, scaling 5)."""
+    from scipy import ndimage
+
+    from fleetsim.nav.costmap.inflation_layer import costs_from_distances
+
+    n = round(6.0 / res)
+    lethal = np.zeros((n, n), bool)
+    lethal[round(2.95 / res) : round(3.05 / res), :] = True
+    for lo, hi in ((2.3, 2.7), (4.0, 5.0)):  # the gaps
+        lethal[:, round(lo / res) : round(hi / res)] = False
+    m = Costmap2D(n, n, res)
+    dist = ndimage.distance_transform_edt(~lethal)
+    m.costs[:] = costs_from_distances(dist, res, 0.16, 0.45, 5.0)
+    return m
+
+
+def test_circumscribed_clearance_plans_through_the_gap_the_body_can_turn_in():
+    from fleetsim.nav.costmap.footprint import footprint_costs, outline_points
+    from fleetsim.nav.move_base_plugins import circumscribed_cost
+
+    m = clutter_row()
+    footprint = np.array([[-0.19, -0.16], [-0.19, 0.16], [0.19, 0.16], [0.19, -0.16]])
+    start, goal = (2.5, 3.6, -math.pi / 2), (1.0, 1.0, 0.0)  # the narrow gap is on the way
+
+    class Layered:  # what circumscribed_cost reads of a LayeredCostmap
+        from fleetsim.nav.costmap.inflation_layer import InflationLayer, InflationLayerParams
+
+        inscribed_radius, circumscribed_radius, costmap = 0.16, math.hypot(0.19, 0.16), m
+        layers = [InflationLayer(params=InflationLayerParams(cost_scaling_factor=5.0))]
+
+    cost, radius = circumscribed_cost(Layered)
+    assert 150 < cost < 253 and radius == pytest.approx(0.248, abs=1e-3)
+
+    def turnable(path):
+        """Per pose: can the footprint turn a full circle there without a lethal cell?"""
+        outline = outline_points(footprint, m.resolution)
+        yaws = np.linspace(-math.pi, math.pi, 72, endpoint=False)
+        out = []
+        for x, y, _ in path.poses:
+            poses = np.c_[np.full(72, x), np.full(72, y), yaws]
+            fc = footprint_costs(m.costs, m.origin_x, m.origin_y, m.resolution, outline, poses)
+            out.append(bool((fc >= 0).all()))
+        return np.array(out)
+
+    plain = NavFn(m).create_plan(start, goal)  # ROS: through the 0.4 m gap, a turn inside it
+    assert (np.abs(plain.poses[:, 0] - 2.5) < 0.3)[np.abs(plain.poses[:, 1] - 3.0) < 0.1].all()
+    assert not turnable(plain).all()
+
+    roomy = NavFn(m, NavfnParams(circumscribed_clearance=True))
+    roomy.set_circumscribed(cost, radius)
+    path = roomy.create_plan(start, goal)
+    crossing = path.poses[np.abs(path.poses[:, 1] - 3.0) < 0.1]
+    assert len(crossing) and (np.abs(crossing[:, 0] - 4.5) < 0.3).all()  # the wide gap
+    assert turnable(path).all()
+    assert path.poses[-1, :2].tolist() == pytest.approx([1.0, 1.0])
+
+    m.costs[:, round(4.0 / 0.05) : round(5.0 / 0.05)] = 254  # the wide gap closed:
+    path = roomy.create_plan(start, goal)  # as ROS, through the narrow one
+    assert path.poses[-1, :2].tolist() == pytest.approx([1.0, 1.0])
+    assert not turnable(path).all()

@@ -5,6 +5,16 @@ it reaches the goal cell; with ``default_tolerance`` the reachable point nearest
 within a square of that half-size is used instead; the path is extracted by gradient descent
 from the goal down to the robot and returned robot-first, ending with the goal pose.
 Path points are cell centres (navfn places them at cell corners, half a cell off).
+
+``circumscribed_clearance`` (a fleetsim addition, off by default as in ROS): navfn treats only
+cells at or above the inscribed cost as obstacles, so with a rectangular footprint its path may
+run through a gap the body passes straight but cannot turn in (a lizi, 0.32 m wide, through
+0.4 m between Willow's clutter, where the path bends): the local planner then meets a wedge that
+ROS's recoveries (clear, rotate in place) cannot undo. With the option the planner first plans
+on cells below costmap_2d's circumscribed cost (the cost at the footprint's circumscribed
+radius, where the body clears obstacles in any heading), except within that radius of the start
+and the goal (the robot may stand, and a goal may lie, nearer a wall); only where no such path
+exists does it plan as ROS does, through the narrower gaps.
 """
 
 from __future__ import annotations
@@ -31,7 +41,13 @@ from fleetsim.nav.planners.base import (
     StartOccupied,
     StartOutsideMap,
 )
-from fleetsim.nav.planners.navfn_kernels import POT_HIGH, navfn_costs, navfn_path, navfn_potential
+from fleetsim.nav.planners.navfn_kernels import (
+    COST_OBS,
+    POT_HIGH,
+    navfn_costs,
+    navfn_path,
+    navfn_potential,
+)
 from fleetsim.runtime import param
 
 
@@ -49,6 +65,11 @@ class NavfnParams:
     )
     planner_window_y: float = param(
         0.0, unit="m", range=(0.0, None), help="plan only in a window this tall (0: whole map)"
+    )
+    circumscribed_clearance: bool = param(
+        False,
+        help="fleetsim: plan first where the footprint can turn (below the circumscribed cost), "
+        "through narrower gaps only if no such path exists",
     )
 
 
@@ -68,6 +89,13 @@ class NavFn(GlobalPlanner):
         self.params = params or NavfnParams()
         self.potential: np.ndarray | None = None
         self.window: tuple[int, int, int, int] = (0, 0, costmap.size_x, costmap.size_y)
+        #: (cost, radius in m) at the footprint's circumscribed radius, set by the costmap's
+        #: owner (`set_circumscribed`); cost 0: unknown, ``circumscribed_clearance`` is inert
+        self.circumscribed: tuple[int, float] = (0, 0.0)
+
+    def set_circumscribed(self, cost: int, radius: float) -> None:
+        """costmap_2d's circumscribed cost and radius (m), for ``circumscribed_clearance``."""
+        self.circumscribed = (int(cost), float(radius))
 
     def _window(self, sx: int, sy: int) -> tuple[int, int, int, int]:
         m, p = self.costmap, self.params
@@ -130,7 +158,14 @@ class NavFn(GlobalPlanner):
         goal_cell = cells[0]
         goal_idx = (goal_cell[1] - y0) * nx + (goal_cell[0] - x0)
         cycles = max(costarr.size // 20, nx + (yn - y0))
-        pot, finished = navfn_potential(costarr, nx, start_idx, goal_idx, True, cycles)
+        pot, finished = None, False
+        if p.circumscribed_clearance and self.circumscribed[0] > 0:
+            roomy = self._roomy_costs(costarr, s_cell, goal_cell)
+            pot, finished = navfn_potential(roomy, nx, start_idx, goal_idx, True, cycles)
+            if not (pot[(cells[:, 1] - y0) * nx + (cells[:, 0] - x0)] < POT_HIGH).any():
+                pot = None  # no roomy path: plan as ROS does
+        if pot is None:
+            pot, finished = navfn_potential(costarr, nx, start_idx, goal_idx, True, cycles)
         self.potential = pot.reshape(yn - y0, nx)
         reached = pot[(cells[:, 1] - y0) * nx + (cells[:, 0] - x0)] < POT_HIGH
         if not reached.any():
@@ -162,6 +197,22 @@ class NavFn(GlobalPlanner):
         poses[:-1, 2] = np.arctan2(d[:, 1], d[:, 0])
         poses[-1, 2] = _wrap(goal_yaw)
         return Path(poses, self.frame_id)
+
+    def _roomy_costs(self, costarr: np.ndarray, s_cell, goal_cell) -> np.ndarray:
+        """``costarr`` with the cells at or above the circumscribed cost made obstacles, except
+        within the circumscribed radius (plus a cell) of the start and the goal cells."""
+        m = self.costmap
+        x0, y0, xn, yn = self.window
+        cost, radius = self.circumscribed
+        window = m.costs[y0:yn, x0:xn]
+        tight = (window >= cost) & (window != NO_INFORMATION)  # unknown: allow_unknown's
+        reach = radius / m.resolution + 1.0
+        ys, xs = np.ogrid[y0:yn, x0:xn]
+        for cx, cy in (s_cell, goal_cell):
+            tight &= (xs - int(cx)) ** 2 + (ys - int(cy)) ** 2 > reach * reach
+        out = costarr.copy()
+        out[tight.ravel()] = COST_OBS
+        return out
 
     def _raise_unreachable(self, cells: np.ndarray, gx: float, gy: float, sx: float, sy: float):
         costs = self.costmap.costs[cells[:, 1], cells[:, 0]]

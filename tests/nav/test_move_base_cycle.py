@@ -126,3 +126,20 @@ def test_a_new_goal_during_a_rotate_recovery_starts_afresh():
     assert first.status == GoalStatus.PREEMPTED
     assert second.status == GoalStatus.SUCCEEDED
     assert spinning.start_angle is None
+
+
+def test_a_moveback_recovery_backs_the_robot_up_then_move_base_goes_on():
+    params = move_base_params(
+        planner_patience=0.5,
+        recovery_behaviors=[{"name": "back", "type": "moveback_recovery/MoveBackRecovery"}],
+        back={"step_back_length": 0.5, "linear_vel_back": -0.2},
+    )
+    w = nav_world(params, start=(3.0, 1.0, 0.0))
+    h = run_goal(w, goal_msg(4.0, 1.0))  # inside the wall: planning fails, then recovery
+    assert h.status == GoalStatus.ABORTED
+    assert "navfn: the goal (4.000, 1.000) is in an obstacle" in h.text
+    backs = [m.linear.x for _, m in w.watch.cmds if m.linear.x < 0]
+    assert backs and set(backs) == {-0.2}
+    assert 2.4 <= w.bot.pose[0] <= 2.55, w.bot.pose  # 0.5 m straight back, then stopped
+    assert abs(w.bot.pose[1] - 1.0) < 1e-6 and w.watch.cmds[-1][1].linear.x == 0.0
+    assert w.mb.recoveries[0].moveback.outcome == "moved backwards 0.5 m"

@@ -76,7 +76,7 @@ def test_unknown_local_planner_is_an_error(kind, value, match):
 
 
 def names(recs):
-    return [(r.name, "clear" if r.clear else "rotate") for r in recs]
+    return [(r.name, "clear" if r.clear else "back" if r.moveback else "rotate") for r in recs]
 
 
 def test_default_recoveries_follow_move_base():
@@ -101,12 +101,15 @@ def test_a_recovery_list_reads_each_namespace():
         recovery_behaviors=[
             {"name": "spin", "type": "rotate_recovery/RotateRecovery"},
             {"name": "wipe", "type": "clear_costmap_recovery/ClearCostmapRecovery"},
+            {"name": "back", "type": "moveback_recovery/MoveBackRecovery"},
         ]
     )
     ns = {"spin": {"sim_granularity": 0.05}, "wipe": {"reset_distance": 0.5,
-          "layer_names": ["obstacles"]}}  # fmt: skip
+          "layer_names": ["obstacles"]}, "back": {"step_back_length": 0.3}}  # fmt: skip
     recs = recovery_behaviors(p, ns, {"max_vel_theta": 0.9}, 0.3, LocalCostmap(), "/mb")
-    assert names(recs) == [("spin", "rotate"), ("wipe", "clear")]
+    assert names(recs) == [("spin", "rotate"), ("wipe", "clear"), ("back", "back")]
+    assert recs[2].moveback.params.step_back_length == 0.3
+    assert recs[2].moveback.params.linear_vel_back == -0.3
     assert recs[0].rotate.params.sim_granularity == 0.05
     assert recs[0].rotate.params.max_rotational_vel == 0.9
     assert recs[1].clear.params.layer_names == ["obstacles"]
@@ -128,3 +131,11 @@ def test_bad_recovery_entries(entry, match):
     p = MoveBaseParams(recovery_behaviors=[entry])
     with pytest.raises(ParameterError, match=match):
         recovery_behaviors(p, {}, {}, 0.3, LocalCostmap(), "/mb")
+
+
+def test_moveback_forwards_is_an_error_naming_the_parameter():
+    p = MoveBaseParams(
+        recovery_behaviors=[{"name": "back", "type": "moveback_recovery/MoveBackRecovery"}]
+    )
+    with pytest.raises(ParameterError, match=r"/mb/back.*linear_vel_back"):
+        recovery_behaviors(p, {"back": {"linear_vel_back": 0.3}}, {}, 0.3, LocalCostmap(), "/mb")

@@ -244,6 +244,8 @@ class MoveBase(ExecuteCycle, Node):
         for rec in self.recoveries:
             if rec.rotate is not None:
                 rec.rotate.start_angle = None
+            if rec.moveback is not None:
+                rec.moveback.start = None
 
     def _wake_planner(self) -> None:
         self.run_planner = True

@@ -200,6 +200,14 @@ class ExecuteCycle:
         pose = self.local_costmap.robot_pose()
         if pose is None:
             return True
+        if rec.moveback is not None:
+            cmd = rec.moveback.command(*pose, self.now())
+            if cmd is None:  # moveback_recovery logs each ending at INFO
+                self.get_logger().info(f"recovery '{rec.name}': {rec.moveback.outcome}")
+                self.publish_zero_velocity()
+                return True
+            self.cmd_pub.publish(geometry_msgs.Twist(linear=geometry_msgs.Vector3(x=cmd.vx)))
+            return False
         cmd = rec.rotate.command(*pose)
         if cmd is None:
             if rec.rotate.aborted:

@@ -13,8 +13,9 @@
   ``nav2_mppi_controller::MPPIController`` (or ``nav2_mppi_controller/MPPIController``) ->
   `fleetsim.nav.controllers.mppi.MPPIController` reading ``~MPPIController/``.
 * ``recovery_behaviors``: a list of ``{name, type}`` (types
-  ``clear_costmap_recovery/ClearCostmapRecovery``, ``rotate_recovery/RotateRecovery``), each
-  reading ``~<name>/``; when unset, move_base's defaults: ``conservative_reset`` (reset_distance
+  ``clear_costmap_recovery/ClearCostmapRecovery``, ``rotate_recovery/RotateRecovery``,
+  ``moveback_recovery/MoveBackRecovery`` from mbf_recovery_behaviors), each reading
+  ``~<name>/``; when unset, move_base's defaults: ``conservative_reset`` (reset_distance
   ``conservative_reset_dist``), ``rotate_recovery`` (if ``clearing_rotation_allowed``),
   ``aggressive_reset`` (reset_distance 4 x the circumscribed radius), ``rotate_recovery`` again
   (if allowed). RotateRecovery takes its limits from the local planner's namespace
@@ -38,6 +39,8 @@ from fleetsim.nav.planners import NavFn, NavfnParams
 from fleetsim.nav.recovery import (
     ClearCostmapRecovery,
     ClearCostmapRecoveryParams,
+    MoveBackRecovery,
+    MoveBackRecoveryParams,
     RotateRecovery,
     RotateRecoveryParams,
 )
@@ -53,7 +56,11 @@ LOCAL_PLANNERS = {
     "nav2_mppi_controller::MPPIController": "MPPIController",
     "nav2_mppi_controller/MPPIController": "MPPIController",
 }
-RECOVERY_TYPES = ("clear_costmap_recovery/ClearCostmapRecovery", "rotate_recovery/RotateRecovery")
+RECOVERY_TYPES = (
+    "clear_costmap_recovery/ClearCostmapRecovery",
+    "rotate_recovery/RotateRecovery",
+    "moveback_recovery/MoveBackRecovery",
+)
 
 #: DWAPlannerROS name -> TrajectoryPlannerROS name
 DWA_RENAMES = {
@@ -170,11 +177,13 @@ def make_local_planner(node: Any, name: str, ns: dict, costmap_ros: Any, where: 
 
 @dataclass
 class Recovery:
-    """One recovery behaviour: a clearing (instant) or a rotation (over several cycles)."""
+    """One recovery behaviour: a clearing (instant), a rotation or a backing up (over several
+    cycles)."""
 
     name: str
     clear: ClearCostmapRecovery | None = None
     rotate: RotateRecovery | None = None
+    moveback: MoveBackRecovery | None = None
 
 
 def rotate_params(ns: dict, planner_ns: dict, name: str, where: str) -> RotateRecoveryParams:
@@ -232,6 +241,12 @@ def recovery_behaviors(
             out.append(clearing(name))
         elif kind == RECOVERY_TYPES[1]:
             out.append(rotation(name))
+        elif kind == RECOVERY_TYPES[2]:
+            params = load_params(
+                MoveBackRecoveryParams, ns.get(name) or {}, f"{where}/{name}", logger=_log
+            )
+            moveback = MoveBackRecovery(local_cm.costmap, local_cm.footprint, params)
+            out.append(Recovery(name, moveback=moveback))
         else:
             raise ParameterError(
                 f"{where}: recovery_behaviors[{i}] '{name}' has type '{kind}', which is not "

@@ -1,9 +1,12 @@
-"""move_base's recovery behaviours: clear_costmap_recovery and rotate_recovery.
+"""move_base's recovery behaviours: clear_costmap_recovery, rotate_recovery, moveback_recovery.
 
 Each is a class with one main method. `ClearCostmapRecovery.run` forgets what the named
 layers sensed outside a square around the robot; `RotateRecovery.command` is called once per
 control cycle and returns the next rotation command, or None once a full turn is done (or
-the footprint would collide, as ROS aborts).
+the footprint would collide, as ROS aborts); `MoveBackRecovery.command` likewise drives the
+robot straight back (mbf_recovery_behaviors' ``moveback_recovery/MoveBackRecovery``, which
+ROS 1 users add to move_base's list where rotating in place is not enough: a rectangular
+robot nose-first in clutter cannot turn, but can back out the way it came).
 """
 
 from __future__ import annotations
@@ -135,3 +138,72 @@ class RotateRecovery:
         vel = math.sqrt(2 * p.acc_lim_theta * dist_left)
         vel = min(max(vel, p.min_in_place_rotational_vel), p.max_rotational_vel)
         return VelocityCommand(0.0, 0.0, vel)
+
+
+@dataclass(frozen=True)
+class MoveBackRecoveryParams:
+    """``moveback_recovery/MoveBackRecovery`` (mbf_recovery_behaviors), in its ``~name/``."""
+
+    control_frequency: float = param(20.0, unit="Hz", range=(1e-6, None), help="command rate")
+    linear_vel_back: float = param(
+        -0.3, unit="m/s", range=(None, 0.0), help="velocity backwards (negative)"
+    )
+    step_back_length: float = param(
+        1.0, unit="m", range=(0.0, None), help="distance to back up before stopping"
+    )
+    step_back_timeout: float = param(
+        15.0, unit="s", range=(0.0, None), help="give up after this long (0: never)"
+    )
+    look_behind_dist: float = param(
+        0.1,
+        unit="m",
+        range=(0.0, None),
+        help="stop when the footprint this far behind meets a lethal cell",
+    )
+
+
+class MoveBackRecovery:
+    """Back up straight (MoveBackRecovery::runBehavior), one command per control cycle, until
+    ``step_back_length`` is covered, ``step_back_timeout`` has passed, or the footprint
+    ``look_behind_dist`` behind the robot would touch a lethal cell of the local costmap (or an
+    unknown one, as base_local_planner's costmap model counts them; moveback_recovery lays the
+    filled footprint, this the outline, as `RotateRecovery` does)."""
+
+    Params = MoveBackRecoveryParams
+
+    def __init__(
+        self,
+        costmap: Costmap2D,
+        footprint: np.ndarray,
+        params: MoveBackRecoveryParams | None = None,
+    ) -> None:
+        self.costmap = costmap
+        self.params = params or MoveBackRecoveryParams()
+        self.outline = outline_points(footprint, costmap.resolution)
+        self.start: tuple[float, float, float] | None = None  # x, y, time
+        #: how the last run ended (moveback_recovery's result message)
+        self.outcome = ""
+
+    def command(self, x: float, y: float, yaw: float, now: float) -> VelocityCommand | None:
+        """The next command, or None when the run is over (``outcome`` says why)."""
+        p = self.params
+        if self.start is None:
+            self.start, self.outcome = (x, y, now), ""
+        x0, y0, t0 = self.start
+        if p.step_back_timeout > 0 and now > t0 + p.step_back_timeout:
+            return self._end(f"time out after {p.step_back_timeout:g} s, moving backwards")
+        behind = np.array([[x - p.look_behind_dist * math.cos(yaw),
+                            y - p.look_behind_dist * math.sin(yaw), yaw]])  # fmt: skip
+        m = self.costmap
+        fc = footprint_costs(m.costs, m.origin_x, m.origin_y, m.resolution, self.outline, behind)
+        if fc[0] < 0:
+            return self._end(
+                f"stopped moving backwards at ({x:.2f}, {y:.2f}): an obstacle behind the robot"
+            )
+        if math.hypot(x - x0, y - y0) > p.step_back_length:
+            return self._end(f"moved backwards {p.step_back_length:g} m")
+        return VelocityCommand(p.linear_vel_back, 0.0, 0.0)
+
+    def _end(self, outcome: str) -> None:
+        self.start, self.outcome = None, outcome
+        return None

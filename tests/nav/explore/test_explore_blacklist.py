@@ -5,6 +5,7 @@ progress for ``progress_timeout`` are blacklisted; the robot pose is not used on
 import logging
 
 import numpy as np
+import pytest
 
 from fleetsim.msgs import move_base_msgs, nav_msgs, std_msgs
 from fleetsim.nav.explore import Explore, frontiers_from_grid
@@ -159,3 +160,29 @@ def test_a_robot_pose_older_than_transform_tolerance_is_not_used(caplog):
     world.send_pose()  # tf is back
     rt.run(duration=1.0)
     assert len(mb.goals) == 1
+
+
+@pytest.mark.parametrize("switch_distance", [0.0, 5.0])
+def test_a_frontier_that_only_creeps_is_given_up_with_switch_distance(switch_distance):
+    # the room's east edge shrinks from its north end one cell a second while the robot does
+    # not move: its centroid (the goal) creeps 5 cm a plan, its nearest cell stays put
+    data = room()
+    rt = Runtime(seed=0)
+    rt.params.set("/explore/progress_timeout", 2.0)
+    rt.params.set("/explore/potential_scale", 0.0)
+    rt.params.set("/explore/switch_distance", switch_distance)
+    world = World(rt, data)
+    mb = MoveBase(rt, lambda g: None)  # accepted, never reached
+    ex = Explore(rt)
+    for row in range(19, 13, -1):
+        rt.run(duration=1.0)
+        world.data[row, 10:] = 100  # a wall found where the frontier's north end was
+        world.publish()
+    assert len(set(mb.goals)) >= 4  # the goal moved with the centroid
+    if switch_distance == 0.0:
+        # explore_lite: every moved goal restarts the progress clock; never given up
+        assert not ex.blacklist
+    else:
+        # tracked as one frontier: no progress towards it for 2 s, blacklisted
+        assert len(ex.blacklist) == 1
+        assert ex.blacklist[0][0] == pytest.approx(1.05)  # the east edge, where it crept to

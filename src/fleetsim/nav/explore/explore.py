@@ -30,7 +30,13 @@ hunters crossed the office's corridor to each other's end); ``switch_distance`` 
 frontier it heads for unless another is clearly cheaper; each explorer publishes its blacklist
 on ``~blacklist`` (geometry_msgs/PoseArray) and skips the frontiers its peers blacklisted
 (``peer_blacklists``: two hunters each gave up on a corner of the office and then crossed the
-office to the corner the other had given up on). The rules: `fleetsim.nav.explore.peers`.
+office to the corner the other had given up on); ``path_costs`` measures a frontier by the
+distance the robot drives to it (navfn's wavefront over the costmap,
+`fleetsim.nav.explore.path_costs`), for ranking and, with peers, for which robot is nearer
+(a straight line through a wall gave a robot the next room's frontiers). With
+``switch_distance`` the progress clock keeps running while the frontier it heads for only
+shrinks (its centroid creeping); explore_lite restarts it whenever the goal point moves. The
+rules: `fleetsim.nav.explore.peers`.
 
 ``costmap_updates_topic`` is accepted but fleetsim's costmaps publish whole grids only (see
 `fleetsim.nav.costmap.costmap_ros`), so it is not subscribed. ``orientation_scale`` is accepted
@@ -53,7 +59,8 @@ from fleetsim.runtime import Node, param
 from fleetsim.tf.names import resolve_frame_once
 
 from .frontier_search import Frontier, frontiers_from_grid
-from .peers import frontier_for_robot
+from .path_costs import by_path
+from .peers import frontier_for_robot, tracked_frontier
 
 BLACKLIST_RADIUS_CELLS = 5  # explore_lite's goalOnBlacklist tolerance
 SUCCEEDED, ABORTED = 3, 4
@@ -98,6 +105,10 @@ class ExploreParams:
         unit="m",
         range=(0.0, None),
         help="keep the frontier it heads for unless another is cheaper by this much distance",
+    )
+    path_costs: bool = param(
+        False,
+        help="measure frontiers by the distance driven (navfn's wavefront), not straight lines",
     )
 
 
@@ -275,14 +286,23 @@ class Explore(Node):
         if not candidates:
             self.stop("all frontiers traversed/tried out, stopping")
             return
+        positions = self._peer_positions(frame)
+        distances = None
+        if p.path_costs:
+            origin = (info.origin.position.x, info.origin.position.y)
+            candidates, distances = by_path(
+                data, info.resolution, origin, candidates, [robot, *positions],
+                p.potential_scale, p.gain_scale,
+            )  # fmt: skip
         chosen = frontier_for_robot(
             candidates,
             robot,
             self.goal,
             [g for g in self.peers.values() if g is not None],
-            self._peer_positions(frame),
+            positions,
             p.peer_radius,
             p.potential_scale * info.resolution * p.switch_distance,
+            distances,
         )
         if chosen is None:  # the peers have every frontier left: wait for them
             self._withdraw_goal()
@@ -292,14 +312,24 @@ class Explore(Node):
             return
         target = chosen.centroid
         same = self.goal is not None and math.dist(target, self.goal) < 1e-6
+        # with switch_distance the frontier it heads for is tracked as its centroid moves
+        # (peers.tracked_frontier); explore_lite restarts the progress clock whenever the goal point
+        # moves, and a frontier whose centroid crept a few cm every plan then kept a robot
+        # that could not get to it busy indefinitely (office, two hunters, seed 2: hunter1
+        # 112 s at a door, resent six goals on one frontier, each restarting move_base too)
+        kept = same or (
+            p.switch_distance > 0.0
+            and self.goal is not None
+            and chosen is tracked_frontier(candidates, self.goal)
+        )
         # progress as explore_lite measures it: towards the frontier's nearest cell (its
         # centroid may lie behind a wall the robot has to go round)
         distance = chosen.min_distance
         now = self.now()
-        if not same or distance < self._best_distance:
+        if not kept or distance < self._best_distance:
             self._best_distance = distance
             self._last_progress = now
-        if same and now - self._last_progress > p.progress_timeout:
+        if kept and now - self._last_progress > p.progress_timeout:
             self.get_logger().info(f"no progress towards {target} for {p.progress_timeout} s")
             self._blacklist(target)
             self.goal = None

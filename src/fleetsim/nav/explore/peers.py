@@ -22,6 +22,13 @@ is needed:
   equal costs explore_lite's replanning flipped the goal between two frontiers every plan
   (office, two hunters, seed 1: 45 of hunter1's 55 goals replaced before they were reached).
 
+"Nearer" is by straight lines to the centroid, or (explore's ``path_costs``) by the distances
+the robots drive (`fleetsim.nav.explore.path_costs`): each robot computes them for itself and
+for its peers from the same merged map, so both share the frontiers out alike, each taking
+those it reaches first along the floor, a division by travel cost as in Burgard et al.'s
+coordinated exploration (a straight line through a wall gave a robot the next room's
+frontiers, 15-20 m away by the door, and kept the nearer robot waiting at the end).
+
 With no peers and ``switch_distance`` 0 the choice is explore_lite's: the cheapest frontier.
 """
 
@@ -29,6 +36,8 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+
+import numpy as np
 
 from .frontier_search import Frontier
 
@@ -44,6 +53,7 @@ def frontier_for_robot(
     peer_positions: Sequence[tuple[float, float]],
     peer_radius: float,
     switch_margin: float = 0.0,
+    distances: np.ndarray | None = None,
 ) -> Frontier | None:
     """The frontier this robot should head for; None: wait, the peers have the rest.
 
@@ -57,21 +67,30 @@ def frontier_for_robot(
     peer_radius : m; frontiers with a centroid this near a peer's goal are that peer's.
     switch_margin : cost (explore_lite's units) by which another frontier must beat the one it
         heads for to replace it; 0 replaces it whenever another is cheapest.
+    distances : (F, 1 + P) m, optional: how far this robot (column 0) and each peer (the next
+        columns, in ``peer_positions``' order) drive to each candidate (inf: cannot reach it);
+        when given, a frontier is this robot's when no peer's distance is shorter, instead of
+        comparing straight lines to its centroid.
     """
+    if distances is None:
+        nearer = {id(f): _nearer_to_robot(f, robot, peer_positions) for f in candidates}
+    else:
+        distances = np.asarray(distances, dtype=float).reshape(len(candidates), -1)
+        nearer = {id(f): bool(np.all(row[1:] >= row[0])) for f, row in zip(candidates, distances)}
     free = [
         f for f in candidates if all(math.dist(f.centroid, g) >= peer_radius for g in peer_goals)
     ]
-    mine = [f for f in free if _nearer_to_robot(f, robot, peer_positions)]
+    mine = [f for f in free if nearer[id(f)]]
     if mine or free:
         best = (mine or free)[0]
     else:
-        ours = [f for f in candidates if _nearer_to_robot(f, robot, peer_positions)]
+        ours = [f for f in candidates if nearer[id(f)]]
         if not ours:
             return None
         best = ours[0]
     if switch_margin <= 0.0 or goal is None:
         return best
-    current = _tracked(free, goal)
+    current = tracked_frontier(free, goal)
     if current is not None and current.cost < best.cost + switch_margin:
         return current
     return best
@@ -85,7 +104,7 @@ def _nearer_to_robot(
     return all(math.dist(frontier.centroid, o) >= mine for o in others)
 
 
-def _tracked(frontiers: Sequence[Frontier], goal: tuple[float, float]) -> Frontier | None:
+def tracked_frontier(frontiers: Sequence[Frontier], goal: tuple[float, float]) -> Frontier | None:
     """The frontier the goal was sent to, as it is now: its centroid moves as it shrinks, so
     the one whose centroid, or a cell, lies within `TRACK_RADIUS` of the goal (nearest
     centroid first)."""

@@ -183,7 +183,7 @@ def office(
         explored_at = s.runtime.now()
         slam = slam_node.grid_msg if robots == 1 else s.nodes["/map_merge"].merged
     state = ", ".join(
-        f"{n or robot}: finished={ex.finished} blacklisted={len(ex.blacklist)}"
+        f"{n or robot}: finished={ex.finished} gave_up={ex.gave_up} blacklisted={len(ex.blacklist)}"
         for n, ex in zip(names, explorers)
     )
     print(f"office ({robots} {robot}(s) explore, seed {seed}): {state}")

@@ -139,3 +139,29 @@ def test_moveback_forwards_is_an_error_naming_the_parameter():
     )
     with pytest.raises(ParameterError, match=r"/mb/back.*linear_vel_back"):
         recovery_behaviors(p, {"back": {"linear_vel_back": 0.3}}, {}, 0.3, LocalCostmap(), "/mb")
+
+
+def lizi_global_costmap(inflation_radius):
+    from types import SimpleNamespace
+
+    from fleetsim.nav.costmap import LayeredCostmap
+
+    fp = [[-0.19, -0.16], [-0.19, 0.16], [0.19, 0.16], [0.19, -0.16]]
+    ns = {"static_map": False, "width": 4.0, "height": 4.0, "footprint": fp,
+          "inflation_radius": inflation_radius, "cost_scaling_factor": 5.0}  # fmt: skip
+    lc = LayeredCostmap.from_params(ns, "global_costmap")
+    return SimpleNamespace(layered=lc, costmap=lc.costmap, global_frame="map")
+
+
+def test_circumscribed_clearance_takes_the_global_costmaps_circumscribed_cost(caplog):
+    from fleetsim.nav.move_base_plugins import global_planner
+
+    ns = {"NavfnROS": {"circumscribed_clearance": True}}
+    _, planner = global_planner("navfn/NavfnROS", ns, lizi_global_costmap(0.45), "/mb")
+    cost, radius = planner.circumscribed
+    assert radius == pytest.approx(np.hypot(0.20, 0.17))  # footprint_padding 0.01 m
+    assert cost == int(252 * np.exp(-5.0 * (radius - 0.17)))  # costmap_2d's computeCost
+    with caplog.at_level(logging.WARNING):
+        _, planner = global_planner("navfn/NavfnROS", ns, lizi_global_costmap(0.2), "/mb")
+    assert planner.circumscribed[0] == 0
+    assert "circumscribed_clearance has no effect" in caplog.text

@@ -38,6 +38,7 @@ Usage: python benchmarks/multi_robot.py [--seeds 10] [--first-seed 0]
 from __future__ import annotations
 
 import argparse
+import itertools
 import logging
 import math
 import os
@@ -57,6 +58,7 @@ START_DELAY = 2.0  # s, the scenarios' default
 SAMPLE = 0.1  # s
 DEADLOCK_TIME, DEADLOCK_NEAR, DEADLOCK_PROGRESS = 20.0, 0.5, 0.2
 SAME_CONTACT = 1.0  # s
+MARKS = 8  # m: --phases reports when each robot first came within 1, 2, ... MARKS m of its goal
 
 
 @dataclass
@@ -74,6 +76,8 @@ class Run:
     arrival: dict[str, float] = field(default_factory=dict)
     wall: float = 0.0
     crashed: str = ""  # the simulator's error, when the run ended in one
+    #: robot -> {whole metres to its goal: s since the goals went out when it first came closer}
+    crossing: dict[str, dict[int, float]] = field(default_factory=dict)
 
 
 def jittered_plan(path: Path, args: dict[str, str], seed: int, jitter: float):
@@ -129,6 +133,13 @@ def run_once(name: str, robots: int, planner: str, seed: int, limit: float, jitt
                     continue
                 pos = np.asarray(engine.model_pose(r.model)[0][:2], dtype=float)
                 d = math.dist(pos, r.goal)
+                marks = out.crossing.get(r.model)
+                if marks is None:  # the metres it starts inside of do not count
+                    out.crossing[r.model] = marks = dict.fromkeys(
+                        range(math.ceil(d), MARKS + 1), 0.0
+                    )
+                for k in range(math.floor(d) + 1, MARKS + 1):
+                    marks.setdefault(k, now - START_DELAY)
                 b = best.get(r.model)
                 if b is None or d < b[0] - DEADLOCK_PROGRESS:
                     best[r.model] = (d, now)
@@ -161,6 +172,27 @@ def run_once(name: str, robots: int, planner: str, seed: int, limit: float, jitt
             out.makespan = max(out.arrival.values())
     out.wall = time.perf_counter() - t0
     return out
+
+
+def metre_times(run: Run, model: str) -> list[float]:
+    """s the robot took for each metre to its goal, farthest first, then the rest to its
+    arrival (the goal turn included)."""
+    marks = run.crossing.get(model, {})
+    ks = sorted((k for k in marks if marks[k] > 0.0), reverse=True)
+    t = [0.0] + [marks[k] for k in ks] + [run.arrival[model]]
+    return [b - a for a, b in itertools.pairwise(t)]
+
+
+def phase_line(run: Run, alone: dict[str, Run]) -> str:
+    """Where the seed's slowest robot lost its time: seconds per metre to its goal (farthest
+    first, the last figure from 1 m to its arrival) in the run and alone."""
+    if not run.arrival:
+        return f"seed {run.seed}: no arrival"
+    m = max(run.arrival, key=run.arrival.get)
+    fmt = " ".join
+    here = fmt(f"{x:.1f}" for x in metre_times(run, m))
+    solo = fmt(f"{x:.1f}" for x in metre_times(alone[m], m)) if m in alone else "-"
+    return f"seed {run.seed}: slowest {m} {run.arrival[m]:.1f} s, s per metre {here} (alone {solo})"
 
 
 def cycle_time(neighbours: int = 16, cycles: int = 400) -> tuple[float, float, float, float]:
@@ -221,6 +253,11 @@ def main() -> None:
     ap.add_argument("--limit", type=float, default=120.0, help="s of sim time per run")
     ap.add_argument("--jitter", type=float, default=0.02, help="m (and rad) of start noise")
     ap.add_argument("--cycle-only", action="store_true")
+    ap.add_argument(
+        "--phases",
+        action="store_true",
+        help="per seed, the slowest robot's time for each metre to its goal against its time alone",
+    )
     a = ap.parse_args()
     logging.basicConfig(level=logging.ERROR)
     med, p95, cmed, cp95 = cycle_time()
@@ -263,6 +300,10 @@ def main() -> None:
             )
             print(f"    alone: slowest {alone_time:.1f} s; per seed makespan "
                   + " ".join("-" if math.isnan(s) else f"{s:.1f}" for s in spans))  # fmt: skip
+            if a.phases:
+                alone_by = {m: r for r in alone for m in r.arrival}
+                for r in runs:
+                    print("    " + phase_line(r, alone_by))
             for r in runs:
                 if r.crashed:
                     print(f"    seed {r.seed}: the simulation failed: {r.crashed}")

@@ -61,3 +61,18 @@ def test_bad_map_files_are_named(tmp_path):
     (tmp_path / "c.yaml").write_text("image: x.pgm\nresolution: fast\n")
     with pytest.raises(SimulationError, match=r"c.yaml: bad number"):
         load_map(tmp_path / "c.yaml")
+
+
+@pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (-40.0, 25.0, 0.5)])
+def test_a_map_with_no_occupied_cell_builds_a_world_with_floor_under_it(tmp_path, origin):
+    """It used to fail on the empty wall list (the floor was centred on the walls)."""
+    from fleetsim.sim.world import world_from_map
+
+    world = world_from_map(write_map(tmp_path, np.full((8, 12), 254), origin=origin))
+    ground = world.models[0]
+    middle = (
+        origin[0] + np.cos(origin[2]) * 3.0 - np.sin(origin[2]) * 2.0,
+        origin[1] + np.sin(origin[2]) * 3.0 + np.cos(origin[2]) * 2.0,
+    )  # the 12 x 8 cells of 0.5 m: 6 x 4 m
+    assert ground.name == "ground_plane"
+    assert np.hypot(ground.pose[0] - middle[0], ground.pose[1] - middle[1]) < 1e-9

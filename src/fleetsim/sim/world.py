@@ -127,15 +127,16 @@ def world_from_map(yaml_path: str | Path, wall_height: float = WALL_HEIGHT) -> W
     ]
     h, w = grid.occupied.shape
     extent = float(max(h, w) * grid.resolution) + 20.0
-    ox, oy, yaw = grid.origin  # a map with no occupied cell: the plane under its middle
-    half_x, half_y = w * grid.resolution / 2, h * grid.resolution / 2
-    centre = (
-        ox + math.cos(yaw) * half_x - math.sin(yaw) * half_y,
-        oy + math.sin(yaw) * half_x + math.cos(yaw) * half_y,
-    )
     if len(boxes):
         lo, hi = boxes[:, :2].min(axis=0), boxes[:, :2].max(axis=0)
         centre = (float((lo[0] + hi[0]) / 2), float((lo[1] + hi[1]) / 2))
+    else:  # no occupied cell: the plane under the map's middle
+        ox, oy, yaw = grid.origin
+        half_x, half_y = w * grid.resolution / 2, h * grid.resolution / 2
+        centre = (
+            ox + math.cos(yaw) * half_x - math.sin(yaw) * half_y,
+            oy + math.sin(yaw) * half_x + math.cos(yaw) * half_y,
+        )
     tiles: dict[tuple[int, int], list[GeomDesc]] = {}
     for g in geoms:
         key = (int(g.pose[0] // WALL_TILE), int(g.pose[1] // WALL_TILE))

@@ -16,6 +16,7 @@ from fleetsim.nav.costmap import (
     StaticLayer,
     VoxelLayer,
 )
+from fleetsim.nav.costmap.layered_costmap import costs_from_published, occupancy_from_costs
 from fleetsim.nav.costmap.static_layer import costs_from_occupancy
 from fleetsim.nav.errors import CostmapError
 from fleetsim.nav.map_io import OccupancyMap
@@ -122,3 +123,10 @@ def test_voxel_flattening_rule():
     lc.update_map(0.0, 0.0, 0.0)
     mid = vox.grid.world_to_map(1.0, 0.0)
     assert vox.grid.costs[mid[1], mid[0]] == FREE_SPACE
+
+
+def test_costs_from_published_inverts_the_costmap_publisher():
+    costs = np.arange(256, dtype=np.uint8)
+    published = occupancy_from_costs(costs)
+    assert np.array_equal(occupancy_from_costs(costs_from_published(published)), published)
+    assert costs_from_published(np.array([-1, 0, 99, 100], np.int8)).tolist() == [255, 0, 253, 254]

@@ -6,11 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from fleetsim.nav.costmap.layered_costmap import occupancy_from_costs
 from fleetsim.nav.explore import frontiers_from_grid
 from fleetsim.nav.explore.path_costs import (
     by_path,
-    costs_from_occupancy,
     frontier_distances,
     path_distance_field,
 )
@@ -39,13 +37,6 @@ def rooms() -> np.ndarray:
 
 WEST_ROBOT = (2.5, 2.0)  # in the west room, beside the wall
 PEER = (5.0, 3.5)  # in the corridor above the east room's door
-
-
-def test_costs_from_occupancy_inverts_the_costmap_publisher():
-    costs = np.arange(256, dtype=np.uint8)
-    published = occupancy_from_costs(costs)
-    assert np.array_equal(occupancy_from_costs(costs_from_occupancy(published)), published)
-    assert costs_from_occupancy(np.array([-1, 0, 99, 100], np.int8)).tolist() == [255, 0, 253, 254]
 
 
 def test_the_field_goes_round_walls_through_doors_and_not_into_unknown_cells():

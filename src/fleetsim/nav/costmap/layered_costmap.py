@@ -292,11 +292,32 @@ class LayeredCostmap:
         )
 
 
-def occupancy_from_costs(costs: np.ndarray) -> np.ndarray:
-    """costmap_2d's publisher translation: 0->0, 1..252->1..97, 253->99, 254->100, 255->-1."""
+def _publish_table() -> np.ndarray:
     table = np.empty(256, dtype=np.int8)
     i = np.arange(1, 253)
     table[0] = 0
     table[1:253] = 1 + (97 * (i - 1)) // 251
     table[253], table[254], table[255] = 99, 100, -1
-    return table[np.asarray(costs, dtype=np.uint8)]
+    return table
+
+
+#: costmap_2d's publisher translation, cost (0..255) -> occupancy value
+_PUBLISHED = _publish_table()
+#: its inverse, occupancy value as an unsigned byte -> the least cost published as it (values
+#: above 100 read as lethal, negative ones as unknown)
+_UNPUBLISHED = np.full(256, 254, dtype=np.uint8)
+_UNPUBLISHED[128:] = 255
+for _cost in range(255, -1, -1):  # from the top, so each value keeps its least cost
+    _UNPUBLISHED[int(_PUBLISHED[_cost]) & 0xFF] = _cost
+
+
+def occupancy_from_costs(costs: np.ndarray) -> np.ndarray:
+    """costmap_2d's publisher translation: 0->0, 1..252->1..97, 253->99, 254->100, 255->-1."""
+    return _PUBLISHED[np.asarray(costs, dtype=np.uint8)]
+
+
+def costs_from_published(data: np.ndarray) -> np.ndarray:
+    """(H, W) uint8 costs of a published costmap grid (H, W) int8: the inverse of
+    `occupancy_from_costs`, each value read as the least cost that publishes as it (-1 -> 255
+    unknown, 99 -> 253 inscribed, 100 -> 254 lethal)."""
+    return _UNPUBLISHED[np.asarray(data).astype(np.int16) & 0xFF]

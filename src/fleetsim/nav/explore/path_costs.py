@@ -25,6 +25,7 @@ from dataclasses import replace
 import numpy as np
 from scipy import ndimage
 
+from fleetsim.nav.costmap.layered_costmap import costs_from_published
 from fleetsim.nav.planners.navfn_kernels import (
     COST_NEUTRAL,
     POT_HIGH,
@@ -36,20 +37,6 @@ from .frontier_search import INSCRIBED, Frontier
 
 #: navfn's cycle budget for a whole field (it stops earlier when every cell is reached)
 _CYCLES = 10**8
-
-
-def costs_from_occupancy(data: np.ndarray) -> np.ndarray:
-    """(H, W) uint8 costmap_2d costs from a published costmap grid (H, W) int8: the inverse of
-    costmap_2d's publisher translation (-1 -> 255 unknown, 99 -> 253 inscribed, 100 -> 254
-    lethal, 1..98 -> 1..252: the least cost each stands for)."""
-    data = np.asarray(data).astype(np.int16)
-    out = np.zeros(data.shape, dtype=np.uint8)
-    mid = (data >= 1) & (data < INSCRIBED)
-    out[mid] = 1 + -((-(data[mid] - 1) * 251) // 97)  # the least cost that publishes as it
-    out[data >= INSCRIBED] = 253
-    out[data >= 100] = 254
-    out[data < 0] = 255
-    return out
 
 
 def path_distance_field(
@@ -72,7 +59,7 @@ def path_distance_field(
     if not passable[sy, sx]:
         _, (iy, ix) = ndimage.distance_transform_edt(~passable, return_indices=True)
         sy, sx = int(iy[sy, sx]), int(ix[sy, sx])
-    costarr = navfn_costs(costs_from_occupancy(data), False)
+    costarr = navfn_costs(costs_from_published(data), False)
     pot, _ = navfn_potential(costarr, w, sy * w + sx, 0, False, _CYCLES)
     pot = pot.reshape(h, w).astype(np.float64)
     reached = pot < POT_HIGH

@@ -23,7 +23,7 @@ STALE_RADIUS = 1.0  # m: a goal with no frontier centroid this near has lost its
 
 
 def _near(goal, frontiers, radius: float = STALE_RADIUS) -> bool:
-    return any(math.dist(goal, f.centroid) < radius for f in frontiers)
+    return any(math.dist(goal, f.goal) < radius for f in frontiers)
 
 
 class ExploreTrace:
@@ -43,12 +43,12 @@ class ExploreTrace:
         trace = self
         send, done = Explore._send, Explore._on_done
 
-        def traced_send(ex, target, frame):
+        def traced_send(ex, target, frame, yaw=0.0):
             old = ex.goal if ex._handle is not None else None
             if old is not None:
                 how = "switched" if _near(old, ex.frontiers) else "closed"
                 trace._end(ex, old, how)
-            f = next((f for f in ex.frontiers if math.dist(f.centroid, target) < 1e-6), None)
+            f = next((f for f in ex.frontiers if math.dist(f.goal, target) < 1e-6), None)
             peers = [g for g in ex.peers.values() if g is not None]
             at = trace.paths[ex.namespace][-1] if trace.paths[ex.namespace] else (math.nan,) * 2
             trace.events[ex.namespace].append(
@@ -56,7 +56,7 @@ class ExploreTrace:
                      distance=f.min_distance if f else math.nan, frontiers=len(ex.frontiers),
                      peer_goal=peers[0] if peers else None, at=at)
             )  # fmt: skip
-            return send(ex, target, frame)
+            return send(ex, target, frame, yaw)
 
         def traced_done(ex, goal, status):
             if ex.goal == goal:

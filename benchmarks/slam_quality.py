@@ -184,6 +184,7 @@ def office(
         slam = slam_node.grid_msg if robots == 1 else s.nodes["/map_merge"].merged
     state = ", ".join(
         f"{n or robot}: finished={ex.finished} gave_up={ex.gave_up} blacklisted={len(ex.blacklist)}"
+        f" observed={ex.observed}"
         for n, ex in zip(names, explorers)
     )
     print(f"office ({robots} {robot}(s) explore, seed {seed}): {state}")

@@ -38,6 +38,16 @@ distance the robot drives to it (navfn's wavefront over the costmap,
 shrinks (its centroid creeping); explore_lite restarts it whenever the goal point moves. The
 rules: `fleetsim.nav.explore.peers`.
 
+With ``view_points`` (a fleetsim addition, off by default; slam_explore sets it) each frontier's
+goal is the nearest point the robot can drive to that sees it (within ``view_range``) instead of
+its centroid, progress is measured as the distance driven to that point, and a frontier still
+there after the robot has stood at its view point is *observed as far as it can be*: left, and
+not counted as given up, so exploration that ends with only such frontiers left finished
+(``succeeded``; ``observed`` counts them); one left because move_base aborted, or made no
+progress to, its view point is still given up. Each explorer publishes the view points it stood
+at on ``~observed`` (geometry_msgs/PoseArray) and reads its peers' (``peer_observed``). Why and
+how: `fleetsim.nav.explore.view_points`.
+
 ``costmap_updates_topic`` is accepted but fleetsim's costmaps publish whole grids only (see
 `fleetsim.nav.costmap.costmap_ros`), so it is not subscribed. ``orientation_scale`` is accepted
 and, as in explore_lite, unused.
@@ -47,7 +57,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -55,61 +65,18 @@ import numpy as np
 from fleetsim.errors import FleetsimError
 from fleetsim.msgs import geometry_msgs, move_base_msgs, nav_msgs, std_msgs, visualization_msgs
 from fleetsim.nav.move_base_support import pose_stamped
-from fleetsim.runtime import Node, param
+from fleetsim.runtime import Node
 from fleetsim.tf.names import resolve_frame_once
 
 from .frontier_search import Frontier, frontiers_from_grid
-from .path_costs import by_path
+from .markers import frontier_markers
+from .params import ExploreParams
+from .path_costs import by_path, path_distance_field
 from .peers import frontier_for_robot, tracked_frontier
+from .view_points import cell_value, view_point
 
 BLACKLIST_RADIUS_CELLS = 5  # explore_lite's goalOnBlacklist tolerance
 SUCCEEDED, ABORTED = 3, 4
-
-
-@dataclass(frozen=True)
-class ExploreParams:
-    """explore_lite's parameters (ROS names and defaults)."""
-
-    robot_base_frame: str = param("base_link", help="robot base frame (tf_prefix applied)")
-    costmap_topic: str = param("costmap", help="nav_msgs/OccupancyGrid to explore")
-    costmap_updates_topic: str = param(
-        "costmap_updates", help="accepted; fleetsim's costmaps publish whole grids"
-    )
-    visualize: bool = param(False, help="publish frontiers as markers on ~frontiers")
-    planner_frequency: float = param(1.0, unit="Hz", range=(1e-3, None), help="replanning rate")
-    progress_timeout: float = param(
-        30.0, unit="s", range=(0.0, None), help="blacklist a goal without progress this long"
-    )
-    potential_scale: float = param(1e-3, range=(0.0, None), help="weight of frontier distance")
-    orientation_scale: float = param(0.0, range=(0.0, None), help="unused, as in explore_lite")
-    gain_scale: float = param(1.0, range=(0.0, None), help="weight of frontier size")
-    transform_tolerance: float = param(
-        0.3, unit="s", range=(0.0, None), help="oldest robot pose (tf) used to plan"
-    )
-    min_frontier_size: float = param(
-        0.5, unit="m", range=(0.0, None), help="smallest frontier considered"
-    )
-    # fleetsim additions: explorers that share a map leave each other's frontiers alone
-    peer_goals: list = param([], help="other explorers' ~goal topics (geometry_msgs/PointStamped)")
-    peer_radius: float = param(
-        3.0, unit="m", range=(0.0, None), help="frontiers this close to a peer's goal are its"
-    )
-    peer_frames: list = param(
-        [], help="other explorers' base frames: frontiers nearer to one of them are its"
-    )
-    peer_blacklists: list = param(
-        [], help="other explorers' ~blacklist topics (geometry_msgs/PoseArray): skipped too"
-    )
-    switch_distance: float = param(
-        0.0,
-        unit="m",
-        range=(0.0, None),
-        help="keep the frontier it heads for unless another is cheaper by this much distance",
-    )
-    path_costs: bool = param(
-        False,
-        help="measure frontiers by the distance driven (navfn's wavefront), not straight lines",
-    )
 
 
 class Explore(Node):
@@ -132,6 +99,13 @@ class Explore(Node):
         #: frontiers left (for the run monitor, which does not count them as failed)
         self.withdrawn_goals: set[str] = set()
         self.goals_sent = 0
+        #: view points move_base reached (view_points), and the peers' (peer_observed), with
+        #: when (sim s; a peer's list at the time it was published)
+        self.stood_at: list[tuple[float, float, float]] = []
+        self.peer_stood_at: dict[str, list[tuple[float, float, float]]] = {}
+        self._grid_time = 0.0
+        #: frontiers left when it stopped that were observed as far as they can be
+        self.observed = 0
         self._handle: Any = None
         self._best_distance = math.inf
         self._last_progress = 0.0
@@ -141,6 +115,17 @@ class Explore(Node):
         self.blacklist_pub = self.create_publisher(
             geometry_msgs.PoseArray, "~blacklist", 1, latch=True
         )
+        self.observed_pub = self.create_publisher(
+            geometry_msgs.PoseArray, "~observed", 1, latch=True
+        )
+        for topic in p.peer_observed:
+            self.peer_stood_at[str(topic)] = []
+            self.create_subscription(
+                geometry_msgs.PoseArray,
+                str(topic),
+                lambda m, t=str(topic): self.on_peer_observed(t, m),
+                1,
+            )
         self.peer_blacklists: dict[str, list[tuple[float, float]]] = {}
         for topic in p.peer_blacklists:
             self.peer_blacklists[str(topic)] = []
@@ -179,24 +164,32 @@ class Explore(Node):
 
     def on_costmap(self, msg: nav_msgs.OccupancyGrid) -> None:
         self.grid = msg
+        self._grid_time = self.now()
+
+    def on_peer_observed(self, topic: str, msg: geometry_msgs.PoseArray) -> None:
+        t = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+        self.peer_stood_at[topic] = [(x, y, t) for x, y in _points(msg)]
 
     def on_peer(self, topic: str, msg: geometry_msgs.PointStamped) -> None:
         x, y = msg.point.x, msg.point.y
         self.peers[topic] = (x, y) if math.isfinite(x) and math.isfinite(y) else None
 
     def on_peer_blacklist(self, topic: str, msg: geometry_msgs.PoseArray) -> None:
-        self.peer_blacklists[topic] = [(q.position.x, q.position.y) for q in msg.poses]
+        self.peer_blacklists[topic] = _points(msg)
 
     def _blacklist(self, goal: tuple[float, float]) -> None:
         """Blacklist a goal and tell the peers (~blacklist)."""
         self.blacklist.append(goal)
+        self._publish_points(self.blacklist_pub, self.blacklist)
+
+    def _publish_points(self, pub, points: list[tuple[float, float]]) -> None:
         frame = self.grid.header.frame_id if self.grid is not None else ""
-        self.blacklist_pub.publish(
+        pub.publish(
             geometry_msgs.PoseArray(
                 header=std_msgs.Header(stamp=self.now_msg(), frame_id=frame),
                 poses=[
                     geometry_msgs.Pose(position=geometry_msgs.Point(x=float(x), y=float(y)))
-                    for x, y in self.blacklist
+                    for x, y in points
                 ],
             )
         )
@@ -276,23 +269,44 @@ class Explore(Node):
         )
         if self.marker_pub is not None:
             self._publish_markers(frame)
+        origin = (info.origin.position.x, info.origin.position.y)
+        field = None
+        if p.view_points:
+            field = path_distance_field(data, info.resolution, origin, robot)
+            self.frontiers = [
+                replace(f, view_point=view_point(field, data, info.resolution, origin, f,
+                                                 p.view_range))
+                for f in self.frontiers
+            ]  # fmt: skip
         tolerance = BLACKLIST_RADIUS_CELLS * info.resolution
         blacklist = [*self.blacklist, *itertools.chain(*self.peer_blacklists.values())]
+        # view points stood at long enough ago for this map to show what was seen from there
+        settled = self._grid_time - p.observe_delay
+        stood = [
+            (x, y)
+            for x, y, t in itertools.chain(self.stood_at, *self.peer_stood_at.values())
+            if t <= settled
+        ]
+        observed = [
+            f
+            for f in self.frontiers
+            if f.view_point is not None and any(math.dist(f.goal, s) < tolerance for s in stood)
+        ]
         candidates = [
             f
             for f in self.frontiers
-            if not any(math.dist(f.centroid, b) < tolerance for b in blacklist)
+            if not any(math.dist(f.goal, b) < tolerance for b in blacklist)
+            and not any(f is o for o in observed)
         ]
         if not candidates:
-            self.stop("all frontiers traversed/tried out, stopping")
+            self.stop("all frontiers traversed/tried out, stopping", len(observed))
             return
         positions = self._peer_positions(frame)
         distances = None
         if p.path_costs:
-            origin = (info.origin.position.x, info.origin.position.y)
             candidates, distances = by_path(
                 data, info.resolution, origin, candidates, [robot, *positions],
-                p.potential_scale, p.gain_scale,
+                p.potential_scale, p.gain_scale, field,
             )  # fmt: skip
         chosen = frontier_for_robot(
             candidates,
@@ -310,7 +324,7 @@ class Explore(Node):
                 self.goal = None
                 self._announce(None)
             return
-        target = chosen.centroid
+        target = chosen.goal
         same = self.goal is not None and math.dist(target, self.goal) < 1e-6
         # with switch_distance the frontier it heads for is tracked as its centroid moves
         # (peers.tracked_frontier); explore_lite restarts the progress clock whenever the goal point
@@ -323,8 +337,13 @@ class Explore(Node):
             and chosen is tracked_frontier(candidates, self.goal)
         )
         # progress as explore_lite measures it: towards the frontier's nearest cell (its
-        # centroid may lie behind a wall the robot has to go round)
+        # centroid may lie behind a wall the robot has to go round); with view_points, the
+        # distance it drives to the view point (the straight line grows on the way out of one
+        # room and into the next: see fleetsim.nav.explore.view_points)
         distance = chosen.min_distance
+        if field is not None and chosen.view_point is not None:
+            along = cell_value(field, info.resolution, origin, chosen.view_point)
+            distance = along if math.isfinite(along) else distance
         now = self.now()
         if not kept or distance < self._best_distance:
             self._best_distance = distance
@@ -337,15 +356,21 @@ class Explore(Node):
             return
         if same and self._handle is not None:
             return
-        self._send(target, frame)
+        # a view point apart from its frontier faces it (for a robot whose move_base turns to
+        # the goal's yaw; explore_lite's goals have yaw 0)
+        toward = chosen.centroid
+        yaw = 0.0
+        if chosen.view_point is not None and math.dist(toward, target) > info.resolution:
+            yaw = math.atan2(toward[1] - target[1], toward[0] - target[0])
+        self._send(target, frame, yaw)
 
-    def _send(self, target: tuple[float, float], frame: str) -> None:
+    def _send(self, target: tuple[float, float], frame: str, yaw: float = 0.0) -> None:
         if not self.move_base.wait_for_server():
             self._warn_once("move_base", f"waiting for move_base at {self.move_base.name}")
             return
         self.goal = target
         self._announce(target, frame)
-        pose = pose_stamped(target[0], target[1], 0.0, frame, self.now_msg())
+        pose = pose_stamped(target[0], target[1], yaw, frame, self.now_msg())
         self.goals_sent += 1
         self._handle = self.move_base.send_goal(
             move_base_msgs.MoveBaseGoal(target_pose=pose),
@@ -359,15 +384,24 @@ class Explore(Node):
         if status == ABORTED:
             self.get_logger().info(f"move_base aborted the goal {goal}; blacklisting it")
             self._blacklist(goal)
+        elif status == SUCCEEDED and self.params.view_points:
+            self.stood_at.append((*goal, self.now()))  # what it sees from here is observed
+            self._publish_points(self.observed_pub, [(x, y) for x, y, _ in self.stood_at])
         self.goal = None
         self._announce(None)
         self.runtime.call_later(0.0, self.make_plan)  # explore_lite replans on reaching a goal
 
-    def stop(self, why: str) -> None:
+    def stop(self, why: str, observed: int = 0) -> None:
+        """Stop exploring; ``observed`` of the frontiers left were observed as far as they can
+        be (view_points), the rest are blacklisted: given up."""
         self.finished = True
-        self.gave_up = bool(self.frontiers)  # what is left is all blacklisted
+        self.observed = observed
+        given_up = len(self.frontiers) - observed
+        self.gave_up = given_up > 0
+        if observed:
+            why += f" ({observed} frontiers left observed as far as they can be)"
         if self.gave_up:
-            why += f" (gave up: {len(self.frontiers)} frontiers left, all blacklisted)"
+            why += f" (gave up: {given_up} frontiers left, blacklisted)"
         self._withdraw_goal()
         self.timer.cancel()
         self._announce(None)
@@ -375,21 +409,8 @@ class Explore(Node):
 
     def _publish_markers(self, frame: str) -> None:
         header = std_msgs.Header(stamp=self.now_msg(), frame_id=frame)
-        markers = [
-            visualization_msgs.Marker(header=header, action=visualization_msgs.Marker.DELETEALL)
-        ]
-        for i, f in enumerate(self.frontiers):
-            markers.append(
-                visualization_msgs.Marker(
-                    header=header,
-                    ns="frontiers",
-                    id=i,
-                    type=visualization_msgs.Marker.POINTS,
-                    scale=geometry_msgs.Vector3(x=0.1, y=0.1, z=0.1),
-                    color=std_msgs.ColorRGBA(r=1.0, g=0.0, b=0.0, a=1.0),
-                    points=[
-                        geometry_msgs.Point(x=float(x), y=float(y), z=0.0) for x, y in f.points
-                    ],
-                )
-            )
-        self.marker_pub.publish(visualization_msgs.MarkerArray(markers=markers))
+        self.marker_pub.publish(frontier_markers(self.frontiers, header))
+
+
+def _points(msg: geometry_msgs.PoseArray) -> list[tuple[float, float]]:
+    return [(q.position.x, q.position.y) for q in msg.poses]

@@ -39,6 +39,14 @@ class Frontier:
     min_distance: float
     cost: float
     points: np.ndarray  # (N, 2) cell centres, m
+    #: where the robot sees it from (explore's ``view_points``, `fleetsim.nav.explore.view_points`)
+    view_point: tuple[float, float] | None = None
+
+    @property
+    def goal(self) -> tuple[float, float]:
+        """The point explore sends move_base to: the view point, else (explore_lite) the
+        centroid."""
+        return self.view_point if self.view_point is not None else self.centroid
 
 
 def frontiers_from_grid(

@@ -99,16 +99,22 @@ def by_path(
     robots: Sequence[tuple[float, float]],
     potential_scale: float,
     gain_scale: float,
+    own_field: np.ndarray | None = None,
 ) -> tuple[list[Frontier], np.ndarray]:
     """The frontiers ranked by explore_lite's cost with the distance the first of ``robots``
     drives in place of the straight line, and the (F, R) metres each robot drives to each (in
     the new order; inf: cannot reach it).
 
     The returned frontiers are copies whose ``cost`` is the path cost; ``min_distance`` stays
-    explore_lite's straight line, which its progress check measures (progress measured along
-    the path instead was tried and dropped: see the README's SLAM row). A frontier the robot's
-    own field does not reach keeps its straight-line cost."""
-    fields = [path_distance_field(data, resolution, origin, r) for r in robots]
+    explore_lite's straight line (explore's ``view_points`` measures progress along the path to
+    the frontier's view point instead, `fleetsim.nav.explore.view_points`). A frontier the
+    robot's own field does not reach keeps its straight-line cost. ``own_field``: the first
+    robot's `path_distance_field`, when the caller has it already."""
+    fields = [
+        own_field if i == 0 and own_field is not None
+        else path_distance_field(data, resolution, origin, r)
+        for i, r in enumerate(robots)
+    ]  # fmt: skip
     dist = np.column_stack(
         [frontier_distances(f, resolution, origin, frontiers) for f in fields]
     ).reshape(len(frontiers), len(robots))

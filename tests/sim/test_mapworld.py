@@ -76,3 +76,32 @@ def test_a_map_with_no_occupied_cell_builds_a_world_with_floor_under_it(tmp_path
     )  # the 12 x 8 cells of 0.5 m: 6 x 4 m
     assert ground.name == "ground_plane"
     assert np.hypot(ground.pose[0] - middle[0], ground.pose[1] - middle[1]) < 1e-9
+
+
+@pytest.mark.parametrize("origin", [(0.0, 0.0, 0.0), (-3.0, 1.0, 0.7)])
+def test_a_map_world_is_bounded_as_stage_floorplans_are(tmp_path, origin):
+    """Willow's grey surround reads as free: without a boundary a robot pushed past the map's
+    edge drove off every costmap (the soak's warnings). A ray from the middle of an all-free
+    map hits a wall just outside each edge and each corner; ``boundary=False`` leaves it open."""
+    import mujoco
+
+    from fleetsim.sim.engine import Engine
+    from fleetsim.sim.world import world_from_map
+
+    path = write_map(tmp_path, np.full((8, 12), 254), origin=origin)  # 6 x 4 m of free cells
+    ox, oy, yaw = origin
+    c, s = np.cos(yaw), np.sin(yaw)
+    middle = np.array([ox + c * 3.0 - s * 2.0, oy + s * 3.0 + c * 2.0, 0.5])
+    # local directions and the distance to the map's edge along them
+    cases = [((1, 0), 3.0), ((-1, 0), 3.0), ((0, 1), 2.0), ((0, -1), 2.0)]
+    cases.append(((3 / np.hypot(3, 2), 2 / np.hypot(3, 2)), np.hypot(3, 2)))
+    for bounded in (True, False):
+        e = Engine(world_from_map(path, boundary=bounded))
+        for (dx, dy), edge in cases:
+            vec = np.array([c * dx - s * dy, s * dx + c * dy, 0.0])
+            geomid = np.zeros(1, np.int32)
+            d = mujoco.mj_ray(e.model, e.data, middle, vec, None, 1, -1, geomid)
+            if bounded:
+                assert edge - 1e-6 <= d <= edge + 0.5 * np.sqrt(2) + 1e-6, (dx, dy, d)
+            else:
+                assert d == -1, (dx, dy, d)

@@ -14,7 +14,8 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    ``max_vel_x``, slowing at a quarter of ``acc_lim_x`` (not below ``min_vel_x``) to stop at
    the goal; while another robot ahead, nearer than the goal, is closing in, it is turned by
    ``left_pref`` rad (negative: keep right), which breaks the symmetry of head-on meetings that
-   plain ORCA cannot;
+   plain ORCA cannot; outside a meeting, a robot carried off its way by a higher-priority robot
+   beside it that moves the same way drops back behind it (`fleetsim.nav.multirobot.crossing`);
 3. the `DeadlockRule` may make the robot yield (at once when a robot faces it across a
    passage too narrow for two): it backs out along the way it came (``max_vel_x_backwards``)
    to a place wide enough, aside to the right, taking full responsibility for avoiding the
@@ -67,6 +68,7 @@ from fleetsim.nav.controllers.collvoid_preference import (
     CollvoidPreference,
 )
 from fleetsim.nav.costmap.footprint import footprint_radii, outline_points
+from fleetsim.nav.multirobot.crossing import GiveWay
 from fleetsim.nav.multirobot.deadlock import DeadlockRule
 from fleetsim.nav.multirobot.holonomic import (
     obstacle_points,
@@ -156,6 +158,8 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
         self.last_w = 0.0
         self.last_holo = np.zeros(2)
         self.yielding_to: str | None = None
+        self.give_way = GiveWay(self.robot_id)  # the crossing rule's state
+        self.giving_way_to: str | None = None  # this cycle's robot given way to
         self.waiting = False  # yielding, in the refuge: stands still while ORCA lets it
         self.plan_index = 0
         self.retreat = Retreat()  # the way back and the refuge of a yield
@@ -190,6 +194,7 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
             self.detour_sides.clear()
             self.deadlock.reset(self.node.now())
             self.retreat.reset()
+            self.give_way.reset()
             self.escape_from = None
 
     def is_goal_reached(self) -> bool:
@@ -317,11 +322,17 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
             if self.yielding_to is not None:
                 resp[k] = 1.0
                 self.waiting = not pref.any()
+        self.giving_way_to = None
         if self.yielding_to is None and ids:
+            wanted = pref
             near_goal = remaining < KEEP_RIGHT_UNTIL
-            if not near_goal and self._oncoming(pos - xy, nvel, vel, pref, dist, remaining).any():
+            meeting = self._oncoming(pos - xy, nvel, vel, pref, dist, remaining).any()
+            if not near_goal and meeting:
                 pref = rotated(pref, p.left_pref)
             pref = self._around_still(pref, xy, vel, pos - xy, nvel, own_r + radii, controlled, ids)
+            pref = self._give_way(
+                pref, wanted, vel, pos - xy, nvel, own_r + radii, resp, controlled, ids, meeting
+            )
         return self._orca(xy, vel, pref, pos - xy, nvel, own_r + radii, resp)
 
     def _orca(self, xy, vel, pref, rel, nvel, radii, resp) -> np.ndarray:

@@ -1,16 +1,18 @@
 """The preferred velocity's rules around other robots, for ``CollvoidLocalPlanner``: keeping
-right in a meeting (`_oncoming`), going round robots that stand in the way (`_around_still`)
-and the velocity of a robot that yields (`_yield_velocity`).
+right in a meeting (`_oncoming`), going round robots that stand in the way (`_around_still`),
+giving way at a crossing (`_give_way`, `fleetsim.nav.multirobot.crossing`) and the velocity
+of a robot that yields (`_yield_velocity`).
 
 `CollvoidPreference` is mixed into the planner, which owns the state it reads (``params``,
 ``node``, ``plan``, ``costmap``, ``body_radius``, ``deadlock``, ``retreat``, ``yielding_to``,
-``detour_sides``).
+``detour_sides``, ``give_way``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
+from fleetsim.nav.multirobot.crossing import GIVE_WAY_SPEED, REACH, across_way, carried_by
 from fleetsim.nav.multirobot.holonomic import detour_velocity, gaps_closed
 from fleetsim.nav.multirobot.yielding import has_passed
 
@@ -69,6 +71,22 @@ class CollvoidPreference:
             bearing = rel[idx[k]]
             sides[near[k]] = int(bearing[0] * out[1] - bearing[1] * out[0] > 0.0)
         return out
+
+    def _give_way(self, pref, wanted, vel, rel, nvel, radii, resp, controlled, ids, meeting):
+        """``pref``, or its `GIVE_WAY_SPEED` share while this robot gives way at a crossing
+        (`fleetsim.nav.multirobot.crossing`; then ``giving_way_to`` names the robot and its
+        responsibility ``resp`` (N,) becomes all of it). ``wanted`` (2,) m/s: the way to the
+        carrot before keeping right; ``radii`` (N,) m combined; ``meeting``: keeping right
+        (robots coming against us are keeping right's, not a crossing)."""
+        moving = (np.hypot(nvel[:, 0], nvel[:, 1]) >= STILL_SPEED) & controlled
+        carrying = carried_by(rel, nvel, radii, vel, wanted, REACH) & moving & (not meeting)
+        in_the_way = across_way(rel, radii, wanted, REACH)
+        to = self.give_way.update(self.node.now(), list(ids), carrying, in_the_way, moving)
+        self.giving_way_to = to
+        if to is None:
+            return pref
+        resp[list(ids).index(to)] = 1.0  # ORCA moves us out of its way, all of it ours
+        return GIVE_WAY_SPEED * pref
 
     @staticmethod
     def _oncoming(rel, nvel, vel, pref, dist, reach) -> np.ndarray:

@@ -1,0 +1,114 @@
+"""Giving way at a crossing (`fleetsim.nav.multirobot.crossing`): a robot carried off its way by
+a neighbour beside it that moves the same way drops back when it has the lower priority."""
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+
+from fleetsim.msgs import collvoid_msgs, geometry_msgs
+from fleetsim.msgs.builtin_interfaces import Time
+from fleetsim.nav.controllers.collvoid_planner import CollvoidLocalPlanner
+from fleetsim.nav.costmap.costmap_2d import Costmap2D
+from fleetsim.nav.multirobot.crossing import CROSSING_TIME, GIVE_WAY_TIME, GiveWay, carried_by
+from fleetsim.runtime import Node, Runtime
+
+LIZI = np.array([[-0.19, -0.16], [-0.19, 0.16], [0.19, 0.16], [0.19, -0.16]])
+BODY = math.hypot(0.19, 0.16)
+#: held-out seed 9 of the circle of 16, lizi10 beside lizi2 (their frame: lizi10 at the origin)
+OURS = np.array([-0.27, -0.42])  # m/s
+WANTED = np.array([0.31, -0.40])  # m/s, to the carrot
+BESIDE, ITS_VEL = np.array([[0.58, 0.05]]), np.array([[-0.30, -0.27]])
+R = np.array([0.56])
+
+
+def test_a_neighbour_beside_us_moving_our_way_across_our_preferred_way_carries_us():
+    assert carried_by(BESIDE, ITS_VEL, R, OURS, WANTED, 1.0).tolist() == [True]
+
+
+@pytest.mark.parametrize(
+    "rel, vel, ours, why",
+    [
+        ([0.0, -0.8], [-0.27, -0.42], OURS, "a leader ahead on our own way: we follow it"),
+        ([0.58, 0.05], [0.30, 0.27], OURS, "it moves against us: a meeting, keeping right's"),
+        ([0.58, 0.05], [-0.30, -0.27], [0.2, -0.45], "our velocity within 60 deg of our way"),
+        ([-0.58, 0.05], [-0.30, -0.27], OURS, "it is on the other side: not across our way"),
+        ([0.58, 0.05], [-0.30, -0.27], [0.0, 0.0], "we stand: nothing carries us"),
+    ],
+)
+def test_not_carried(rel, vel, ours, why):
+    out = carried_by(np.array([rel]), np.array([vel]), R, np.array(ours), WANTED, 1.0)
+    assert out.tolist() == [False], why
+
+
+def test_the_lower_priority_robot_gives_way_after_crossing_time_until_the_other_has_crossed():
+    yes, no = np.array([True]), np.array([False])
+    low, high = GiveWay("lizi10"), GiveWay("lizi1")
+    for t in np.arange(0.0, CROSSING_TIME, 0.1):
+        assert low.update(t, ["lizi2"], yes, yes, yes) is None
+        assert high.update(t, ["lizi2"], yes, yes, yes) is None
+    t = CROSSING_TIME + 0.05
+    assert low.update(t, ["lizi2"], yes, yes, yes) == "lizi2"
+    assert high.update(t, ["lizi2"], yes, yes, yes) is None  # lizi1 has priority over lizi2
+    # carried or not, the way is given until lizi2 is out of our way ...
+    assert low.update(t + 1.0, ["lizi2"], no, yes, yes) == "lizi2"
+    assert low.update(t + 1.1, ["lizi2"], no, no, yes) is None
+    # ... stops (parked robots are gone round), or GIVE_WAY_TIME has passed
+    low.reset()
+    low.update(0.0, ["lizi2"], yes, yes, yes)
+    assert low.update(CROSSING_TIME, ["lizi2"], yes, yes, yes) == "lizi2"
+    assert low.update(CROSSING_TIME + 0.5, ["lizi2"], yes, yes, no) is None
+    low.reset()
+    low.update(0.0, ["lizi2"], yes, yes, yes)
+    low.update(CROSSING_TIME, ["lizi2"], yes, yes, yes)
+    assert low.update(CROSSING_TIME + GIVE_WAY_TIME + 0.1, ["lizi2"], no, yes, yes) is None
+
+
+def _beside(robot_id: str, neighbour_id: str, cycles: int):
+    """A planner at the origin moving along OURS, its plan along WANTED, and a neighbour
+    published beside it every 0.1 s moving the same way at the same speed (the seed-9 pair,
+    drawn together), for ``cycles`` cycles: (the robot given way to each cycle, the planner)."""
+    rt = Runtime()
+    node = Node(rt, "move_base", f"/{robot_id}")
+    costmap = SimpleNamespace(
+        costmap=Costmap2D(80, 80, 0.05, -2.0, -2.0), footprint=LIZI, global_frame="map"
+    )
+    params = {"max_vel_x": 0.5, "min_vel_x": 0.1, "max_error_holo": 0.05}  # the lizi's
+    planner = CollvoidLocalPlanner.from_namespace(node, costmap, params, robot_id)
+    line = np.linspace([0.0, 0.0], WANTED / np.hypot(*WANTED) * 3.0, 40)
+    planner.set_plan(np.c_[line, np.zeros(40)])
+    pub = Node(rt, "sim", "/").create_publisher(
+        collvoid_msgs.PoseTwistWithCovariance, "/position_share"
+    )
+    yaw, speed = math.atan2(OURS[1], OURS[0]), float(np.hypot(*OURS))
+    given = []
+    for _ in range(cycles):
+        m = collvoid_msgs.PoseTwistWithCovariance(robot_id=neighbour_id, radius=BODY)
+        m.header.stamp = Time.from_sec(rt.now())
+        m.controlled = True
+        m.pose.pose.position = geometry_msgs.Point(x=0.58, y=-0.05)
+        m.pose.pose.orientation = geometry_msgs.Quaternion(z=math.sin(yaw / 2), w=math.cos(yaw / 2))
+        m.holonomic_velocity = geometry_msgs.Vector3(
+            x=speed * math.cos(yaw), y=speed * math.sin(yaw)
+        )
+        m.footprint.polygon.points = [geometry_msgs.Point32(x=a, y=b) for a, b in LIZI]
+        pub.publish(m)
+        rt.run(duration=0.1)
+        planner.compute_velocity_commands((0.0, 0.0, yaw), (speed, 0.0, 0.0))
+        given.append(planner.giving_way_to)
+    return given, planner
+
+
+def test_the_planner_drops_back_behind_a_higher_priority_robot_that_carries_it():
+    """Carried beside lizi2 (ORCA keeps it alongside, at lizi2's pace, off its own way), lizi10
+    drops back after CROSSING_TIME: its ORCA velocity falls behind lizi2's along lizi2's
+    motion; lizi1 in its place keeps pace (it has priority over lizi2)."""
+    along = OURS / np.hypot(*OURS)  # lizi2 moves as we do
+    given, low = _beside("lizi10", "lizi2", 15)
+    n = round(CROSSING_TIME / 0.1)
+    assert given[: n - 1] == [None] * (n - 1) and given[-1] == "lizi2"
+    assert float(low.last_holo @ along) < 0.4
+    given, high = _beside("lizi1", "lizi2", 15)
+    assert given == [None] * 15
+    assert float(high.last_holo @ along) > 0.45

@@ -4,7 +4,7 @@ view point observed as far as it can be, not given up; one whose view point move
 not reach still given up."""
 
 import numpy as np
-from test_explore_blacklist import ROBOT, MoveBase, World, room
+from test_explore_blacklist import MoveBase, World, room
 from test_path_costs import rooms
 
 from fleetsim.nav.explore import Explore
@@ -122,4 +122,23 @@ def test_progress_is_measured_along_the_way_to_the_view_point():
     assert not ex.blacklist and ex.goal is not None
 
 
-assert ROBOT  # the room's robot position is the one test_explore_blacklist's World publishes
+def test_a_way_the_map_blocks_restarts_the_progress_clock():
+    # the robot stands still in a known 3 x 4 m room whose east edge is the frontier; at 2.5 s
+    # a wall found between it and the view point makes the way there 2.7 m longer: a new
+    # route, measured afresh (blacklisted 2 s after that, not at 4 s, as it would be had the
+    # longer way been no progress)
+    data = np.full((40, 60), -1, dtype=np.int8)
+    data[:, :30] = 0
+    rt = Runtime(seed=0)
+    world = republishing(rt, data)
+    MoveBase(rt, lambda g: None)
+    ex = explorer(rt, progress_timeout=2.0)
+    rt.run(duration=2.5)
+    goal = ex.goal
+    assert goal is not None and not ex.blacklist
+    world.data[1:38, 15] = 100
+    world.publish()
+    rt.run(duration=2.0)
+    assert ex.goal == goal and not ex.blacklist  # 4.5 s
+    rt.run(duration=2.0)
+    assert ex.blacklist == [goal]  # 6.5 s: standing still is still no progress

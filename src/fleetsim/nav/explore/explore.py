@@ -77,6 +77,9 @@ from .view_points import cell_value, view_point
 
 BLACKLIST_RADIUS_CELLS = 5  # explore_lite's goalOnBlacklist tolerance
 SUCCEEDED, ABORTED = 3, 4
+#: m: a way to the goal this much longer than at the last plan was blocked by the map
+#: (view_points; fleetsim.nav.explore.view_points)
+REROUTE_JUMP = 1.0
 
 
 class Explore(Node):
@@ -108,6 +111,7 @@ class Explore(Node):
         self.observed = 0
         self._handle: Any = None
         self._best_distance = math.inf
+        self._last_distance = math.inf
         self._last_progress = 0.0
         self.frontiers: list[Frontier] = []
         self.peers: dict[str, tuple[float, float] | None] = {}
@@ -272,7 +276,7 @@ class Explore(Node):
         origin = (info.origin.position.x, info.origin.position.y)
         field = None
         if p.view_points:
-            field = path_distance_field(data, info.resolution, origin, robot)
+            field = path_distance_field(data, info.resolution, origin, robot, allow_unknown=True)
             self.frontiers = [
                 replace(f, view_point=view_point(field, data, info.resolution, origin, f,
                                                  p.view_range))
@@ -306,7 +310,7 @@ class Explore(Node):
         if p.path_costs:
             candidates, distances = by_path(
                 data, info.resolution, origin, candidates, [robot, *positions],
-                p.potential_scale, p.gain_scale, field,
+                p.potential_scale, p.gain_scale,
             )  # fmt: skip
         chosen = frontier_for_robot(
             candidates,
@@ -341,11 +345,15 @@ class Explore(Node):
         # distance it drives to the view point (the straight line grows on the way out of one
         # room and into the next: see fleetsim.nav.explore.view_points)
         distance = chosen.min_distance
+        rerouted = False
         if field is not None and chosen.view_point is not None:
             along = cell_value(field, info.resolution, origin, chosen.view_point)
             distance = along if math.isfinite(along) else distance
+            # the map blocked the planned way (view_points): restart from the new way's length
+            rerouted = kept and distance > self._last_distance + REROUTE_JUMP
+        self._last_distance = distance
         now = self.now()
-        if not kept or distance < self._best_distance:
+        if not kept or rerouted or distance < self._best_distance:
             self._best_distance = distance
             self._last_progress = now
         if kept and now - self._last_progress > p.progress_timeout:

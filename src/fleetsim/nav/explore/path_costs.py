@@ -40,14 +40,21 @@ _CYCLES = 10**8
 
 
 def path_distance_field(
-    data: np.ndarray, resolution: float, origin: tuple[float, float], start: tuple[float, float]
+    data: np.ndarray,
+    resolution: float,
+    origin: tuple[float, float],
+    start: tuple[float, float],
+    allow_unknown: bool = False,
 ) -> np.ndarray:
     """(H, W) float: metres of driving from ``start`` (m, in the grid's frame) to every cell of
     the published costmap grid ``data`` (H, W) int8, inf where the robot cannot go.
 
     A start off the grid reaches nothing; a start on a cell of inscribed cost or more (a robot
     brushing a wall in the costmap) starts from the nearest cell below it, as explore_lite's
-    frontier search does."""
+    frontier search does. ``allow_unknown``: through unknown cells too, at navfn's cost for
+    them (``COST_OBS - 1``, about five free cells' worth each), as move_base's navfn with its
+    ``allow_unknown`` plans: the field then ranks ways as the planner does, in free-driving
+    metres where the way is known."""
     data = np.asarray(data)
     h, w = data.shape
     out = np.full((h, w), np.inf)
@@ -59,7 +66,7 @@ def path_distance_field(
     if not passable[sy, sx]:
         _, (iy, ix) = ndimage.distance_transform_edt(~passable, return_indices=True)
         sy, sx = int(iy[sy, sx]), int(ix[sy, sx])
-    costarr = navfn_costs(costs_from_published(data), False)
+    costarr = navfn_costs(costs_from_published(data), allow_unknown)
     pot, _ = navfn_potential(costarr, w, sy * w + sx, 0, False, _CYCLES)
     pot = pot.reshape(h, w).astype(np.float64)
     reached = pot < POT_HIGH

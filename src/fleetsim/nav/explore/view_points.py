@@ -12,13 +12,20 @@ on its way there, from the next room (7.1, 1.0) and from the corridor (24.9, 1.0
 it could not see, but goals it could not be seen heading for by a straight line.
 
 So, as next-best-view exploration does, each frontier's goal is a *view point*: the cell
-nearest its centroid that the robot can drive to (cost below the inscribed cost, connected to
-the robot: a finite `fleetsim.nav.explore.path_costs.path_distance_field`) from which one of
+nearest its centroid that the robot can drive to (known, cost below the inscribed cost, reached
+by `fleetsim.nav.explore.path_costs.path_distance_field` from the robot) from which one of
 its cells is within ``view_range`` and in the laser's line of sight (no lethal cell of the
 costmap between; unknown cells do not block it, the laser maps them on the way). Where the
-centroid is such a cell the view point is the centroid's cell. Progress is then measured as
-the distance the robot drives to that point (the same wavefront), which shrinks all the way
-there. A frontier still on the map after the robot has stood at its view point (move_base
+centroid is such a cell the view point is the centroid's cell. Progress is then measured by
+the wavefront move_base's navfn plans with (``allow_unknown``: through unknown cells too, at
+their cost), from the robot to that point, which shrinks all the way there while the robot
+follows the plan. When the map shows that a way planned through unknown cells is blocked,
+that measure jumps up; the route, not the robot, failed, and the progress clock restarts from
+the new measure (office seed 1, with view points measured along known cells only: sent from
+inside room 5's door to room 4's desk strip, the hunter drove 3.5 m south into room 5 and the
+goal was blacklisted after 30 s; not traced further than that).
+
+A frontier still on the map after the robot has stood at its view point (move_base
 reached it) is *observed as far as it can be*: what is left of it no drivable pose in its
 neighbourhood sees (the inside of a desk, a gap under a shelf) and driving there again would
 not change that; explore then leaves it, and does not count it as given up.
@@ -31,7 +38,7 @@ import math
 import numba
 import numpy as np
 
-from .frontier_search import Frontier
+from .frontier_search import INSCRIBED, Frontier
 
 #: candidates checked in order of distance before falling back to sorting them all
 _NEAREST_FIRST = 64
@@ -97,7 +104,8 @@ def view_point(
     Parameters
     ----------
     field : (H, W) float, metres of driving from the robot to each cell, inf where it cannot
-        go (`fleetsim.nav.explore.path_costs.path_distance_field` of ``data``).
+        go (`fleetsim.nav.explore.path_costs.path_distance_field` of ``data``); view points are
+        known cells of cost below the inscribed cost where it is finite.
     data : (H, W) int8, the published costmap (100 lethal: blocks the line of sight).
     resolution, origin : the grid's cell size (m) and lower-left corner (m).
     frontier : one frontier of ``data``; its cells are ``frontier.points`` (N, 2) m.
@@ -112,7 +120,9 @@ def view_point(
     if x0 >= x1 or y0 >= y1:
         return None
     # every line of sight within range runs inside the window: work in its cells
-    ys, xs = np.nonzero(np.isfinite(field[y0:y1, x0:x1]))
+    known = data[y0:y1, x0:x1]
+    drivable = np.isfinite(field[y0:y1, x0:x1]) & (known >= 0) & (known < INSCRIBED)
+    ys, xs = np.nonzero(drivable)
     if len(ys) == 0:
         return None
     blocked = data[y0:y1, x0:x1] == 100
@@ -123,7 +133,7 @@ def view_point(
     cells = float(view_range / resolution)
     k = min(_NEAREST_FIRST, len(d2))
     near = np.argpartition(d2, k - 1)[:k]
-    near = near[np.argsort(d2[near], kind="stable")]
+    near = near[np.lexsort((near, d2[near]))]  # ties in the grid's order: a goal that stays
     i = _first_seeing(blocked, ys[near], xs[near], cy, cx, cells)
     if i < 0 and k < len(d2):
         rest = np.argsort(d2, kind="stable")[k:]

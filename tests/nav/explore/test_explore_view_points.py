@@ -142,3 +142,43 @@ def test_a_way_the_map_blocks_restarts_the_progress_clock():
     assert ex.goal == goal and not ex.blacklist  # 4.5 s
     rt.run(duration=2.0)
     assert ex.blacklist == [goal]  # 6.5 s: standing still is still no progress
+
+
+def test_blacklisted_frontiers_are_tried_again_once_nothing_else_is_left():
+    # the first try at each frontier fails (a robot stuck in a door); on the second the robot
+    # maps the rest: finished, not given up
+    data = room()
+    rt = Runtime(seed=0)
+    world = republishing(rt, data)
+    tries: dict = {}
+
+    def outcome(goal):
+        tries[goal] = tries.get(goal, 0) + 1
+        if tries[goal] == 1:
+            return "abort"
+        world.data[:] = 0  # on its way there it maps the rest
+        world.publish()
+        return None
+
+    mb = MoveBase(rt, outcome)
+    ex = explorer(rt, blacklist_retries=1)
+    rt.run(duration=6.0)
+    assert ex.retries == 1 and ex.finished and ex.succeeded and not ex.gave_up
+    assert len(mb.goals) == 3  # two given up, the first of them tried again and reached
+    # without retries: given up
+    rt = Runtime(seed=0)
+    republishing(rt, room())
+    MoveBase(rt, lambda g: "abort")
+    ex = explorer(rt)
+    rt.run(duration=6.0)
+    assert ex.finished and ex.gave_up and ex.retries == 0
+
+
+def test_a_frontier_given_up_twice_is_given_up():
+    rt = Runtime(seed=0)
+    republishing(rt, room())
+    mb = MoveBase(rt, lambda g: "abort")
+    ex = explorer(rt, blacklist_retries=1)
+    rt.run(duration=6.0)
+    assert ex.finished and ex.gave_up and ex.retries == 1
+    assert len(mb.goals) == 4 and len(set(mb.goals)) == 2

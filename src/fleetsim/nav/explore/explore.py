@@ -102,6 +102,8 @@ class Explore(Node):
         #: frontiers left (for the run monitor, which does not count them as failed)
         self.withdrawn_goals: set[str] = set()
         self.goals_sent = 0
+        #: times the blacklist was cleared (blacklist_retries)
+        self.retries = 0
         #: view points move_base reached (view_points), and the peers' (peer_observed), with
         #: when (sim s; a peer's list at the time it was published)
         self.stood_at: list[tuple[float, float, float]] = []
@@ -303,6 +305,19 @@ class Explore(Node):
             and not any(f is o for o in observed)
         ]
         if not candidates:
+            given_up = len(self.frontiers) - len(observed)
+            if given_up and self.retries < p.blacklist_retries:
+                # blacklisted on the way by a robot stuck at a door for progress_timeout, or a
+                # goal move_base aborted while the map was wrong: tried again once nothing
+                # else is left (office seed 1: the north-west room's last frontier, given up
+                # at 584 s, 30 s in a door, was all that was left at 1080 s)
+                self.retries += 1
+                self.get_logger().info(f"trying the {given_up} blacklisted frontiers again")
+                self.blacklist.clear()
+                self._publish_points(self.blacklist_pub, self.blacklist)
+                self.peer_blacklists = {t: [] for t in self.peer_blacklists}
+                self.make_plan()
+                return
             self.stop("all frontiers traversed/tried out, stopping", len(observed))
             return
         positions = self._peer_positions(frame)

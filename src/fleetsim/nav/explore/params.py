@@ -71,6 +71,11 @@ class ExploreParams:
         "point is observed (the map shows what the laser saw there only after the SLAM node's "
         "map_update_interval and the costmap's publish period)",
     )
+    blacklist_retries: int = param(
+        0,
+        range=(0, None),
+        help="times the frontiers left, all blacklisted, are tried again before giving up",
+    )
     peer_observed: list = param(
         [], help="other explorers' ~observed topics (geometry_msgs/PoseArray): view points stood at"
     )

@@ -101,14 +101,14 @@ def _beside(robot_id: str, neighbour_id: str, cycles: int):
 
 
 def test_the_planner_drops_back_behind_a_higher_priority_robot_that_carries_it():
-    """Carried beside lizi2 (ORCA keeps it alongside, at lizi2's pace, off its own way), lizi10
-    drops back after CROSSING_TIME: its ORCA velocity falls behind lizi2's along lizi2's
-    motion; lizi1 in its place keeps pace (it has priority over lizi2)."""
+    """Carried beside lizi2 (ORCA keeps it alongside, near lizi2's pace, off its own way),
+    lizi10 drops back after CROSSING_TIME: its ORCA velocity falls well behind lizi2's (0.5
+    m/s) along lizi2's motion; lizi1 in its place keeps near that pace (it has priority)."""
     along = OURS / np.hypot(*OURS)  # lizi2 moves as we do
     given, low = _beside("lizi10", "lizi2", 15)
     n = round(CROSSING_TIME / 0.1)
     assert given[: n - 1] == [None] * (n - 1) and given[-1] == "lizi2"
-    assert float(low.last_holo @ along) < 0.4
     given, high = _beside("lizi1", "lizi2", 15)
     assert given == [None] * 15
-    assert float(high.last_holo @ along) > 0.45
+    assert float(high.last_holo @ along) > 0.4
+    assert float(low.last_holo @ along) < 0.3

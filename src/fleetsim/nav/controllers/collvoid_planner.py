@@ -41,7 +41,8 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
 
 The rules that shape the preferred velocity around other robots (keeping right, going round
 robots standing in the way on the side the robot heads for and keeping that side, yielding)
-are in `collvoid_preference`; the base's command in `collvoid_drive`.
+are in `collvoid_preference`; the neighbours and their radii in `collvoid_neighbours`; the
+base's command in `collvoid_drive`.
 
 Neighbours arrive in the ``map`` frame; the local costmap's frame (often ``odom``) is reached
 through tf. Only ORCA is available: ``clearpath: true`` or ``orca: false`` is an error, and
@@ -56,15 +57,15 @@ from typing import Any
 
 import numpy as np
 
-from fleetsim.errors import ParameterError, TransformError
+from fleetsim.errors import ParameterError
 from fleetsim.msgs import geometry_msgs
 from fleetsim.nav.controllers.base import EmptyPlan, LocalPlanner, VelocityCommand
 from fleetsim.nav.controllers.collvoid_drive import UNTRUNCATED, CollvoidDrive
+from fleetsim.nav.controllers.collvoid_neighbours import MAP_FRAME, CollvoidNeighbours
 from fleetsim.nav.controllers.collvoid_params import CollvoidParams
 from fleetsim.nav.controllers.collvoid_preference import (
     DECELERATION,
     KEEP_RIGHT_UNTIL,
-    STILL_SPEED,
     CollvoidPreference,
 )
 from fleetsim.nav.costmap.footprint import footprint_radii, outline_points
@@ -78,16 +79,12 @@ from fleetsim.nav.multirobot.holonomic import (
 )
 from fleetsim.nav.multirobot.orca import orca_halfplanes, orca_velocity
 from fleetsim.nav.multirobot.position_share import PositionShare
-from fleetsim.nav.multirobot.uncertainty import (
-    cloud_covariance,
-    pair_padding,
-    side_by_side_padding,
-)
+from fleetsim.nav.multirobot.uncertainty import cloud_covariance
 from fleetsim.nav.multirobot.yielding import Retreat, narrow_meetings
 from fleetsim.runtime import load_params
 
 _log = logging.getLogger("fleetsim.nav.collvoid")
-MAP_FRAME = "map"
+__all__ = ["MAP_FRAME", "CollvoidLocalPlanner"]
 #: bearing sectors for static obstacle points
 OBSTACLE_SECTORS = 24
 #: share of the preferred speed under which the walls block the circumscribed disc (then the
@@ -100,7 +97,7 @@ WALLS_BLOCK = 0.25
 SAME_GOAL_SHIFT = 0.5
 
 
-class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
+class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive, LocalPlanner):
     """ORCA among the robots on /position_share, for one move_base (see the module doc)."""
 
     Params = CollvoidParams
@@ -221,71 +218,6 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
         return self._track(holo, (x, y, yaw), velocity)
 
     # -- the cycle -----------------------------------------------------------------------------
-    def own_radius(self, speed: float) -> float:
-        """Own safety radius: body + margin + allowed tracking error, m (the localization
-        spread is the pair's, `pair_padding`)."""
-        p = self.params
-        err = p.min_error_holo
-        if not p.holonomic_robot:
-            err += (p.max_error_holo - p.min_error_holo) * min(1.0, speed / p.max_vel_x)
-        return self.body_radius + p.safety_margin + err
-
-    def neighbour_radii(
-        self, own_r: float, map_xy: np.ndarray, near: Any, map_vel: Any = (0.0, 0.0)
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """The others' radii (N,) m against this robot (``own_r`` m, at ``map_xy``, moving at
-        ``map_vel`` m/s): for ORCA, each one's body grown by both robots' localization spreads
-        across the leg of the pair's velocity obstacle the relative velocity passes
-        (`pair_padding`); for the width of a passage, by half the
-        spreads across the line between the two (`side_by_side_padding`: the spreads part the
-        two robots, not a robot from its walls, which it sees itself). The radius as sent for
-        a robot that shares no covariance; with no spread anywhere (fake_localization) the
-        radii as sent, exactly."""
-        covs = near.covariances
-        if self._covariance is None and not covs.any():
-            return near.radii, near.radii
-        shared = covs.reshape(-1, 4).any(axis=1)
-        body = np.where(shared, near.body_radii, near.radii)
-        rel, cap, eps = near.positions - map_xy, 2.0 * self.body_radius, self.params.eps
-        vrel = np.asarray(map_vel, dtype=np.float64) - near.velocities
-        pad = pair_padding(rel, own_r + body, self._covariance, cap, covs, 2.0 * body, eps, vrel)
-        across = side_by_side_padding(rel, self._covariance, cap, covs, 2.0 * body, eps)
-        return body + pad, body + 0.5 * across
-
-    def _map_to_local(self) -> tuple[float, float, float]:
-        if self.frame == MAP_FRAME:
-            return 0.0, 0.0, 0.0
-        return self.node.tf_buffer.lookup_pose2d(self.frame, MAP_FRAME, 0.0)
-
-    def _neighbours(self, xy: np.ndarray, own_r: float, vel: np.ndarray) -> tuple:
-        """The robots around ``xy`` (m, local costmap frame) on /position_share, in that frame:
-        (own position in map (2,), ids, positions (N, 2), velocities (N, 2), radii (N,) against
-        this robot of radius ``own_r`` moving at ``vel`` (`neighbour_radii`), ORCA
-        responsibilities (N,): all of it for a robot not ``controlled`` or standing still, half
-        otherwise; controlled (N,) bool, yaws (N,), radii (N,) for the width of a passage).
-        None around without tf."""
-        p, now = self.params, self.node.now()
-        ids: list[str] = []
-        pos, nvel, radii = np.zeros((0, 2)), np.zeros((0, 2)), np.zeros(0)
-        resp, controlled, yaws = np.zeros(0), np.zeros(0, dtype=bool), np.zeros(0)
-        try:
-            tx, ty, tyaw = self._map_to_local()
-        except TransformError:
-            return xy, ids, pos, nvel, radii, resp, controlled, yaws, radii
-        map_xy = rotated(xy - [tx, ty], -tyaw)
-        near = self.share.table.near(
-            now, (map_xy[0], map_xy[1]), p.neighbor_dist, p.max_neighbors, self.robot_id
-        )
-        cr, sr = math.cos(tyaw), math.sin(tyaw)
-        rot = np.array([[cr, -sr], [sr, cr]])
-        pos = near.positions @ rot.T + [tx, ty]
-        nvel = near.velocities @ rot.T
-        still = np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED
-        resp = np.where(~near.controlled | still, 1.0, 0.5)
-        yaws = np.array([r.yaw for r in near.robots]) + tyaw
-        radii, wide = self.neighbour_radii(own_r, map_xy, near, rotated(vel, -tyaw))
-        return map_xy, near.ids, pos, nvel, radii, resp, near.controlled, yaws, wide
-
     def holonomic_velocity(self, xy, yaw, vel, carrot, remaining) -> np.ndarray:
         """The ORCA velocity for this cycle, (2,) m/s in the local costmap's frame."""
         p, now = self.params, self.node.now()
@@ -297,6 +229,7 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
             xy, own_r, vel
         )
         dist = np.hypot(pos[:, 0] - xy[0], pos[:, 1] - xy[1])
+        pair = self.pair_radii(own_r, radii, dist)
         active = {k: d for k, d, c in zip(ids, dist.tolist(), controlled) if c}
         narrow: list[str] = []
         if active and self.yielding_to is None:
@@ -329,11 +262,11 @@ class CollvoidLocalPlanner(CollvoidPreference, CollvoidDrive, LocalPlanner):
             meeting = self._oncoming(pos - xy, nvel, vel, pref, dist, remaining).any()
             if not near_goal and meeting:
                 pref = rotated(pref, p.left_pref)
-            pref = self._around_still(pref, xy, vel, pos - xy, nvel, own_r + radii, controlled, ids)
+            pref = self._around_still(pref, xy, vel, pos - xy, nvel, pair, controlled, ids)
             pref = self._give_way(
-                pref, wanted, vel, pos - xy, nvel, own_r + radii, resp, controlled, ids, meeting
+                pref, wanted, vel, pos - xy, nvel, pair, resp, controlled, ids, meeting
             )
-        return self._orca(xy, vel, pref, pos - xy, nvel, own_r + radii, resp)
+        return self._orca(xy, vel, pref, pos - xy, nvel, pair, resp)
 
     def _orca(self, xy, vel, pref, rel, nvel, radii, resp) -> np.ndarray:
         """The velocity nearest ``pref`` (2,) m/s that the half-planes of the local costmap's

@@ -20,23 +20,14 @@ explore_lite stops either way; a goal it cancels itself (on stopping, or to wait
 takes the frontiers left) is listed in ``withdrawn_goals``, so that the run monitor does not
 count it as a failed goal.
 
-Explorers sharing one map (slam_explore ``robots:=2``) would all head for the same best
-frontier; fleetsim adds ``peer_goals``: each explorer announces its goal on ``~goal`` and leaves
-frontiers within ``peer_radius`` of a peer's goal to that peer, unless every frontier is; with
-``peer_frames`` (the peers' base frames, found in the shared map through tf) it also leaves to
-a peer every frontier whose centroid is nearer to that peer than to itself, so that each
-robot takes the frontiers on its side instead of both heading for the same region (the pair of
-hunters crossed the office's corridor to each other's end); ``switch_distance`` keeps it on the
-frontier it heads for unless another is clearly cheaper; each explorer publishes its blacklist
-on ``~blacklist`` (geometry_msgs/PoseArray) and skips the frontiers its peers blacklisted
-(``peer_blacklists``: two hunters each gave up on a corner of the office and then crossed the
-office to the corner the other had given up on); ``path_costs`` measures a frontier by the
-distance the robot drives to it (navfn's wavefront over the costmap,
-`fleetsim.nav.explore.path_costs`), for ranking and, with peers, for which robot is nearer
-(a straight line through a wall gave a robot the next room's frontiers). With
-``switch_distance`` the progress clock keeps running while the frontier it heads for only
-shrinks (its centroid creeping); explore_lite restarts it whenever the goal point moves. The
-rules: `fleetsim.nav.explore.peers`.
+Explorers sharing one map (slam_explore ``robots:=2``) would all head for the same frontier;
+fleetsim's additions share the frontiers out (`fleetsim.nav.explore.peers` gives the rules and
+why): each announces its goal on ``~goal`` and its blacklist on ``~blacklist``
+(geometry_msgs/PoseArray) and reads its peers' (``peer_goals``, ``peer_blacklists``); frontiers
+near a peer's goal (``peer_radius``) or nearer to a peer (``peer_frames``, through tf) are the
+peer's; ``switch_distance`` keeps the frontier it heads for unless another is clearly cheaper
+(and keeps the progress clock running while that frontier only creeps); ``path_costs``
+measures frontiers by the distance driven (`fleetsim.nav.explore.path_costs`).
 
 With ``view_points`` (a fleetsim addition, off by default; slam_explore sets it) each frontier's
 goal is the nearest point the robot can drive to that sees it (within ``view_range``) instead of
@@ -46,7 +37,8 @@ not counted as given up, so exploration that ends with only such frontiers left 
 (``succeeded``; ``observed`` counts them); one left because move_base aborted, or made no
 progress to, its view point is still given up. Each explorer publishes the view points it stood
 at on ``~observed`` (geometry_msgs/PoseArray) and reads its peers' (``peer_observed``). Why and
-how: `fleetsim.nav.explore.view_points`.
+how: `fleetsim.nav.explore.view_points`. With ``blacklist_retries`` (a fleetsim addition, 0 by
+default) the frontiers left, all blacklisted, are tried again that many times before it gives up.
 
 ``costmap_updates_topic`` is accepted but fleetsim's costmaps publish whole grids only (see
 `fleetsim.nav.costmap.costmap_ros`), so it is not subscribed. ``orientation_scale`` is accepted
@@ -107,7 +99,6 @@ class Explore(Node):
         #: view points move_base reached (view_points), and the peers' (peer_observed), with
         #: when (sim s; a peer's list at the time it was published)
         self.stood_at: list[tuple[float, float, float]] = []
-        self.peer_stood_at: dict[str, list[tuple[float, float, float]]] = {}
         self._grid_time = 0.0
         #: frontiers left when it stopped that were observed as far as they can be
         self.observed = 0
@@ -116,7 +107,6 @@ class Explore(Node):
         self._last_distance = math.inf
         self._last_progress = 0.0
         self.frontiers: list[Frontier] = []
-        self.peers: dict[str, tuple[float, float] | None] = {}
         self.goal_pub = self.create_publisher(geometry_msgs.PointStamped, "~goal", 1, latch=True)
         self.blacklist_pub = self.create_publisher(
             geometry_msgs.PoseArray, "~blacklist", 1, latch=True
@@ -124,31 +114,10 @@ class Explore(Node):
         self.observed_pub = self.create_publisher(
             geometry_msgs.PoseArray, "~observed", 1, latch=True
         )
-        for topic in p.peer_observed:
-            self.peer_stood_at[str(topic)] = []
-            self.create_subscription(
-                geometry_msgs.PoseArray,
-                str(topic),
-                lambda m, t=str(topic): self.on_peer_observed(t, m),
-                1,
-            )
-        self.peer_blacklists: dict[str, list[tuple[float, float]]] = {}
-        for topic in p.peer_blacklists:
-            self.peer_blacklists[str(topic)] = []
-            self.create_subscription(
-                geometry_msgs.PoseArray,
-                str(topic),
-                lambda m, t=str(topic): self.on_peer_blacklist(t, m),
-                1,
-            )
-        for topic in p.peer_goals:
-            self.peers[str(topic)] = None
-            self.create_subscription(
-                geometry_msgs.PointStamped,
-                str(topic),
-                lambda m, t=str(topic): self.on_peer(t, m),
-                1,
-            )
+        # what the peers tell it, by topic: their goals, blacklists and view points stood at
+        self.peers = self._listen(geometry_msgs.PointStamped, p.peer_goals, _goal, None)
+        self.peer_blacklists = self._listen(geometry_msgs.PoseArray, p.peer_blacklists, _points)
+        self.peer_stood_at = self._listen(geometry_msgs.PoseArray, p.peer_observed, _stamped)
         _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now
         self.create_subscription(nav_msgs.OccupancyGrid, p.costmap_topic, self.on_costmap, 1)
         self.move_base = self.create_action_client(move_base_msgs.MoveBase, "move_base")
@@ -172,16 +141,15 @@ class Explore(Node):
         self.grid = msg
         self._grid_time = self.now()
 
-    def on_peer_observed(self, topic: str, msg: geometry_msgs.PoseArray) -> None:
-        t = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
-        self.peer_stood_at[topic] = [(x, y, t) for x, y in _points(msg)]
-
-    def on_peer(self, topic: str, msg: geometry_msgs.PointStamped) -> None:
-        x, y = msg.point.x, msg.point.y
-        self.peers[topic] = (x, y) if math.isfinite(x) and math.isfinite(y) else None
-
-    def on_peer_blacklist(self, topic: str, msg: geometry_msgs.PoseArray) -> None:
-        self.peer_blacklists[topic] = _points(msg)
+    def _listen(self, kind, topics, read, empty: Any = ()) -> dict[str, Any]:
+        """Subscribe to each of ``topics``; the dict returned holds each one's latest message
+        as ``read`` gives it (``empty`` until one arrives)."""
+        latest = {str(t): empty for t in topics}
+        for topic in latest:
+            self.create_subscription(
+                kind, topic, lambda m, t=topic: latest.__setitem__(t, read(m)), 1
+            )
+        return latest
 
     def _blacklist(self, goal: tuple[float, float]) -> None:
         """Blacklist a goal and tell the peers (~blacklist)."""
@@ -315,7 +283,7 @@ class Explore(Node):
                 self.get_logger().info(f"trying the {given_up} blacklisted frontiers again")
                 self.blacklist.clear()
                 self._publish_points(self.blacklist_pub, self.blacklist)
-                self.peer_blacklists = {t: [] for t in self.peer_blacklists}
+                self.peer_blacklists.update(dict.fromkeys(self.peer_blacklists, ()))
                 self.make_plan()
                 return
             self.stop("all frontiers traversed/tried out, stopping", len(observed))
@@ -356,8 +324,8 @@ class Explore(Node):
             and chosen is tracked_frontier(candidates, self.goal)
         )
         # progress as explore_lite measures it: towards the frontier's nearest cell (its
-        # centroid may lie behind a wall the robot has to go round); with view_points, the
-        # distance it drives to the view point (the straight line grows on the way out of one
+        # centroid may lie behind a wall the robot has to go round); with view_points, along
+        # the way navfn plans to the view point (the straight line grows on the way out of one
         # room and into the next: see fleetsim.nav.explore.view_points)
         distance = chosen.min_distance
         rerouted = False
@@ -437,3 +405,15 @@ class Explore(Node):
 
 def _points(msg: geometry_msgs.PoseArray) -> list[tuple[float, float]]:
     return [(q.position.x, q.position.y) for q in msg.poses]
+
+
+def _stamped(msg: geometry_msgs.PoseArray) -> list[tuple[float, float, float]]:
+    """The points with the message's time (sim s)."""
+    t = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+    return [(x, y, t) for x, y in _points(msg)]
+
+
+def _goal(msg: geometry_msgs.PointStamped) -> tuple[float, float] | None:
+    """A peer's announced goal; None (NaN announced): it has none."""
+    x, y = msg.point.x, msg.point.y
+    return (x, y) if math.isfinite(x) and math.isfinite(y) else None

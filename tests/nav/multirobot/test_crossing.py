@@ -11,7 +11,14 @@ from fleetsim.msgs import collvoid_msgs, geometry_msgs
 from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.nav.controllers.collvoid_planner import CollvoidLocalPlanner
 from fleetsim.nav.costmap.costmap_2d import Costmap2D
-from fleetsim.nav.multirobot.crossing import CROSSING_TIME, GIVE_WAY_TIME, GiveWay, carried_by
+from fleetsim.nav.multirobot.crossing import (
+    CROSSING_TIME,
+    GIVE_WAY_TIME,
+    GiveWay,
+    across_way,
+    carried_by,
+)
+from fleetsim.nav.multirobot.holonomic import rays_blocked
 from fleetsim.runtime import Node, Runtime
 
 LIZI = np.array([[-0.19, -0.16], [-0.19, 0.16], [0.19, 0.16], [0.19, -0.16]])
@@ -21,6 +28,19 @@ OURS = np.array([-0.27, -0.42])  # m/s
 WANTED = np.array([0.31, -0.40])  # m/s, to the carrot
 BESIDE, ITS_VEL = np.array([[0.58, 0.05]]), np.array([[-0.30, -0.27]])
 R = np.array([0.56])
+
+
+def test_across_way_is_rays_blocked_disc_by_disc():
+    rng = np.random.default_rng(3)
+    for _ in range(300):
+        n = int(rng.integers(1, 6))
+        rel, r = rng.uniform(-2, 2, (n, 2)), rng.uniform(0.1, 1.0, n)
+        d, reach = rng.normal(size=2), float(rng.uniform(0.0, 2.0))
+        u = d / np.hypot(*d)
+        one_by_one = [
+            rays_blocked(u[None], rel[k : k + 1], r[k : k + 1], reach)[0] for k in range(n)
+        ]
+        assert across_way(rel, r, d, reach).tolist() == one_by_one
 
 
 def test_a_neighbour_beside_us_moving_our_way_across_our_preferred_way_carries_us():

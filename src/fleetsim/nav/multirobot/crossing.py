@@ -31,7 +31,6 @@ from __future__ import annotations
 import numpy as np
 
 from fleetsim.nav.multirobot.deadlock import priority_key
-from fleetsim.nav.multirobot.holonomic import rays_blocked
 
 #: s a robot is carried by the same neighbour before the one with the lower priority gives way
 #: (the narrow meeting's 1 s: short, the pair drifts off at full speed meanwhile)
@@ -54,16 +53,17 @@ REACH = 1.0
 
 def across_way(rel_pos: np.ndarray, radii: np.ndarray, direction: np.ndarray, reach: float):
     """(N,) bool: whether the ray from the robot (at the origin) along ``direction`` (2,) enters
-    each disc (``rel_pos`` (N, 2) m, combined ``radii`` (N,) m) within ``reach`` m."""
+    each disc (``rel_pos`` (N, 2) m, combined ``radii`` (N,) m) within ``reach`` m (per disc,
+    where `fleetsim.nav.multirobot.holonomic.rays_blocked` answers for all discs at once)."""
     n = float(np.hypot(*direction))
     if n < 1e-9 or rel_pos.shape[0] == 0:
         return np.zeros(rel_pos.shape[0], dtype=bool)
     u = np.asarray(direction, dtype=np.float64) / n
-    return np.array(
-        [rays_blocked(u[None, :], rel_pos[k : k + 1], radii[k : k + 1], reach)[0]
-         for k in range(rel_pos.shape[0])],
-        dtype=bool,
-    )  # fmt: skip
+    along = rel_pos @ u
+    side = u[0] * rel_pos[:, 1] - u[1] * rel_pos[:, 0]
+    inside = radii**2 - side**2
+    entry = along - np.sqrt(np.maximum(inside, 0.0))
+    return (along > 1e-9) & (inside > 0.0) & (entry < reach)
 
 
 def carried_by(

@@ -250,6 +250,11 @@ def measure_launch(layer: str, n: int, duration: float, seed: int, chunks: int =
                 per_chunk.append({"rtf": duration / chunks / (clock() - t0), "rss_mb": rss_mb()})
             reached = sum(r.goals_reached for r in s.monitor.results())
             collisions = sum(r.collisions for r in s.monitor.results())
+            events = [
+                f"{r.model} with {other} at t={t:.1f} s, ({x:.2f}, {y:.2f})"
+                for r in s.monitor.results()
+                for t, other, x, y in r.collision_events
+            ]
     wall_total = sum(duration / chunks / c["rtf"] for c in per_chunk)
     return {
         "rtf": duration / wall_total,
@@ -257,6 +262,7 @@ def measure_launch(layer: str, n: int, duration: float, seed: int, chunks: int =
         "chunks": per_chunk,
         "goals_reached": reached,
         "collisions": collisions,
+        "collision_events": events[:20],
         "warnings": counter.count,
         "first_warnings": counter.first,
     }
@@ -441,6 +447,8 @@ def soak(minutes: float, localization: str, seed: int, planner: str = "collvoid"
     )
     for text in r["first_warnings"]:
         print("  WARNING", text)
+    for text in r.get("collision_events", []):
+        print("  collision:", text)
     return True
 
 

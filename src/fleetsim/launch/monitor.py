@@ -84,6 +84,10 @@ class RobotResult:
     time_of_last_result: float | None = None
     path_length: float = 0.0
     collisions: int = 0
+    #: each collision's onset: sim time (s), the other model, and this robot's x, y (m)
+    collision_events: list[tuple[float, str, float, float]] = field(
+        default_factory=list, repr=False
+    )
     last_text: str = ""
     #: SUCCEEDED results whose goal ground truth did not confirm (too far, or no ground truth)
     goals_unconfirmed: int = 0
@@ -316,6 +320,7 @@ class RunMonitor:
                 last = self._last_contact.get((model, other))
                 if last is None or now - last > COLLISION_GAP:
                     r.collisions += 1  # a new collision, not the same one going on
+                    r.collision_events.append((now, other, x, y))
                 self._last_contact[(model, other)] = now
 
     # -- summary ------------------------------------------------------------------------

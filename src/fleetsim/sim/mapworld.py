@@ -9,6 +9,7 @@ map loaded by map_server lines up with the simulated walls by construction.
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -141,16 +142,60 @@ def wall_boxes(grid: OccupancyMap, height: float = 1.0) -> np.ndarray:
         raise SimulationError(f"{grid.source}: wall height must be > 0, got {height}")
     rects = rectangles_from_occupancy(grid.occupied).astype(np.float64)
     res = grid.resolution
+    return _placed(
+        grid,
+        (rects[:, 1] + rects[:, 3]) * 0.5 * res,
+        (rects[:, 0] + rects[:, 2]) * 0.5 * res,
+        (rects[:, 3] - rects[:, 1]) * 0.5 * res,
+        (rects[:, 2] - rects[:, 0]) * 0.5 * res,
+        height,
+    )
+
+
+def boundary_boxes(grid: OccupancyMap, height: float, segment: float) -> np.ndarray:
+    """One cell thick walls just outside the map's edges, as Stage's ``floorplan`` builds with
+    ``boundary 1`` ("most maps will need a bounding box"; the lesson's Willow map came from
+    Stage's ``willow-full`` world). Without them a robot pushed past the map's edge where its
+    cells are free (Willow's grey surround reads as free with map_server's thresholds) drives
+    into space no costmap covers. Rows as `wall_boxes`; each side is split into pieces no
+    longer than ``segment`` m (so they join the wall tiles of their stretch).
+    """
+    res = grid.resolution
+    h, w = grid.occupied.shape
+    width, top = w * res, h * res
+    t = res  # thickness: one cell, outside the map
+    # each side's centre line, (x0, y0) to (x1, y1), in the map's own frame
+    sides = [
+        (-t / 2, -t, -t / 2, top + t),  # west
+        (width + t / 2, -t, width + t / 2, top + t),  # east
+        (0.0, -t / 2, width, -t / 2),  # south
+        (0.0, top + t / 2, width, top + t / 2),  # north
+    ]
+    cols: list[tuple[float, float, float, float]] = []  # centre x, y, half sizes x, y
+    for x0, y0, x1, y1 in sides:
+        length = math.hypot(x1 - x0, y1 - y0)
+        n = max(1, math.ceil(length / segment))
+        half = length / n / 2
+        for k in range(n):
+            b = (k + 0.5) / n
+            hx, hy = (t / 2, half) if x0 == x1 else (half, t / 2)
+            cols.append((x0 + (x1 - x0) * b, y0 + (y1 - y0) * b, hx, hy))
+    lx, ly, hx, hy = np.asarray(cols, dtype=np.float64).T
+    return _placed(grid, lx, ly, hx, hy, height)
+
+
+def _placed(grid: OccupancyMap, lx, ly, hx, hy, height: float) -> np.ndarray:
+    """Box rows ``[cx, cy, cz, hx, hy, hz, yaw]`` from centres (``lx``, ``ly``) and half sizes
+    (``hx``, ``hy``), m, in the map's own frame (its lower-left corner, along its rows):
+    placed by the map's ``origin``, standing on z = 0, ``height`` m tall."""
     ox, oy, yaw = grid.origin
-    lx = (rects[:, 1] + rects[:, 3]) * 0.5 * res
-    ly = (rects[:, 0] + rects[:, 2]) * 0.5 * res
     c, s = np.cos(yaw), np.sin(yaw)
-    out = np.empty((len(rects), 7))
+    out = np.empty((len(lx), 7))
     out[:, 0] = ox + c * lx - s * ly
     out[:, 1] = oy + s * lx + c * ly
     out[:, 2] = height / 2
-    out[:, 3] = (rects[:, 3] - rects[:, 1]) * 0.5 * res
-    out[:, 4] = (rects[:, 2] - rects[:, 0]) * 0.5 * res
+    out[:, 3] = hx
+    out[:, 4] = hy
     out[:, 5] = height / 2
     out[:, 6] = yaw
     return out

@@ -13,7 +13,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fleetsim.sim.mapworld import OccupancyMap, load_map, wall_boxes
+from fleetsim.sim.mapworld import OccupancyMap, boundary_boxes, load_map, wall_boxes
 from fleetsim.sim.sdf_poses import ZERO_POSE, Pose
 
 #: walls extruded from a map are building walls: taller than any robot's sensors (the lesson
@@ -107,43 +107,6 @@ def sun() -> LightDesc:
 WALL_TILE = 4.0  # m, side of the square tiles map walls are grouped into
 
 
-def boundary_boxes(grid: OccupancyMap, height: float) -> np.ndarray:
-    """One cell thick walls just outside the map's edges, as Stage's ``floorplan`` builds with
-    ``boundary 1`` ("most maps will need a bounding box"; the lesson's Willow map came from
-    Stage's ``willow-full`` world). Without them a robot pushed past the map's edge where its
-    cells are free (Willow's grey surround reads as free with map_server's thresholds) drives
-    into space no costmap covers. Rows as ``wall_boxes``; each side is split into segments no
-    longer than ``WALL_TILE`` so they join the wall tiles of their stretch.
-    """
-    res = grid.resolution
-    h, w = grid.occupied.shape
-    width, height_m = w * res, h * res
-    t = res  # thickness: one cell, outside the map
-    rows = []
-    # (start, end) of each side in map-local coordinates, the wall's centre line
-    sides = [
-        ((-t / 2, -t), (-t / 2, height_m + t)),  # west
-        ((width + t / 2, -t), (width + t / 2, height_m + t)),  # east
-        ((0.0, -t / 2), (width, -t / 2)),  # south
-        ((0.0, height_m + t / 2), (width, height_m + t / 2)),  # north
-    ]
-    ox, oy, yaw = grid.origin
-    c, s = math.cos(yaw), math.sin(yaw)
-    for (x0, y0), (x1, y1) in sides:
-        length = math.hypot(x1 - x0, y1 - y0)
-        n = max(1, math.ceil(length / WALL_TILE))
-        vertical = x0 == x1
-        for k in range(n):
-            b = (k + 0.5) / n
-            lx, ly = x0 + (x1 - x0) * b, y0 + (y1 - y0) * b
-            half = length / n / 2
-            hx, hy = (t / 2, half) if vertical else (half, t / 2)
-            rows.append(
-                (ox + c * lx - s * ly, oy + s * lx + c * ly, height / 2, hx, hy, height / 2, yaw)
-            )
-    return np.asarray(rows, dtype=np.float64).reshape(-1, 7)
-
-
 def world_from_map(
     yaml_path: str | Path, wall_height: float = WALL_HEIGHT, boundary: bool = True
 ) -> WorldDesc:
@@ -158,7 +121,7 @@ def world_from_map(
     grid = load_map(yaml_path)
     boxes = wall_boxes(grid, wall_height)
     if boundary:
-        boxes = np.concatenate([boxes, boundary_boxes(grid, wall_height)])
+        boxes = np.concatenate([boxes, boundary_boxes(grid, wall_height, WALL_TILE)])
     geoms = [
         GeomDesc(
             "box",

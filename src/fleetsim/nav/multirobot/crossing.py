@@ -106,7 +106,6 @@ class GiveWay:
         self.to: str | None = None  # the robot given way to
         self.until = -np.inf
         self.since: dict[str, float] = {}  # neighbour -> since when it carries us
-        self.count = 0  # how often this robot gave way
 
     def update(
         self,
@@ -138,5 +137,4 @@ class GiveWay:
             return None
         self.to = min(due, key=priority_key)
         self.until = now + GIVE_WAY_TIME
-        self.count += 1
         return self.to

@@ -59,3 +59,52 @@ def test_a_door_with_a_little_inflation_cost_does_not_hide_the_frontiers_beyond_
     assert fs[0].centroid == pytest.approx((2.05, 1.0))
     d[9:11, 10] = 99  # a door the robot does not fit through: nothing reachable beyond
     assert frontiers_from_grid(d, 0.1, (0.0, 0.0), (0.35, 1.05)) == []
+
+
+def _slam_sized(rng):
+    """A gmapping-sized grid (400 x 500 cells at 0.05 m) that is all unknown but for a 4 x 3 m
+    office of two rooms with a door and a gap in its outer wall, part of it seen, placed off the
+    grid's middle."""
+    d = np.full((400, 500), -1, dtype=np.int8)
+    room = np.zeros((60, 80), dtype=np.int8)
+    room[0, :] = room[-1, :] = room[:, 0] = room[:, -1] = 100
+    room[:, 40] = 100
+    room[25:35, 40] = 0  # the door
+    room[0, 10:20] = 0  # a gap in the south wall onto the unknown outside
+    room[30:, 60:] = -1  # the east room's far corner not seen yet
+    room[rng.integers(1, 59, 40), rng.integers(1, 79, 40)] = 60  # some cost
+    d[250:310, 120:200] = room
+    return d
+
+
+def test_the_known_window_gives_the_whole_grids_frontiers_and_driving_distances():
+    from fleetsim.nav.explore.frontier_search import known_window
+    from fleetsim.nav.explore.path_costs import path_distance_field
+
+    d = _slam_sized(np.random.default_rng(3))
+    origin, robot, peer = (-10.0, -12.0), (-10 + 130 * 0.05, -12 + 280 * 0.05), (-3.0, 7.0)
+    win, worigin = known_window(d, 0.05, origin, [robot, peer])
+    assert win.size < d.size / 4
+    assert win.base is d or win.base is d.base  # a view, not a copy
+    whole = frontiers_from_grid(d, 0.05, origin, robot, min_frontier_size=0.1)
+    part = frontiers_from_grid(win, 0.05, worigin, robot, min_frontier_size=0.1)
+    assert len(whole) == len(part) > 0
+    for a, b in zip(whole, part):
+        assert a.size == b.size and a.cost == pytest.approx(b.cost)
+        np.testing.assert_allclose(a.points, b.points)
+    # the peer, on unknown cells far outside the office, is inside the window
+    cx = int(np.floor((peer[0] - worigin[0]) / 0.05))
+    cy = int(np.floor((peer[1] - worigin[1]) / 0.05))
+    assert 0 <= cx < win.shape[1] and 0 <= cy < win.shape[0]
+    for allow_unknown in (False, True):
+        f_whole = path_distance_field(d, 0.05, origin, robot, allow_unknown)
+        f_part = path_distance_field(win, 0.05, worigin, robot, allow_unknown)
+        x0 = round((worigin[0] - origin[0]) / 0.05)
+        y0 = round((worigin[1] - origin[1]) / 0.05)
+        known = d >= 0
+        cut = f_whole[y0 : y0 + win.shape[0], x0 : x0 + win.shape[1]]
+        np.testing.assert_array_equal(cut[known[y0:, x0:][: win.shape[0], : win.shape[1]]],
+                                      f_part[win >= 0])  # fmt: skip
+    # nothing known: the grid as it is
+    empty = np.full((50, 60), -1, dtype=np.int8)
+    assert known_window(empty, 0.05, origin, [robot])[0] is empty

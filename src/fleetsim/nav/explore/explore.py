@@ -60,7 +60,7 @@ from fleetsim.nav.move_base_support import pose_stamped
 from fleetsim.runtime import Node
 from fleetsim.tf.names import resolve_frame_once
 
-from .frontier_search import Frontier, frontiers_from_grid
+from .frontier_search import Frontier, frontiers_from_grid, known_window
 from .markers import frontier_markers
 from .params import ExploreParams
 from .path_costs import by_path, path_distance_field
@@ -232,10 +232,18 @@ class Explore(Node):
         info = grid.info
         data = np.asarray(grid.data, dtype=np.int8).reshape(info.height, info.width)
         p = self.params
-        self.frontiers = frontiers_from_grid(
+        positions = self._peer_positions(frame)
+        # the grid's known part, not gmapping's whole xmin..ymax (known_window says why)
+        data, origin = known_window(
             data,
             info.resolution,
             (info.origin.position.x, info.origin.position.y),
+            [robot, *positions],
+        )
+        self.frontiers = frontiers_from_grid(
+            data,
+            info.resolution,
+            origin,
             robot,
             p.potential_scale,
             p.gain_scale,
@@ -243,7 +251,6 @@ class Explore(Node):
         )
         if self.marker_pub is not None:
             self._publish_markers(frame)
-        origin = (info.origin.position.x, info.origin.position.y)
         field = None
         if p.view_points:
             field = path_distance_field(data, info.resolution, origin, robot, allow_unknown=True)
@@ -288,7 +295,6 @@ class Explore(Node):
                 return
             self.stop("all frontiers traversed/tried out, stopping", len(observed))
             return
-        positions = self._peer_positions(frame)
         distances = None
         if p.path_costs:
             candidates, distances = by_path(

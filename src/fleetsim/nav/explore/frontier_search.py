@@ -17,6 +17,7 @@ smaller than ``min_frontier_size`` m are dropped, and the list is sorted by cost
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -47,6 +48,46 @@ class Frontier:
         """The point explore sends move_base to: the view point, else (explore_lite) the
         centroid."""
         return self.view_point if self.view_point is not None else self.centroid
+
+
+#: unknown cells kept around the known part of a grid by `known_window`, m
+KNOWN_MARGIN = 1.0
+
+
+def known_window(
+    data: np.ndarray,
+    resolution: float,
+    origin: tuple[float, float],
+    points: list[tuple[float, float]],
+    margin: float = KNOWN_MARGIN,
+) -> tuple[np.ndarray, tuple[float, float]]:
+    """The part of the (H, W) grid ``data`` holding its known cells (>= 0) and ``points`` (m,
+    e.g. the robots), widened by ``margin`` m of unknown cells and clipped to the grid, as a view,
+    with that part's origin.
+
+    A SLAM map starts at gmapping's ``xmin..ymax`` (slam_explore's hunter: 100 x 100 m, 4 M
+    cells) around a 30 x 20 m office, 3 % of it known: explore's flood fills and wavefronts over
+    the whole grid took ~300 ms a plan (navfn's field through unknown cells alone 200 ms), over
+    the window ~20 ms. Frontier cells are unknown cells next to known ones, so the window holds
+    every frontier and every cell the search walks; a wavefront through unknown cells
+    (``path_distance_field`` with ``allow_unknown``) no longer finds ways looping more than
+    ``margin`` outside everything known, which cost ``margin`` / resolution unknown cells each
+    way (navfn charges an unknown cell as five free ones)."""
+    data = np.asarray(data)
+    h, w = data.shape
+    rows = np.flatnonzero((data >= 0).any(axis=1))
+    if rows.size == 0:
+        return data, origin
+    cols = np.flatnonzero((data >= 0).any(axis=0))
+    y0, y1, x0, x1 = int(rows[0]), int(rows[-1]), int(cols[0]), int(cols[-1])
+    for px, py in points:
+        cx = math.floor((px - origin[0]) / resolution)
+        cy = math.floor((py - origin[1]) / resolution)
+        x0, x1, y0, y1 = min(x0, cx), max(x1, cx), min(y0, cy), max(y1, cy)
+    pad = max(2, math.ceil(margin / resolution))
+    y0, x0 = max(0, y0 - pad), max(0, x0 - pad)
+    y1, x1 = min(h, y1 + pad + 1), min(w, x1 + pad + 1)
+    return data[y0:y1, x0:x1], (origin[0] + x0 * resolution, origin[1] + y0 * resolution)
 
 
 def frontiers_from_grid(

@@ -215,3 +215,77 @@ def test_circumscribed_clearance_plans_through_the_gap_the_body_can_turn_in():
     path = roomy.create_plan(start, goal)  # as ROS, through the narrow one
     assert path.poses[-1, :2].tolist() == pytest.approx([1.0, 1.0])
     assert not turnable(path).all()
+
+
+def _slam_costmap(rng):
+    """A gmapping-sized costmap (16 x 14 m at 0.05 m) that is unknown but for a 5 x 3 m office
+    of two rooms, a door between them, a gap in the outer wall onto the unknown outside, and
+    random cost inside; placed off the middle."""
+    m = Costmap2D(320, 280, 0.05, -8.0, -7.0, default_value=255)
+    room = rng.integers(0, 120, (60, 100)).astype(np.uint8)
+    room[rng.random(room.shape) < 0.03] = 254
+    room[0, :] = room[-1, :] = room[:, 0] = room[:, -1] = room[:, 50] = 254
+    room[20:35, 50] = 0  # the door
+    room[-1, 70:80] = 0  # the gap in the outer wall, onto unknown cells
+    m.costs[150:210, 60:160] = room
+    return m
+
+
+@pytest.mark.parametrize("circumscribed", [False, True])
+@pytest.mark.parametrize("margin", ["shipped", "tight"])
+def test_planning_in_the_known_part_first_gives_the_whole_maps_paths(
+    circumscribed, margin, monkeypatch
+):
+    """NavFn plans first in the known part of a mostly unknown costmap and keeps that run only
+    when the whole map's run would repeat it (the wavefront never reached the part's cut
+    edges): every potential is the whole map's bit for bit, and both kinds of run happen
+    (a tight margin forces the whole map's run on most plans)."""
+    import fleetsim.nav.planners.navfn as navfn_module
+
+    if margin == "tight":
+        monkeypatch.setattr(navfn_module, "PART_MARGIN", 0.1)
+        monkeypatch.setattr(navfn_module, "PART_REACH", 0.0)
+    rng = np.random.default_rng(7)
+    m = _slam_costmap(rng)
+    known = np.argwhere(m.costs[:, :] < 120)
+    pairs = []
+    for _ in range(40):
+        (sy, sx), (gy, gx) = known[rng.integers(len(known), size=2)]
+        pairs.append(((-8.0 + (sx + 0.5) * 0.05, -7.0 + (sy + 0.5) * 0.05, 0.0),
+                      (-8.0 + (gx + 0.5) * 0.05, -7.0 + (gy + 0.5) * 0.05, 0.3)))  # fmt: skip
+    pairs.append(((-8.0 + 65 * 0.05, -7.0 + 155 * 0.05, 0.0), (6.0, -5.0, 0.0)))  # far outside
+
+    def planner():
+        nf = NavFn(m, NavfnParams(circumscribed_clearance=circumscribed))
+        nf.set_circumscribed(200, 0.25)
+        return nf
+
+    fast, sizes = planner(), []
+    got = []
+    for s, g in pairs:
+        try:
+            got.append(fast.create_plan(s, g).poses)
+        except NoPathFound as e:
+            got.append(str(e))
+        sizes.append((fast.window[2] - fast.window[0]) * (fast.window[3] - fast.window[1]))
+        got.append((fast.window, fast.potential.copy()))
+    monkeypatch.setattr(NavFn, "_known_part", lambda self, full, s, c: full)
+    whole = planner()
+    for k, (s, g) in enumerate(pairs):
+        mine, ((x0, y0, xn, yn), pot) = got[2 * k], got[2 * k + 1]
+        try:
+            ref = whole.create_plan(s, g).poses
+        except NoPathFound as e:
+            ref = str(e)
+        assert whole.window == (0, 0, m.size_x, m.size_y)
+        full = whole.potential
+        np.testing.assert_array_equal(pot, full[y0:yn, x0:xn])  # bit for bit
+        outside = np.ones(full.shape, bool)
+        outside[y0:yn, x0:xn] = False
+        assert (full[outside] >= POT_HIGH).all()
+        if isinstance(ref, str):
+            assert mine == ref
+        else:  # cell coordinates offset by the part's corner: the last bits of a float differ
+            np.testing.assert_allclose(mine, ref, rtol=0, atol=1e-9)
+    assert min(sizes) < m.costs.size / 3  # planned in the known part
+    assert max(sizes) == m.costs.size  # and, where the wavefront left it, in the whole map

@@ -44,6 +44,7 @@ from fleetsim.nav.planners.base import (
 from fleetsim.nav.planners.navfn_kernels import (
     COST_OBS,
     POT_HIGH,
+    known_bounds,
     navfn_costs,
     navfn_path,
     navfn_potential,
@@ -71,6 +72,12 @@ class NavfnParams:
         help="fleetsim: plan first where the footprint can turn (below the circumscribed cost), "
         "through narrower gaps only if no such path exists",
     )
+
+
+#: unknown cells around the known part of the costmap navfn plans in first, m, and per metre
+#: of straight line from the robot to the goal (`NavFn._known_part`)
+PART_MARGIN = 2.0
+PART_REACH = 0.5
 
 
 def _wrap(a: float) -> float:
@@ -129,15 +136,10 @@ class NavFn(GlobalPlanner):
                 f"navfn: the goal {pose_text(gx_w, gy_w)} is off the global costmap "
                 f"({self._extent()})"
             )
-        x0, y0, xn, yn = self.window = self._window(*s_cell)
-        nx = xn - x0
-        costarr = navfn_costs(m.costs[y0:yn, x0:xn], p.allow_unknown)
-        start_idx = (s_cell[1] - y0) * nx + (s_cell[0] - x0)
-        if 0 < s_cell[0] - x0 < nx - 1 and 0 < s_cell[1] - y0 < yn - y0 - 1:
-            costarr[start_idx] = navfn_costs(np.zeros((3, 3), np.uint8), True)[4]  # clearRobotCell
-
-        # the reachable point nearest the goal within the tolerance square (cells, not metres)
+        full = self._window(*s_cell)
+        x0, y0, xn, yn = full
         res = m.resolution
+        # the reachable point nearest the goal within the tolerance square (cells, not metres)
         tol = p.default_tolerance
         n_tol = math.floor(tol / res + 1e-9)
         offsets = np.arange(-n_tol, n_tol + 1) * res
@@ -154,19 +156,19 @@ class NavFn(GlobalPlanner):
         cand, cells = cand[inside], cells[inside]
         order = np.argsort(((cand - [gx_w, gy_w]) ** 2).sum(axis=1), kind="stable")
         cand, cells = cand[order], cells[order]
-
         goal_cell = cells[0]
-        goal_idx = (goal_cell[1] - y0) * nx + (goal_cell[0] - x0)
-        cycles = max(costarr.size // 20, nx + (yn - y0))
+
+        # navfn's own cycle budget, of the whole window (NavFn::calcNavFnDijkstra)
+        cycles = max((xn - x0) * (yn - y0) // 20, (xn - x0) + (yn - y0))
         pot, finished = None, False
-        if p.circumscribed_clearance and self.circumscribed[0] > 0:
-            roomy = self._roomy_costs(costarr, s_cell, goal_cell)
-            pot, finished = navfn_potential(roomy, nx, start_idx, goal_idx, True, cycles)
-            if not (pot[(cells[:, 1] - y0) * nx + (cells[:, 0] - x0)] < POT_HIGH).any():
-                pot = None  # no roomy path: plan as ROS does
+        part = self._known_part(full, s_cell, cells)
+        if part != full:
+            # None: a wavefront reached the part's edge; then the whole window, as ROS plans
+            pot, finished = self._potential(part, s_cell, goal_cell, cells, cycles, full)
         if pot is None:
-            pot, finished = navfn_potential(costarr, nx, start_idx, goal_idx, True, cycles)
-        self.potential = pot.reshape(yn - y0, nx)
+            pot, finished = self._potential(full, s_cell, goal_cell, cells, cycles, full)
+        x0, y0, xn, yn = self.window
+        nx = xn - x0
         reached = pot[(cells[:, 1] - y0) * nx + (cells[:, 0] - x0)] < POT_HIGH
         if not reached.any():
             if not finished:
@@ -177,7 +179,8 @@ class NavFn(GlobalPlanner):
             self._raise_unreachable(cells, gx_w, gy_w, sx_w, sy_w)
         best = int(np.argmax(reached))
         bx, by = int(cells[best, 0]) - x0, int(cells[best, 1]) - y0
-        steps = 4 * (nx + (yn - y0))  # NavfnROS uses 4 * size_x, too short for tall maps
+        # NavfnROS uses 4 * size_x, too short for tall maps; of the whole window, as cycles
+        steps = 4 * ((full[2] - full[0]) + (full[3] - full[1]))
         cells_path = navfn_path(pot, nx, bx, by, s_cell[0] - x0, s_cell[1] - y0, steps, 0.5)
         if cells_path.shape[0] == 0:
             raise NoPathFound(
@@ -197,6 +200,75 @@ class NavFn(GlobalPlanner):
         poses[:-1, 2] = np.arctan2(d[:, 1], d[:, 0])
         poses[-1, 2] = _wrap(goal_yaw)
         return Path(poses, self.frame_id)
+
+    def _potential(
+        self, window, s_cell, goal_cell, cells, cycles, full
+    ) -> tuple[np.ndarray | None, bool]:
+        """navfn's potential over ``window`` (x0, y0, xn, yn cells, which becomes
+        ``self.window``) from the robot's cell to ``goal_cell``, first on the roomy costs with
+        ``circumscribed_clearance``; (flat potential, finished within ``cycles``). In a part
+        of the whole window ``full``: (None, False) when a wavefront ran out of cycles or
+        reached the part's cut edges (`_inside`), so that only a run the whole window would
+        repeat bit for bit is kept."""
+        m, p = self.costmap, self.params
+        x0, y0, xn, yn = self.window = window
+        nx = xn - x0
+        costarr = navfn_costs(m.costs[y0:yn, x0:xn], p.allow_unknown)
+        start_idx = (s_cell[1] - y0) * nx + (s_cell[0] - x0)
+        if 0 < s_cell[0] - x0 < nx - 1 and 0 < s_cell[1] - y0 < yn - y0 - 1:
+            costarr[start_idx] = navfn_costs(np.zeros((3, 3), np.uint8), True)[4]  # clearRobotCell
+        goal_idx = (goal_cell[1] - y0) * nx + (goal_cell[0] - x0)
+        if p.circumscribed_clearance and self.circumscribed[0] > 0:
+            roomy = self._roomy_costs(costarr, s_cell, goal_cell)
+            pot, finished = navfn_potential(roomy, nx, start_idx, goal_idx, True, cycles)
+            if window != full and not (finished and self._inside(pot, window, full)):
+                return None, False
+            if (pot[(cells[:, 1] - y0) * nx + (cells[:, 0] - x0)] < POT_HIGH).any():
+                self.potential = pot.reshape(yn - y0, nx)
+                return pot, finished
+            # no roomy path: plan as ROS does
+        pot, finished = navfn_potential(costarr, nx, start_idx, goal_idx, True, cycles)
+        if window != full and not (finished and self._inside(pot, window, full)):
+            return None, False
+        self.potential = pot.reshape(yn - y0, nx)
+        return pot, finished
+
+    def _known_part(self, full, s_cell, cells) -> tuple[int, int, int, int]:
+        """The part of the window ``full`` worth planning in first: the known cells' bounds
+        (with the robot's and the goal's cells), widened by `PART_MARGIN` m plus `PART_REACH`
+        times the straight line from the robot to the goal (a wavefront runs into unknown cells
+        about a fifth as far as through free ones; 0.5 covers ways twice the straight line)."""
+        m = self.costmap
+        x0, y0, xn, yn = full
+        kx0, ky0, kxn, kyn = known_bounds(m.costs[y0:yn, x0:xn])
+        if kxn <= kx0:
+            return full
+        bx0, by0, bxn, byn = kx0 + x0, ky0 + y0, kxn + x0, kyn + y0
+        xs = (int(s_cell[0]), *cells[:, 0].tolist())
+        ys = (int(s_cell[1]), *cells[:, 1].tolist())
+        bx0, bxn = min(bx0, *xs), max(bxn, max(xs) + 1)
+        by0, byn = min(by0, *ys), max(byn, max(ys) + 1)
+        reach = math.hypot(int(cells[0, 0]) - int(s_cell[0]), int(cells[0, 1]) - int(s_cell[1]))
+        pad = math.ceil(PART_MARGIN / m.resolution + PART_REACH * reach)
+        return (max(x0, bx0 - pad), max(y0, by0 - pad), min(xn, bxn + pad), min(yn, byn + pad))
+
+    @staticmethod
+    def _inside(pot: np.ndarray, part, full) -> bool:
+        """Whether the wavefront over ``part`` left untouched the cells next to its cut edges
+        (those not edges of ``full``): then the whole window's run processes the same cells in
+        the same order, and gives this potential bit for bit (cells outside ``part`` unreached)."""
+        x0, y0, xn, yn = part
+        grid = pot.reshape(yn - y0, xn - x0)
+        edges = []
+        if x0 > full[0]:
+            edges.append(grid[:, 1])
+        if xn < full[2]:
+            edges.append(grid[:, -2])
+        if y0 > full[1]:
+            edges.append(grid[1, :])
+        if yn < full[3]:
+            edges.append(grid[-2, :])
+        return all(bool((e >= POT_HIGH).all()) for e in edges)
 
     def _roomy_costs(self, costarr: np.ndarray, s_cell, goal_cell) -> np.ndarray:
         """``costarr`` with the cells at or above the circumscribed cost made obstacles, except

@@ -46,6 +46,36 @@ def navfn_costs(costs, allow_unknown):
     return out
 
 
+@njit(cache=True)
+def known_bounds(costs):
+    """(x0, y0, xn, yn): the bounds (end exclusive) of the cells of the (ny, nx) uint8 costmap
+    that are not unknown (255); (0, 0, 0, 0) when every cell is. One pass that stops at the
+    first known cell from each side: on a SLAM map mostly unknown it reads the unknown rows
+    once, not the four temporaries of numpy's ``any`` along both axes."""
+    ny, nx = costs.shape
+    y0 = 0
+    while y0 < ny and (costs[y0] == COST_UNKNOWN_ROS).all():
+        y0 += 1
+    if y0 == ny:
+        return 0, 0, 0, 0
+    yn = ny
+    while (costs[yn - 1] == COST_UNKNOWN_ROS).all():
+        yn -= 1
+    x0 = nx
+    xn = 0
+    for y in range(y0, yn):
+        row = costs[y]
+        for x in range(min(x0, nx)):
+            if row[x] != COST_UNKNOWN_ROS:
+                x0 = x
+                break
+        for x in range(nx - 1, xn - 1, -1):
+            if row[x] != COST_UNKNOWN_ROS:
+                xn = x + 1
+                break
+    return x0, y0, xn, yn
+
+
 @njit(cache=True, error_model="numpy")  # no zero-division checks: costs are >= 50
 def navfn_potential(costarr, nx, goal, start, at_start, cycles):
     """Potential from ``goal`` by navfn's Dijkstra-like wavefront (propNavFnDijkstra).

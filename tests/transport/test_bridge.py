@@ -146,3 +146,47 @@ def test_close_is_idempotent_and_local_graph_keeps_working(endpoint):
     assert [m.data for m in got] == ["a"]
     assert rt.graph.listeners == []
     rt.shutdown()
+
+
+def test_the_pump_yields_the_gil_only_while_another_bridge_is_alive(monkeypatch, endpoint):
+    """sleep(0) in every pump gave the CPU away on a loaded machine; a simulation alone does
+    not yield, one with a `fleetsim node run`-like follower does, and stops after it left."""
+    import fleetsim.transport.bridge as bridge_module
+
+    calls = []
+    real_sleep = bridge_module._wall.sleep
+
+    class Wall:  # the bridge's view of the time module, counting sleep(0)
+        def __getattr__(self, name):
+            return getattr(time, name)
+
+        @staticmethod
+        def sleep(s):
+            calls.append(s)
+            real_sleep(s)
+
+    monkeypatch.setattr(bridge_module, "_wall", Wall())
+    rt = Runtime(seed=1)
+    sim = ZenohBridge(rt, listen=[endpoint])
+    try:
+        sim.pump()
+        assert calls == [] and not sim.alive_peers
+        frt = Runtime(seed=2)
+        follower = ZenohBridge(frt, mode="client", connect=[endpoint])
+        try:
+            deadline = time.monotonic() + 5.0
+            while not sim.alive_peers and time.monotonic() < deadline:
+                time.sleep(0.01)
+            assert sim.alive_peers == {follower.zid}
+            sim.pump()
+            assert calls == [0]
+        finally:
+            frt.shutdown()
+        deadline = time.monotonic() + 5.0
+        while sim.alive_peers and time.monotonic() < deadline:
+            time.sleep(0.01)
+        calls.clear()
+        sim.pump()
+        assert calls == [] and not sim.alive_peers
+    finally:
+        rt.shutdown()

@@ -113,6 +113,8 @@ class ServiceBridging:
     # -- remote processes -------------------------------------------------------------------
     def _declare_remote_watch(self) -> None:
         zenoh, s, k = self._zenoh, self.session, self.keys
+        #: other bridges' processes alive (simulations, ``fleetsim node run``), by zid
+        self.alive_peers: set[str] = set()
 
         def on_alive(sample: Any) -> None:
             zid = k.last_chunk(sample.key_expr)
@@ -121,8 +123,10 @@ class ServiceBridging:
             if sample.kind == zenoh.SampleKind.DELETE:
                 if zid == getattr(self, "_clock_origin", None):
                     self._master_lost = True
+                self.alive_peers.discard(zid)
                 self._inbox.put(("gone", zid))
             else:
+                self.alive_peers.add(zid)
                 self._inbox.put(("want_graph", zid))
 
         self._watch = [

@@ -1,5 +1,7 @@
 """Giving way at a crossing (`fleetsim.nav.multirobot.crossing`): a robot carried off its way by
-a neighbour beside it that moves the same way drops back when it has the lower priority."""
+a neighbour beside it that moves the same way gives way when it has the lower priority: it
+stands and turns on the spot towards its way, or, with another robot within its turn's reach,
+drops back."""
 
 import math
 from types import SimpleNamespace
@@ -14,9 +16,11 @@ from fleetsim.nav.costmap.costmap_2d import Costmap2D
 from fleetsim.nav.multirobot.crossing import (
     CROSSING_TIME,
     GIVE_WAY_TIME,
+    TURN_CLEARANCE,
     GiveWay,
     across_way,
     carried_by,
+    room_to_turn,
 )
 from fleetsim.nav.multirobot.holonomic import rays_blocked
 from fleetsim.runtime import Node, Runtime
@@ -74,7 +78,8 @@ def test_the_lower_priority_robot_gives_way_after_crossing_time_until_the_other_
     # carried or not, the way is given until lizi2 is out of our way ...
     assert low.update(t + 1.0, ["lizi2"], no, yes, yes) == "lizi2"
     assert low.update(t + 1.1, ["lizi2"], no, no, yes) is None
-    # ... stops (parked robots are gone round), or GIVE_WAY_TIME has passed
+    # ... stops navigating (parked robots are gone round; a robot slowing down for a moment
+    # still navigates: the first line above), or GIVE_WAY_TIME has passed
     low.reset()
     low.update(0.0, ["lizi2"], yes, yes, yes)
     assert low.update(CROSSING_TIME, ["lizi2"], yes, yes, yes) == "lizi2"
@@ -85,10 +90,12 @@ def test_the_lower_priority_robot_gives_way_after_crossing_time_until_the_other_
     assert low.update(CROSSING_TIME + GIVE_WAY_TIME + 0.1, ["lizi2"], no, yes, yes) is None
 
 
-def _beside(robot_id: str, neighbour_id: str, cycles: int):
+def _beside(robot_id: str, neighbour_id: str, cycles: int, behind: bool = False):
     """A planner at the origin moving along OURS, its plan along WANTED, and a neighbour
     published beside it every 0.1 s moving the same way at the same speed (the seed-9 pair,
-    drawn together), for ``cycles`` cycles: (the robot given way to each cycle, the planner)."""
+    drawn together), for ``cycles`` cycles (with ``behind``, a third robot, lizi9, follows
+    0.55 m behind it): (the robot given way to each cycle, the commands (cycles, 3), the
+    planner)."""
     rt = Runtime()
     node = Node(rt, "move_base", f"/{robot_id}")
     costmap = SimpleNamespace(
@@ -102,33 +109,58 @@ def _beside(robot_id: str, neighbour_id: str, cycles: int):
         collvoid_msgs.PoseTwistWithCovariance, "/position_share"
     )
     yaw, speed = math.atan2(OURS[1], OURS[0]), float(np.hypot(*OURS))
-    given = []
+    c, s = math.cos(yaw), math.sin(yaw)
+    others = [(neighbour_id, (0.58, -0.05))]
+    if behind:
+        others.append(("lizi9", (-0.55 * c, -0.55 * s)))
+    given, commands = [], []
     for _ in range(cycles):
-        m = collvoid_msgs.PoseTwistWithCovariance(robot_id=neighbour_id, radius=BODY)
-        m.header.stamp = Time.from_sec(rt.now())
-        m.controlled = True
-        m.pose.pose.position = geometry_msgs.Point(x=0.58, y=-0.05)
-        m.pose.pose.orientation = geometry_msgs.Quaternion(z=math.sin(yaw / 2), w=math.cos(yaw / 2))
-        m.holonomic_velocity = geometry_msgs.Vector3(
-            x=speed * math.cos(yaw), y=speed * math.sin(yaw)
-        )
-        m.footprint.polygon.points = [geometry_msgs.Point32(x=a, y=b) for a, b in LIZI]
-        pub.publish(m)
+        for other, (x, y) in others:
+            m = collvoid_msgs.PoseTwistWithCovariance(robot_id=other, radius=BODY)
+            m.header.stamp = Time.from_sec(rt.now())
+            m.controlled = True
+            m.pose.pose.position = geometry_msgs.Point(x=x, y=y)
+            q = geometry_msgs.Quaternion(z=math.sin(yaw / 2), w=math.cos(yaw / 2))
+            m.pose.pose.orientation = q
+            m.holonomic_velocity = geometry_msgs.Vector3(x=speed * c, y=speed * s)
+            m.footprint.polygon.points = [geometry_msgs.Point32(x=a, y=b) for a, b in LIZI]
+            pub.publish(m)
         rt.run(duration=0.1)
-        planner.compute_velocity_commands((0.0, 0.0, yaw), (speed, 0.0, 0.0))
+        cmd = planner.compute_velocity_commands((0.0, 0.0, yaw), (speed, 0.0, 0.0))
         given.append(planner.giving_way_to)
-    return given, planner
+        commands.append(cmd)
+    return given, np.array(commands), planner
 
 
-def test_the_planner_drops_back_behind_a_higher_priority_robot_that_carries_it():
+def test_the_planner_gives_way_to_a_higher_priority_robot_that_carries_it():
     """Carried beside lizi2 (ORCA keeps it alongside, near lizi2's pace, off its own way),
-    lizi10 drops back after CROSSING_TIME: its ORCA velocity falls well behind lizi2's (0.5
-    m/s) along lizi2's motion; lizi1 in its place keeps near that pace (it has priority)."""
+    lizi10 gives way after CROSSING_TIME: it turns towards its way (to the left; dropping back
+    at half speed, ORCA turned it right, off with lizi2), driving only as ORCA requires (here
+    on: this lizi2 never reacts, and its way grazes lizi10's disc); lizi1 in its place keeps
+    near that pace (it has priority)."""
     along = OURS / np.hypot(*OURS)  # lizi2 moves as we do
-    given, low = _beside("lizi10", "lizi2", 15)
+    given, cmds, low = _beside("lizi10", "lizi2", 20)
     n = round(CROSSING_TIME / 0.1)
     assert given[: n - 1] == [None] * (n - 1) and given[-1] == "lizi2"
-    given, high = _beside("lizi1", "lizi2", 15)
-    assert given == [None] * 15
+    assert low.turning_to is not None
+    assert np.all(cmds[-5:, 2] > 0.5)  # turns left, towards WANTED
+    given, cmds, high = _beside("lizi1", "lizi2", 20)
+    assert given == [None] * 20 and high.turning_to is None
     assert float(high.last_holo @ along) > 0.4
-    assert float(low.last_holo @ along) < 0.3
+
+
+def test_with_a_robot_close_behind_the_planner_drops_back_instead_of_turning():
+    """lizi9 0.55 m behind lizi10, within its turning corners' reach: lizi10 gives way to
+    lizi2 as it did before (half its preferred speed, all the responsibility: here ORCA keeps
+    it going, lizi9 never slows down), not turning towards its way."""
+    given, cmds, low = _beside("lizi10", "lizi2", 20, behind=True)
+    assert given[-1] == "lizi2" and low.turning_to is None
+    assert np.all(cmds[-5:, 2] < 0.5)
+
+
+def test_room_to_turn_is_no_other_robot_within_the_combined_radius_and_clearance():
+    rel = np.array([[0.56, 0.0], [0.0, 0.70], [-1.0, 0.0]])
+    r = np.array([0.52, 0.52, 0.52])
+    assert room_to_turn(rel, r, 0)  # the one given way to does not count
+    assert not room_to_turn(rel, r + TURN_CLEARANCE * 0.5, 0)  # 0.70 < 0.52 + 0.075 + 0.15
+    assert room_to_turn(rel[[0, 2]], r[:2], 0)

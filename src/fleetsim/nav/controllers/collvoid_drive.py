@@ -5,7 +5,8 @@ holonomic ORCA velocity to the command a base can follow.
 * a differential drive tracks it (`tracking_command`, ``time_to_holo``), its forward speed cut
   to what the cycle's half-planes admit along its heading (`speed_along_heading`); a yielding
   robot backs out, one waiting in its refuge only moves as ORCA requires
-  (`speed_nearest_still`); then the command's rollout over ``time_horizon_obst`` is checked
+  (`speed_nearest_still`), and so does one giving way at a crossing, turning on the spot
+  towards its way; then the command's rollout over ``time_horizon_obst`` is checked
   with the real footprint on the local costmap and, if it touches an obstacle, replaced by the
   clear command that best follows the holonomic velocity (`footprint_safe_command`); a robot
   wedged nose first (the best clear command is to stand) backs out straight a little;
@@ -13,8 +14,8 @@ holonomic ORCA velocity to the command a base can follow.
 * within the goal's xy tolerance, the turn in place to the goal yaw (base_local_planner's).
 
 `CollvoidDrive` is mixed into the planner, which owns the state it reads (``params``,
-``lines``, ``last_holo``, ``yielding_to``, ``waiting``, ``outline``, ``costmap``, ``dt``,
-``escape_from``, ``escapes``).
+``lines``, ``last_holo``, ``yielding_to``, ``waiting``, ``turning_to``, ``outline``,
+``costmap``, ``dt``, ``escape_from``, ``escapes``).
 """
 
 from __future__ import annotations
@@ -60,6 +61,14 @@ class CollvoidDrive:
             nudge = speed_nearest_still(*self.lines[:2], yaw, p.max_vel_x, back)
         if nudge is not None:
             cmd = (nudge, 0.0, 0.0)
+        elif self.turning_to is not None and not p.holonomic_robot:
+            # giving way at a crossing (`fleetsim.nav.multirobot.crossing`): it stands and
+            # turns on the spot towards its way, moving along its heading only as ORCA requires
+            back = min(p.max_vel_x, p.max_vel_x_backwards)
+            v = speed_nearest_still(*self.lines[:2], yaw, p.max_vel_x, back)
+            way = math.atan2(self.turning_to[1], self.turning_to[0])
+            w = math.remainder(way - yaw, 2 * math.pi) / p.time_to_holo
+            cmd = (0.0 if v is None else v, 0.0, _clamp(w, p.min_vel_theta, p.max_vel_theta))
         elif p.holonomic_robot:
             body = rotated(holo, -yaw)
             cmd = (float(body[0]), float(body[1]), 0.0)

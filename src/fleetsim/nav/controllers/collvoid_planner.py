@@ -157,6 +157,8 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         self.yielding_to: str | None = None
         self.give_way = GiveWay(self.robot_id)  # the crossing rule's state
         self.giving_way_to: str | None = None  # this cycle's robot given way to
+        #: (2,) the way a robot giving way turns to on the spot this cycle, or None
+        self.turning_to: np.ndarray | None = None
         self.waiting = False  # yielding, in the refuge: stands still while ORCA lets it
         self.plan_index = 0
         self.retreat = Retreat()  # the way back and the refuge of a yield
@@ -256,6 +258,7 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
                 resp[k] = 1.0
                 self.waiting = not pref.any()
         self.giving_way_to = None
+        self.turning_to = None
         if self.yielding_to is None and ids:
             wanted = pref
             near_goal = remaining < KEEP_RIGHT_UNTIL

@@ -5,14 +5,20 @@ of a robot that yields (`_yield_velocity`).
 
 `CollvoidPreference` is mixed into the planner, which owns the state it reads (``params``,
 ``node``, ``plan``, ``costmap``, ``body_radius``, ``deadlock``, ``retreat``, ``yielding_to``,
-``detour_sides``, ``give_way``).
+``detour_sides``, ``give_way``, ``turning_to``).
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-from fleetsim.nav.multirobot.crossing import GIVE_WAY_SPEED, REACH, across_way, carried_by
+from fleetsim.nav.multirobot.crossing import (
+    GIVE_WAY_SPEED,
+    REACH,
+    across_way,
+    carried_by,
+    room_to_turn,
+)
 from fleetsim.nav.multirobot.holonomic import detour_velocity, gaps_closed
 from fleetsim.nav.multirobot.yielding import has_passed
 
@@ -77,15 +83,20 @@ class CollvoidPreference:
         (`fleetsim.nav.multirobot.crossing`; then ``giving_way_to`` names the robot and its
         responsibility ``resp`` (N,) becomes all of it). ``wanted`` (2,) m/s: the way to the
         carrot before keeping right; ``radii`` (N,) m combined; ``meeting``: keeping right
-        (robots coming against us are keeping right's, not a crossing)."""
+        (robots coming against us are keeping right's, not a crossing). A differential drive
+        with room to turn (`room_to_turn`) stands and turns towards ``wanted`` instead
+        (``turning_to``, the command's side: `CollvoidDrive._track`)."""
         moving = (np.hypot(nvel[:, 0], nvel[:, 1]) >= STILL_SPEED) & controlled
         carrying = carried_by(rel, nvel, radii, vel, wanted, REACH) & moving & (not meeting)
         in_the_way = across_way(rel, radii, wanted, REACH)
-        to = self.give_way.update(self.node.now(), list(ids), carrying, in_the_way, moving)
+        to = self.give_way.update(self.node.now(), list(ids), carrying, in_the_way, controlled)
         self.giving_way_to = to
         if to is None:
             return pref
-        resp[list(ids).index(to)] = 1.0  # ORCA moves us out of its way, all of it ours
+        k = list(ids).index(to)
+        resp[k] = 1.0  # ORCA moves us out of its way, all of it ours
+        if not self.params.holonomic_robot and room_to_turn(rel, radii, k):
+            self.turning_to = np.asarray(wanted, dtype=np.float64)
         return GIVE_WAY_SPEED * pref
 
     @staticmethod

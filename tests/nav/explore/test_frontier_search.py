@@ -61,6 +61,22 @@ def test_a_door_with_a_little_inflation_cost_does_not_hide_the_frontiers_beyond_
     assert frontiers_from_grid(d, 0.1, (0.0, 0.0), (0.35, 1.05)) == []
 
 
+def test_a_door_whose_middle_alone_is_free_opens_onto_a_frontier_as_wide_as_the_door():
+    # a room whose door (10 cells) carries inflation cost but for its 2 middle cells, unknown
+    # beyond it: explore_lite's frontier (unknown cells with a free neighbour) is those 2 cells,
+    # 0.2 m, dropped at min_frontier_size 0.5 (office seed 5: a room never explored); every
+    # door cell the robot's centre may stand on borders the frontier
+    d = np.full((20, 30), -1, dtype=np.int8)
+    d[:, :10] = 0
+    d[:, 10] = 100
+    d[5:15, 10] = [90, 60, 30, 10, 0, 0, 10, 30, 60, 90]
+    fs = frontiers_from_grid(d, 0.1, (0.0, 0.0), (0.35, 1.05), min_frontier_size=0.5)
+    assert [f.size for f in fs] == [10]
+    assert fs[0].centroid == pytest.approx((1.15, 1.0))
+    d[5:15, 10] = 99  # inscribed cost: the robot's centre cannot stand there
+    assert frontiers_from_grid(d, 0.1, (0.0, 0.0), (0.35, 1.05), min_frontier_size=0.1) == []
+
+
 def _slam_sized(rng):
     """A gmapping-sized grid (400 x 500 cells at 0.05 m) that is all unknown but for a 4 x 3 m
     office of two rooms with a door and a gap in its outer wall, part of it seen, placed off the

@@ -8,9 +8,14 @@ cell the robot's centre may occupy (cost below the inscribed cost, published as
 carries a little inflation cost (a 1 m door with the hunter's 1 m inflation radius), so a
 robot that has entered a room finds no frontier beyond it and stops with most of the world
 unknown (m-explore issues #26 and #33 report exactly that; frontier_exploration issue #32
-asks for this very change). Frontier cells are still unknown cells with a *free* 4-neighbour
-in that region. The region is the 4-connected component holding the robot's cell (or the
-nearest such cell), found with `scipy.ndimage.label` instead of a queue, as are the frontiers.
+asks for this very change). For the same reason a frontier cell is an unknown cell with a
+4-neighbour in that region, not only with a *free* one (cost 0): in a door the inflation leaves
+free only the middle, and less than ``min_frontier_size`` of it (office, one hunter, seed 5:
+a 1.2 m door with the manual's 0.15 m radius and 1 m inflation at scaling 20 had 0.25 m of
+free cells, the frontier was dropped, and the room behind it was never explored; any cell
+beyond the inscribed radius is where the robot's centre may stand and look from). The region
+is the 4-connected component holding the robot's cell (or the nearest such cell), found with
+`scipy.ndimage.label` instead of a queue, as are the frontiers.
 A frontier's ``cost = potential_scale * min_distance * res - gain_scale * size * res``; those
 smaller than ``min_frontier_size`` m are dropped, and the list is sorted by cost.
 """
@@ -119,7 +124,7 @@ def frontiers_from_grid(
     if start == 0:  # the robot stands on cost: start from the nearest free cell, as explore_lite
         _, (iy, ix) = ndimage.distance_transform_edt(~free, return_indices=True)
         start = labels[iy[ry, rx], ix[ry, rx]]
-    reachable = (labels == start) & free
+    reachable = labels == start
     unknown = data < 0
     frontier = unknown & ndimage.binary_dilation(reachable, structure=FOUR)
     groups, count = ndimage.label(frontier, structure=EIGHT)

@@ -182,12 +182,19 @@ def office(
                 tracer.sample(s.runtime.now(), by_ns, [t[-1] for t in true], grid)
         explored_at = s.runtime.now()
         slam = slam_node.grid_msg if robots == 1 else s.nodes["/map_merge"].merged
+        touches = [(r.namespace, r.collision_events) for r in s.monitor.results()]
+        until_goals = 0 if s.monitor.success() else 1
     state = ", ".join(
         f"{n or robot}: finished={ex.finished} gave_up={ex.gave_up} blacklisted={len(ex.blacklist)}"
         f" observed={ex.observed}"
         for n, ex in zip(names, explorers)
     )
     print(f"office ({robots} {robot}(s) explore, seed {seed}): {state}")
+    # the run monitor's verdict, as `fleetsim launch ... --until-goals` exits: a touch counts
+    for ns, events in touches:
+        where = "; ".join(f"{t:.0f} s {other} at ({x:.1f}, {y:.1f})" for t, other, x, y in events)
+        print(f"  {ns}: {len(events)} collisions{': ' + where if events else ''}")
+    print(f"  --until-goals would exit {until_goals}")
     if trace:
         tracer.summary()
     if robots > 1:

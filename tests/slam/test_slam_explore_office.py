@@ -1,0 +1,91 @@
+"""slam_explore explores fleetsim's office (30 x 20 m, eight rooms off a corridor, desks and a
+table) to the end, with one hunter and with two (issue 17): ``fleetsim launch slam_explore
+--until-goals`` exits 0 (every explorer stopped with no frontier left, none gave up, no robot
+touched anything), and the saved map is checked against the office's true occupancy.
+
+These are the suite's longest runs (one hunter ~1000 sim s, two ~400 sim s, 2-3 min of wall time
+each); `benchmarks/slam_quality.py` measures the same runs over seeds 1-5 (README, SLAM row).
+"""
+
+import logging
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import fleetsim
+from fleetsim.cli.main import main
+from fleetsim.nav.map_io import load_map
+from fleetsim.slam.quality import occupancy_precision_recall
+
+pytestmark = [pytest.mark.scenario, pytest.mark.long]
+
+OFFICE = Path(fleetsim.__file__).parent / "assets" / "maps" / "office.yaml"
+SEED = 3
+
+
+def precision_recall(saved: Path, start: tuple[float, float]) -> tuple[float, float]:
+    """Occupied-cell precision and recall of the saved map against the office's walls (the
+    walls seen from where a robot starting at ``start`` can go)."""
+    slam, truth = load_map(saved), load_map(OFFICE)
+    iy, ix = np.nonzero(slam.data == 100)
+    xy = np.c_[
+        slam.origin[0] + (ix + 0.5) * slam.resolution,
+        slam.origin[1] + (iy + 0.5) * slam.resolution,
+    ]
+    p, r, _ = occupancy_precision_recall(
+        xy, truth.data == 100, truth.resolution, truth.origin[:2], start
+    )
+    return p, r
+
+
+class Records(logging.Handler):
+    """The fleetsim loggers' records (the CLI replaces the root logger's handlers, caplog's)."""
+
+    def __init__(self):
+        super().__init__(logging.INFO)
+        self.records: list[logging.LogRecord] = []
+
+    def emit(self, record):
+        self.records.append(record)
+
+
+def explore(tmp_path: Path, monkeypatch, *args: str) -> tuple[int, list[logging.LogRecord], Path]:
+    """``fleetsim launch slam_explore ARGS --until-goals`` in ``tmp_path`` (where MuJoCo would
+    write MUJOCO_LOG.TXT): its exit status, the fleetsim loggers' records and the map prefix."""
+    out = tmp_path / "office_slam"
+    monkeypatch.chdir(tmp_path)
+    argv = ["launch", "slam_explore", *args, f"map_out:={out}", "--until-goals"]
+    logger, records = logging.getLogger("fleetsim"), Records()
+    logger.addHandler(records)
+    try:
+        code = main([*argv, "--duration", "1500", "--seed", str(SEED), "--no-bridge"])
+    finally:
+        logger.removeHandler(records)
+    return code, records.records, out
+
+
+def test_one_hunter_explores_the_office_to_the_end(tmp_path, monkeypatch):
+    code, records, out = explore(tmp_path, monkeypatch)
+    log = [r.getMessage() for r in records]
+    assert code == 0, [m for m in log if "explore" in m or "collision" in m][-10:]
+    assert any("all frontiers traversed/tried out, stopping" in m for m in log)
+    assert not any("gave up" in m for m in log)
+    assert not [r.getMessage() for r in records if r.levelno >= logging.WARNING]
+    precision, recall = precision_recall(out.with_suffix(".yaml"), (4.0, 10.0))
+    assert precision >= 0.90 and recall >= 0.90, (precision, recall)  # the issue's target
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()
+
+
+def test_two_hunters_explore_the_office_to_the_end(tmp_path, monkeypatch):
+    code, records, out = explore(tmp_path, monkeypatch, "robots:=2")
+    log = [r.getMessage() for r in records]
+    assert code == 0, [m for m in log if "explore" in m or "collision" in m][-10:]
+    for ns in ("/hunter1", "/hunter2"):  # each explorer stopped with nothing left
+        assert any(f"[{ns}/explore] all frontiers traversed/tried out" in m for m in log), ns
+    assert not any("gave up" in m for m in log)
+    assert not [r.getMessage() for r in records if r.levelno >= logging.WARNING]
+    # the merged map, both hunters' halves of the office in one frame
+    precision, recall = precision_recall(out.with_suffix(".yaml"), (4.0, 10.0))
+    assert precision >= 0.90 and recall >= 0.90, (precision, recall)
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()

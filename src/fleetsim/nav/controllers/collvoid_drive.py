@@ -53,22 +53,26 @@ class CollvoidDrive:
 
     def _track(self, holo: np.ndarray, pose, velocity) -> VelocityCommand:
         p, yaw = self.params, pose[2]
-        nudge = None
-        if self.waiting and not p.holonomic_robot:
+        standing = not p.holonomic_robot and (self.waiting or self.turning_to is not None)
+        # a robot standing moves along its heading only as ORCA requires (None: not at all)
+        along = None
+        if standing:
+            back = min(p.max_vel_x, p.max_vel_x_backwards)
+            along = speed_nearest_still(*self.lines[:2], yaw, p.max_vel_x, back)
+        if self.waiting and along is not None:
             # in the refuge: ORCA's nudge away from the robot going by is not worth a turn on
             # the spot (turning back when the yield ends takes a lizi seconds)
-            back = min(p.max_vel_x, p.max_vel_x_backwards)
-            nudge = speed_nearest_still(*self.lines[:2], yaw, p.max_vel_x, back)
-        if nudge is not None:
-            cmd = (nudge, 0.0, 0.0)
-        elif self.turning_to is not None and not p.holonomic_robot:
+            cmd = (along, 0.0, 0.0)
+        elif standing and self.turning_to is not None:
             # giving way at a crossing (`fleetsim.nav.multirobot.crossing`): it stands and
-            # turns on the spot towards its way, moving along its heading only as ORCA requires
-            back = min(p.max_vel_x, p.max_vel_x_backwards)
-            v = speed_nearest_still(*self.lines[:2], yaw, p.max_vel_x, back)
+            # turns on the spot towards its way
             way = math.atan2(self.turning_to[1], self.turning_to[0])
             w = math.remainder(way - yaw, 2 * math.pi) / p.time_to_holo
-            cmd = (0.0 if v is None else v, 0.0, _clamp(w, p.min_vel_theta, p.max_vel_theta))
+            cmd = (
+                0.0 if along is None else along,
+                0.0,
+                _clamp(w, p.min_vel_theta, p.max_vel_theta),
+            )
         elif p.holonomic_robot:
             body = rotated(holo, -yaw)
             cmd = (float(body[0]), float(body[1]), 0.0)

@@ -355,3 +355,25 @@ def test_a_goal_nudged_by_localization_is_the_same_goal_to_the_deadlock_rule():
     line = np.linspace((0.0, 0.0), (0.0, 3.0), 50)
     pl.set_plan(np.c_[line, np.zeros(50)])  # a new goal
     assert pl.deadlock.best_time == pytest.approx(fleet.rt.now())
+
+
+@pytest.mark.parametrize("overlap_time", [0.0, 1.0])
+def test_overlap_time_parts_overlapping_discs_without_stalling_the_robot(overlap_time):
+    """A robot driving east whose disc overlaps a robot parked beside it (0.4 m to its right,
+    inside their combined radius): ORCA parts them within ``overlap_time``. RVO2's one control
+    period (0) asks for (r - d) / 0.1 s, more than the top speed, so the velocity points
+    straight away from the parked robot (a differential drive stops and turns round); within
+    1 s the robot keeps most of its speed along its way and they part as it drives on."""
+    fleet = Fleet([(0.0, 0.0, 0.0), (0.0, -0.4, 0.0)], [(5.0, 0.0, 0.0), (0.0, -0.4, 0.0)],
+                  overlap_time=overlap_time)  # fmt: skip
+    fleet.share()
+    fleet.rt.run(duration=0.1)
+    pl = fleet.planners[0]
+    pl.compute_velocity_commands((0.0, 0.0, 0.0), (0.3, 0.0, 0.0))
+    away, along = float(pl.last_holo[1]), float(pl.last_holo[0])
+    if overlap_time == 0.0:
+        assert along < 0.1 and away > 0.4
+    else:
+        assert along > 0.3
+        # and 1 s on they are farther apart than the 0.4 m they are now
+        assert math.hypot(along, away + 0.4) > 0.5

@@ -83,6 +83,12 @@ class CollvoidParams:
     safety_margin: float = param(
         0.05, unit="m", range=(0.0, None), help="added to the robot radius against neighbours"
     )
+    overlap_time: float = param(
+        0.0,
+        unit="s",
+        range=(0.0, None),
+        help="time to part two robots whose discs overlap (0: one control period, as RVO2)",
+    )
     robot_id: str = param("", help="this robot's id on /position_share (empty: tf_prefix)")
     carrot_distance: float = param(
         0.8, unit="m", range=(1e-3, None), help="look-ahead along the plan for the heading"

@@ -23,10 +23,12 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
 4. ORCA half-planes (`fleetsim.nav.multirobot.orca`): one per robot on ``/position_share``
    within ``neighbor_dist`` (at most ``max_neighbors``, horizon ``time_horizon``, half the
    responsibility, all of it for a robot that is not ``controlled``, stands still or is yielded
-   to), and one per static obstacle point of the local costmap (the nearest lethal cell per
-   bearing sector, horizon ``time_horizon_obst``, full responsibility, kept hard when the
-   program is infeasible; the robot's circumscribed disc, or its inscribed one where the
-   walls leave that disc no way on);
+   to; two discs that already overlap are parted within ``overlap_time``, a fleetsim addition:
+   RVO2 and collvoid part them within one control period, see `CollvoidParams`), and one per
+   static obstacle point of the local costmap (the nearest lethal cell per bearing sector,
+   horizon ``time_horizon_obst``, full responsibility, kept hard when the program is
+   infeasible; the robot's circumscribed disc, or its inscribed one where the walls leave that
+   disc no way on);
 5. the linear program gives the holonomic velocity nearest the preferred one; a differential
    drive tracks it (`tracking_command`, ``time_to_holo``) within ``acc_lim_x``/``acc_lim_theta``,
    its forward speed cut to what the same half-planes admit along its heading
@@ -142,6 +144,8 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         self._covariance: np.ndarray | None = None  # own localization's, map frame
         node.create_subscription(geometry_msgs.PoseArray, "particlecloud", self._on_cloud, 1)
         self.dt = 1.0 / p.controller_frequency
+        #: s within which ORCA parts two robots whose discs overlap (RVO2: one time step)
+        self.overlap_t = max(self.dt, p.overlap_time)
         self.horizon = p.time_horizon if p.use_truncation else UNTRUNCATED
         self.horizon_obst = p.time_horizon_obst if p.use_truncation else UNTRUNCATED
         self.plan = np.zeros((0, 3))
@@ -290,7 +294,9 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
             lines_p.append(lp)
             lines_d.append(ld)
         if rel.shape[0]:
-            lp, ld = orca_halfplanes(rel, vel - nvel, radii, vel, self.horizon, self.dt, resp)
+            lp, ld = orca_halfplanes(
+                rel, vel - nvel, radii, vel, self.horizon, self.overlap_t, resp
+            )
             lines_p.append(lp)
             lines_d.append(ld)
         self.lines = (

@@ -369,14 +369,19 @@ class Explore(Node):
         self._announce(target, frame)
         pose = pose_stamped(target[0], target[1], yaw, frame, self.now_msg())
         self.goals_sent += 1
+        sent = self.goals_sent
         self._handle = self.move_base.send_goal(
             move_base_msgs.MoveBaseGoal(target_pose=pose),
-            done_cb=lambda h, goal=target: self._on_done(goal, h.status),
+            done_cb=lambda h, goal=target: self._on_done(goal, h.status, sent),
         )
 
-    def _on_done(self, goal: tuple[float, float], status: int) -> None:
-        if self.goal != goal:
-            return  # an older goal, replaced meanwhile
+    def _on_done(self, goal: tuple[float, float], status: int, sent: int) -> None:
+        # an older send, replaced meanwhile: told apart by its count, not its coordinates (the
+        # same point sent again - every frontier blacklisted, the list cleared and retried -
+        # pre-empts the first send, whose PREEMPTED then looked like the new goal's end, which
+        # replanned at once and sent it again: thousands of sends without sim time advancing)
+        if self.goal != goal or sent != self.goals_sent:
+            return
         self._handle = None
         if status == ABORTED:
             self.get_logger().info(f"move_base aborted the goal {goal}; blacklisting it")

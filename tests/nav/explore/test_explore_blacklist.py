@@ -3,6 +3,7 @@ progress for ``progress_timeout`` are blacklisted; the robot pose is not used on
 ``transform_tolerance``; what the explorer tells a goal-sender watcher (done, gave up)."""
 
 import logging
+import math
 
 import numpy as np
 import pytest
@@ -209,3 +210,32 @@ def test_the_same_frontier_sent_again_after_a_retry_does_not_resend_it_at_once()
     rt.run(duration=10.0)
     assert ex.retries == 1
     assert 2 <= len(mb.goals) <= 4 and len(set(mb.goals)) == 1, mb.goals
+
+
+def test_with_nothing_left_of_its_own_it_waits_while_a_peer_explores_then_stops():
+    """Its one frontier aborted and blacklisted, an explorer whose peer still has a goal waits
+    (the peer's mapping may open a way or move a view point) instead of stopping; once the
+    peer announces no goal (NaN: it stopped), it gives up as before."""
+    from fleetsim.msgs import geometry_msgs
+
+    data = room()
+    data[:4, :6] = 0  # the east edge is the only frontier
+    rt = Runtime(seed=0)
+    rt.params.set("/explore/peer_goals", ["/peer/goal"])
+    World(rt, data)
+    MoveBase(rt, lambda g: "abort")
+    peer = Node(rt, "peer").create_publisher(
+        geometry_msgs.PointStamped, "/peer/goal", 1, latch=True
+    )
+
+    def announce(x, y):
+        header = std_msgs.Header(frame_id="map")
+        peer.publish(geometry_msgs.PointStamped(header=header, point=geometry_msgs.Point(x=x, y=y)))
+
+    announce(5.0, 5.0)  # far from this robot's frontier: not the peer's
+    ex = Explore(rt)
+    rt.run(duration=6.0)
+    assert len(ex.blacklist) == 1 and not ex.finished and ex.goal is None
+    announce(math.nan, math.nan)
+    rt.run(duration=4.0)
+    assert ex.finished and ex.gave_up

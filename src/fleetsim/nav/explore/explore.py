@@ -280,6 +280,14 @@ class Explore(Node):
             and not any(f is o for o in observed)
         ]
         if not candidates:
+            if any(g is not None for g in self.peers.values()):
+                # a peer still explores: the merged map it makes may open a way or move a view
+                # point (a frontier "observed" from inside a room whose door the map had not yet
+                # opened; office, two hunters with the hunter's outline as footprint: hunter2
+                # stopped 30 s in and stood in its room while hunter1 explored the rest), so
+                # wait for it rather than stop, as when the peers have every frontier left
+                self._wait()
+                return
             given_up = len(self.frontiers) - len(observed)
             if given_up and self.retries < p.blacklist_retries:
                 # blacklisted on the way by a robot stuck at a door for progress_timeout, or a
@@ -312,10 +320,7 @@ class Explore(Node):
             distances,
         )
         if chosen is None:  # the peers have every frontier left: wait for them
-            self._withdraw_goal()
-            if self.goal is not None:
-                self.goal = None
-                self._announce(None)
+            self._wait()
             return
         target = chosen.goal
         same = self.goal is not None and math.dist(target, self.goal) < 1e-6
@@ -360,6 +365,13 @@ class Explore(Node):
         if chosen.view_point is not None and math.dist(toward, target) > info.resolution:
             yaw = math.atan2(toward[1] - target[1], toward[0] - target[0])
         self._send(target, frame, yaw)
+
+    def _wait(self) -> None:
+        """No goal of its own while the peers explore: the one under way is withdrawn."""
+        self._withdraw_goal()
+        if self.goal is not None:
+            self.goal = None
+            self._announce(None)
 
     def _send(self, target: tuple[float, float], frame: str, yaw: float = 0.0) -> None:
         if not self.move_base.wait_for_server():

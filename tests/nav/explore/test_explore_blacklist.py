@@ -8,7 +8,7 @@ import math
 import numpy as np
 import pytest
 
-from fleetsim.msgs import move_base_msgs, nav_msgs, std_msgs
+from fleetsim.msgs import geometry_msgs, move_base_msgs, nav_msgs, std_msgs
 from fleetsim.nav.explore import Explore, frontiers_from_grid
 from fleetsim.runtime import Node, Runtime
 from fleetsim.tf import StaticTransformBroadcaster, TransformBroadcaster, make_transform_stamped
@@ -216,8 +216,6 @@ def test_with_nothing_left_of_its_own_it_waits_while_a_peer_explores_then_stops(
     """Its one frontier aborted and blacklisted, an explorer whose peer still has a goal waits
     (the peer's mapping may open a way or move a view point) instead of stopping; once the
     peer announces no goal (NaN: it stopped), it gives up as before."""
-    from fleetsim.msgs import geometry_msgs
-
     data = room()
     data[:4, :6] = 0  # the east edge is the only frontier
     rt = Runtime(seed=0)

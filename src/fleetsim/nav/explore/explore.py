@@ -381,19 +381,20 @@ class Explore(Node):
         self._announce(target, frame)
         pose = pose_stamped(target[0], target[1], yaw, frame, self.now_msg())
         self.goals_sent += 1
-        sent = self.goals_sent
         self._handle = self.move_base.send_goal(
             move_base_msgs.MoveBaseGoal(target_pose=pose),
-            done_cb=lambda h, goal=target: self._on_done(goal, h.status, sent),
+            done_cb=lambda h, goal=target: self._on_done(h, goal),
         )
 
-    def _on_done(self, goal: tuple[float, float], status: int, sent: int) -> None:
-        # an older send, replaced meanwhile: told apart by its count, not its coordinates (the
-        # same point sent again - every frontier blacklisted, the list cleared and retried -
-        # pre-empts the first send, whose PREEMPTED then looked like the new goal's end, which
-        # replanned at once and sent it again: thousands of sends without sim time advancing)
-        if self.goal != goal or sent != self.goals_sent:
+    def _on_done(self, handle: Any, goal: tuple[float, float]) -> None:
+        # only the goal in force counts (a withdrawn or replaced one's handle is not
+        # ``_handle``); told apart by its handle, not its coordinates: the same point sent again
+        # - every frontier blacklisted, the list cleared and retried - pre-empts the first send,
+        # whose PREEMPTED then looked like the new goal's end, which replanned at once and sent
+        # it again: thousands of sends without sim time advancing
+        if handle is not self._handle:
             return
+        status = handle.status
         self._handle = None
         if status == ABORTED:
             self.get_logger().info(f"move_base aborted the goal {goal}; blacklisting it")

@@ -190,3 +190,21 @@ def test_the_pump_yields_the_gil_only_while_another_bridge_is_alive(monkeypatch,
         assert calls == [] and not sim.alive_peers
     finally:
         rt.shutdown()
+
+
+def test_a_graph_query_before_the_first_snapshot_still_names_the_process(monkeypatch, endpoint):
+    """The graph queryable answers from zenoh's threads as soon as it is declared; a query that
+    came before the constructor's first snapshot got only time and endpoints, and a tool's
+    merge of several processes failed sorting them (CI, stop 31)."""
+    monkeypatch.setattr(ZenohBridge, "_publish_snapshot", lambda self: None)
+    rt = Runtime()
+    Node(rt, "early").create_publisher(std_msgs.String, "/early")
+    bridge = ZenohBridge(rt, listen=[endpoint], publish_clock=False)
+    try:
+        with SimulationClient(endpoint) as client:
+            (snap,) = client.snapshots()
+            assert snap["zid"] == bridge.zid and snap["role"] == "simulation"
+            assert snap["topics"]["/early"]["publishers"] == ["/early"]
+    finally:
+        bridge.close()
+        rt.shutdown()

@@ -63,3 +63,9 @@ def test_merge_unions_processes_and_flags_conflicting_types():
         "subscribers": ["/n1"],
     }
     assert m["services"] == {"/s": {"type": "S", "node": "/n2"}}
+
+
+def test_merge_orders_a_process_that_has_not_named_itself_last():
+    named = {"zid": "b", "role": "node", "nodes": [], "topics": {}, "services": {}}
+    m = merge_snapshots([{"time": 0.5, "endpoints": ["tcp/127.0.0.1:1"]}, named])
+    assert [p["zid"] for p in m["processes"]] == [None, "b"]

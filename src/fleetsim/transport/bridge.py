@@ -106,7 +106,10 @@ class ZenohBridge(TopicBridging, ServiceBridging, ClockFollowing):
         self._warned: set[str] = set()
         self._out: dict[str, Any] = {}  # name -> topics._Outgoing
         self._in: dict[str, Any] = {}
-        self._snapshot: dict = {}
+        # the graph queryable answers from zenoh's threads as soon as it is declared, before
+        # this constructor's first `_publish_snapshot`: it must never see a snapshot without
+        # the process's identity (a tool's merge sorts processes by role and zid)
+        self._snapshot: dict = graph_snapshot(self.graph, (), self.zid, self.role, runtime.now())
         self._clock_pub = None
         self._timer = None
         self._init_services(proxy_services)

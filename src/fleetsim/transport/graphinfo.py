@@ -82,7 +82,9 @@ def merge_snapshots(snapshots: Iterable[dict]) -> dict:
         for name, s in snap.get("services", {}).items():
             services.setdefault(name, s)
     return {
-        "processes": sorted(processes, key=lambda p: (p["role"] != "simulation", p["zid"])),
+        "processes": sorted(
+            processes, key=lambda p: (p["role"] != "simulation", str(p["zid"] or ""))
+        ),
         "nodes": sorted(nodes),
         "topics": dict(sorted(topics.items())),
         "services": dict(sorted(services.items())),

@@ -90,12 +90,14 @@ def test_the_lower_priority_robot_gives_way_after_crossing_time_until_the_other_
     assert low.update(CROSSING_TIME + GIVE_WAY_TIME + 0.1, ["lizi2"], no, yes, yes) is None
 
 
-def _beside(robot_id: str, neighbour_id: str, cycles: int, behind: bool = False):
+def _beside(
+    robot_id: str, neighbour_id: str, cycles: int, behind: bool = False, drift: float = 0.0
+):
     """A planner at the origin moving along OURS, its plan along WANTED, and a neighbour
     published beside it every 0.1 s moving the same way at the same speed (the seed-9 pair,
-    drawn together), for ``cycles`` cycles (with ``behind``, a third robot, lizi9, follows
-    0.55 m behind it): (the robot given way to each cycle, the commands (cycles, 3), the
-    planner)."""
+    drawn together), plus ``drift`` m/s towards us, for ``cycles`` cycles (with ``behind``, a
+    third robot, lizi9, follows 0.55 m behind it): (the robot given way to each cycle, the
+    commands (cycles, 3), the planner)."""
     rt = Runtime()
     node = Node(rt, "move_base", f"/{robot_id}")
     costmap = SimpleNamespace(
@@ -122,7 +124,10 @@ def _beside(robot_id: str, neighbour_id: str, cycles: int, behind: bool = False)
             m.pose.pose.position = geometry_msgs.Point(x=x, y=y)
             q = geometry_msgs.Quaternion(z=math.sin(yaw / 2), w=math.cos(yaw / 2))
             m.pose.pose.orientation = q
-            m.holonomic_velocity = geometry_msgs.Vector3(x=speed * c, y=speed * s)
+            towards = -np.array([x, y]) / math.hypot(x, y) * (drift if other == neighbour_id else 0)
+            m.holonomic_velocity = geometry_msgs.Vector3(
+                x=speed * c + towards[0], y=speed * s + towards[1]
+            )
             m.footprint.polygon.points = [geometry_msgs.Point32(x=a, y=b) for a, b in LIZI]
             pub.publish(m)
         rt.run(duration=0.1)
@@ -147,6 +152,22 @@ def test_the_planner_gives_way_to_a_higher_priority_robot_that_carries_it():
     given, cmds, high = _beside("lizi1", "lizi2", 20)
     assert given == [None] * 20 and high.turning_to is None
     assert float(high.last_holo @ along) > 0.4
+
+
+def test_a_carrier_drifting_into_us_is_no_meeting_that_keeps_us_from_giving_way():
+    """lizi2 beside lizi10 drifts towards it as well (their lanes converge): it closes in ahead
+    of lizi10, which makes it one of the robots keeping right turns for, but it comes the same
+    way, not against lizi10: lizi10 still gives way to it after CROSSING_TIME (circle of 16,
+    seed 26: lizi14 beside lizi6 was kept from giving way, carried 1.6 m off its plan for 6 s,
+    while lizi6 alone made its meeting)."""
+    rel = np.array([[0.58, -0.05]])  # as _beside publishes it
+    its_vel = OURS - rel / np.hypot(*rel[0]) * 0.05
+    low = _beside("lizi10", "lizi2", 1)[2]
+    meets = low._oncoming(rel, its_vel, OURS, WANTED, np.hypot(*rel.T), 3.0)
+    assert meets.tolist() == [True]  # closing in ahead: keeping right's, as before
+    given, _, low = _beside("lizi10", "lizi2", 20, drift=0.05)
+    n = round(CROSSING_TIME / 0.1)
+    assert given[: n - 1] == [None] * (n - 1) and given[-1] == "lizi2"
 
 
 def test_with_a_robot_close_behind_the_planner_drops_back_instead_of_turning():

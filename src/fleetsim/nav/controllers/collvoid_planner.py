@@ -266,8 +266,8 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         if self.yielding_to is None and ids:
             wanted = pref
             near_goal = remaining < KEEP_RIGHT_UNTIL
-            meeting = self._oncoming(pos - xy, nvel, vel, pref, dist, remaining).any()
-            if not near_goal and meeting:
+            meeting = self._oncoming(pos - xy, nvel, vel, pref, dist, remaining)
+            if not near_goal and meeting.any():
                 pref = rotated(pref, p.left_pref)
             pref = self._around_still(pref, xy, vel, pos - xy, nvel, pair, controlled, ids)
             pref = self._give_way(

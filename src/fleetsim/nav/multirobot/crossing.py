@@ -14,11 +14,12 @@ has a positive component along ours), sits across our preferred way (the ray alo
 preferred velocity, before keeping right, enters its ORCA disc within `REACH`) while our own
 motion does not run into it (the ray along our velocity is clear of it: it is beside us, not a
 leader we follow), and our velocity is more than 60 deg off our preferred way
-(`CARRIED_OFF`). Only outside a meeting: while robots come against us, keeping right
-(``left_pref``) deliberately sets the crowd flowing round side by side, and dropping back there
-jammed the circle of 16 (tuning seeds 0-4: makespan 16.4 / 17.8 s mean / max without the rule,
-22.1 / 24.2 s standing in every crossing, 20.1 / 22.2 s dropping back). After `CROSSING_TIME`
-s of being carried by the same robot, the robot of the two with the lower priority
+(`CARRIED_OFF`). Only outside a meeting (the robots that carry us do not count in it: a carrier
+drifting into us closes in, but does not come against us): while robots come against us, keeping
+right (``left_pref``) deliberately sets the crowd flowing round side by side, and dropping back
+there jammed the circle of 16 (tuning seeds 0-4: makespan 16.4 / 17.8 s mean / max without the
+rule, 22.1 / 24.2 s standing in every crossing, 20.1 / 22.2 s dropping back). After
+`CROSSING_TIME` s of being carried by the same robot, the robot of the two with the lower priority
 (`fleetsim.nav.multirobot.deadlock.priority_key`, the deadlock rule's order: every robot
 reaches the same verdict) *gives way*, until the other robot is no longer across its preferred
 way or has stopped navigating (parked on its goal: a robot standing in the way is gone round),

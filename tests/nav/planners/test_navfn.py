@@ -289,3 +289,30 @@ def test_planning_in_the_known_part_first_gives_the_whole_maps_paths(
             np.testing.assert_allclose(mine, ref, rtol=0, atol=1e-9)
     assert min(sizes) < m.costs.size / 3  # planned in the known part
     assert max(sizes) == m.costs.size  # and, where the wavefront left it, in the whole map
+
+
+def test_a_robot_whose_centre_is_in_inscribed_space_gets_a_way_out():
+    """NavfnROS clears only the robot's cell: a robot whose centre came into the inscribed band
+    by a wall (its polygon footprint still clear of it) had no plan at all, and move_base
+    aborted every goal. With the footprint's circumscribed radius known, the plan leaves the
+    band through the inscribed (never the lethal) cells nearest the robot."""
+    m = Costmap2D(60, 40, 0.05)
+    m.costs[20, :] = 254  # a wall along y = 1.0 m
+    m.costs[14:20, :] = 253  # its inscribed band, 0.3 m
+    m.costs[21:27, :] = 253
+    m.costs[13, :] = 200
+    start, goal = (1.0, 0.8, 0.0), (2.5, 0.3, 0.0)
+    ros = NavFn(m)  # no radius known: as ROS, no way out
+    with pytest.raises(NoPathFound, match="not connected"):
+        ros.create_plan(start, goal)
+    nf = NavFn(m)
+    nf.set_circumscribed(200, 0.48)
+    path = nf.create_plan(start, goal)
+    assert path.poses[-1, :2].tolist() == pytest.approx([2.5, 0.3])
+    cells, inside = m.cells_of(path.poses[:, :2])
+    costs = m.costs[cells[:, 1], cells[:, 0]]
+    assert inside.all() and (costs < 254).all()
+    out = int(np.argmax(costs < 253))  # the first point out of the band, straight down
+    assert 0 < out and abs(path.poses[out, 0] - 1.0) < 0.15
+    # a start off the band plans as before
+    assert nf.create_plan((1.0, 0.3, 0.0), goal).poses[0, :2].tolist() == [1.0, 0.3]

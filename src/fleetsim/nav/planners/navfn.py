@@ -170,6 +170,12 @@ class NavFn(GlobalPlanner):
         x0, y0, xn, yn = self.window
         nx = xn - x0
         reached = pot[(cells[:, 1] - y0) * nx + (cells[:, 0] - x0)] < POT_HIGH
+        if not reached.any() and finished and self._in_inscribed(s_cell):
+            # the robot stands where its centre is in inscribed space: a way out first
+            self.window = x0, y0, xn, yn = full
+            nx = xn - x0
+            pot, finished = self._escape_potential(s_cell, goal_cell, cycles)
+            reached = pot[(cells[:, 1] - y0) * nx + (cells[:, 0] - x0)] < POT_HIGH
         if not reached.any():
             if not finished:
                 raise PlannerTimeout(
@@ -269,6 +275,43 @@ class NavFn(GlobalPlanner):
         if yn < full[3]:
             edges.append(grid[-2, :])
         return all(bool((e >= POT_HIGH).all()) for e in edges)
+
+    def _in_inscribed(self, s_cell) -> bool:
+        """Whether the robot's cell is inscribed (not lethal) and the planner knows how far the
+        footprint reaches (`set_circumscribed`)."""
+        c = self.costmap.costs[s_cell[1], s_cell[0]]
+        return c == INSCRIBED_INFLATED_OBSTACLE and self.circumscribed[1] > 0
+
+    def _escape_potential(self, s_cell, goal_cell, cycles) -> tuple[np.ndarray, bool]:
+        """navfn's potential over ``self.window`` with the inscribed (not lethal) cells within
+        the footprint's circumscribed radius of the robot passable at navfn's highest cost
+        (a fleetsim addition, tried only where ROS's plan found no way).
+
+        Why: NavfnROS clears the robot's own cell (clearRobotCell) and nothing else. A robot
+        whose centre has come into inscribed space (a polygon footprint is checked on its
+        outline, so the local planner may drive it there: by a desk, in a door) has only
+        inscribed cells round that one, so every plan fails, rotate_recovery cannot turn the
+        body, and move_base aborts every goal until the run ends (office, two hunters with
+        their padded outline, seeds 1-4 at stop 31). The body is where it is without touching,
+        so the cells its centre crosses within the circumscribed radius lead out of that
+        space; the local planner checks the footprint along the way as always."""
+        m, p = self.costmap, self.params
+        x0, y0, xn, yn = self.window
+        nx = xn - x0
+        window = m.costs[y0:yn, x0:xn]
+        costarr = navfn_costs(window, p.allow_unknown)
+        reach = self.circumscribed[1] / m.resolution + 1.0
+        ys, xs = np.ogrid[y0:yn, x0:xn]
+        near = (xs - int(s_cell[0])) ** 2 + (ys - int(s_cell[1])) ** 2 <= reach * reach
+        near &= window == INSCRIBED_INFLATED_OBSTACLE
+        near[[0, -1], :] = False  # navfn's border stays an obstacle
+        near[:, [0, -1]] = False
+        costarr[near.ravel()] = COST_OBS - 1
+        start_idx = (s_cell[1] - y0) * nx + (s_cell[0] - x0)
+        goal_idx = (goal_cell[1] - y0) * nx + (goal_cell[0] - x0)
+        pot, finished = navfn_potential(costarr, nx, start_idx, goal_idx, True, cycles)
+        self.potential = pot.reshape(yn - y0, nx)
+        return pot, finished
 
     def _roomy_costs(self, costarr: np.ndarray, s_cell, goal_cell) -> np.ndarray:
         """``costarr`` with the cells at or above the circumscribed cost made obstacles, except

@@ -105,13 +105,12 @@ def global_planner(value: str, ns: dict, costmap_ros: Any, where: str) -> tuple[
     params = load_params(NavfnParams, ns.get(name) or {}, f"{where}/{name}", logger=_log)
     planner = NavFn(costmap_ros.costmap, params, costmap_ros.global_frame)
     cost, radius = circumscribed_cost(costmap_ros.layered)
-    if params.circumscribed_clearance:
-        if cost == 0:
-            _log.warning(
-                "%s/%s: circumscribed_clearance has no effect: the global costmap's inflation "
-                "does not reach the footprint's circumscribed radius (%.3f m)",
-                where, name, radius,
-            )  # fmt: skip
+    if params.circumscribed_clearance and cost == 0:
+        _log.warning(
+            "%s/%s: circumscribed_clearance has no effect: the global costmap's inflation "
+            "does not reach the footprint's circumscribed radius (%.3f m)",
+            where, name, radius,
+        )  # fmt: skip
     planner.set_circumscribed(cost, radius)
     return name, planner
 

@@ -76,6 +76,30 @@ def test_plugins_form_and_unknown_type():
         LayeredCostmap.from_params(ns, "c")
 
 
+def test_pre_hydro_keys_beside_plugins_are_said_once_and_typos_still_warned(caplog):
+    """A common file loaded into a costmap with a plugins list (the manual's nav_stack.launch
+    with a robots layer added): its pre-Hydro keys are unread, as in ROS, and said at INFO."""
+    ns = {
+        "plugins": [{"name": "obs", "type": "costmap_2d::ObstacleLayer"}],
+        "obs": {"observation_sources": ""},
+        "map_type": "voxel",
+        "z_voxels": 2,
+        "observation_sources": "scan",
+        "scan": {"data_type": "LaserScan", "topic": "scan"},
+        "obstacle_range": 3.0,
+        "widht": 4.0,
+    }
+    with caplog.at_level(logging.INFO, logger="fleetsim"):
+        LayeredCostmap.from_params(ns, "lc")
+    warned = [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING]
+    assert len(warned) == 1 and "'widht'" in warned[0]
+    said = [r.getMessage() for r in caplog.records if "pre-Hydro keys" in r.getMessage()]
+    assert said == [
+        "'plugins' is set: the pre-Hydro keys map_type, observation_sources, scan, z_voxels "
+        "are not read (each layer reads its own namespace)"
+    ]
+
+
 def test_bad_parameter_is_named(caplog):
     with pytest.raises(ParameterError, match="'width' must be float"):
         LayeredCostmap.from_params({"width": "wide"}, "local_costmap")

@@ -313,6 +313,6 @@ def test_a_robot_whose_centre_is_in_inscribed_space_gets_a_way_out():
     costs = m.costs[cells[:, 1], cells[:, 0]]
     assert inside.all() and (costs < 254).all()
     out = int(np.argmax(costs < 253))  # the first point out of the band, straight down
-    assert 0 < out and abs(path.poses[out, 0] - 1.0) < 0.15
+    assert out > 0 and abs(path.poses[out, 0] - 1.0) < 0.15
     # a start off the band plans as before
     assert nf.create_plan((1.0, 0.3, 0.0), goal).poses[0, :2].tolist() == [1.0, 0.3]

@@ -109,7 +109,20 @@ def _layer_specs(ns: dict[str, Any], p: CostmapParams) -> tuple[list[tuple[str, 
                     f"plugins[{i}] must be a mapping with 'name' and 'type', got {entry!r}"
                 )
             specs.append((str(entry["name"]), str(entry["type"])))
-        return specs, set()
+        # a common file loaded into both costmaps (the manual's nav_stack.launch) leaves the
+        # pre-Hydro form's keys beside a plugins list; ROS's layers read their own namespaces
+        # and leave those unread without a word: said once, not warned about as unknown
+        old = {"map_type", "observation_sources", *_MOVED_STATIC, *_MOVED_VOXEL}
+        old |= {*_MOVED_OBSTACLE, *_MOVED_INFLATION}
+        old |= set(str(ns.get("observation_sources", "")).split())
+        unread = sorted(k for k in old if k in ns and k not in _SEARCHED)
+        if unread:
+            _log.info(
+                "'plugins' is set: the pre-Hydro keys %s are not read (each layer reads its own "
+                "namespace)",
+                ", ".join(unread),
+            )
+        return specs, set(unread)
     _log.info("no 'plugins' parameter: loading the pre-Hydro static/obstacle/inflation stack")
     consumed: set[str] = set()
 

@@ -6,7 +6,11 @@ position_share_controller does the same job by publishing ``stationary_robots``.
 only robots slower than ``still_speed`` are marked (moving robots are the local planner's
 business, and marking them would make the global planner chase their wake), each footprint
 scaled by ``static_scale`` and padded by this robot's inscribed radius (costmap_2d's
-padFootprint), so that a plan keeps this robot's body clear of theirs.
+padFootprint), so that a plan keeps this robot's body clear of theirs. In a local costmap whose
+planner checks the robot's footprint against lethal cells (TrajectoryPlannerROS), ``pad: false``
+with ``cost: 254`` and a ``still_speed`` above any robot's marks every other robot's body as it
+is: how a robot whose laser passes above the others' bodies sees them at all (slam_explore's
+two hunters).
 
 The cells get ``cost`` (default 252, just below costmap_2d's inscribed cost), not a lethal
 one: navfn then plans around a parked robot where there is room, and still finds a plan when a
@@ -56,6 +60,11 @@ class RobotsLayerParams:
     )
     robot_id: str = param("", help="this robot's id on /position_share (empty: tf_prefix)")
     cost: int = param(252, range=(1, 254), help="cost of the cells under a marked robot")
+    pad: bool = param(
+        True,
+        help="pad the marked footprints by this robot's inscribed radius (for a planner of "
+        "the robot's centre; off in a local costmap whose planner checks the footprint)",
+    )
 
 
 class RobotsLayer(Layer):
@@ -114,7 +123,8 @@ class RobotsLayer(Layer):
         return out
 
     def on_footprint_changed(self) -> None:
-        self._grow = self.layered.inscribed_radius if self.layered is not None else 0.0
+        grow = self.params.pad and self.layered is not None
+        self._grow = self.layered.inscribed_radius if grow else 0.0
 
     def update_bounds(self, robot_x: float, robot_y: float, robot_yaw: float, bounds: Bounds):
         if not self.enabled:

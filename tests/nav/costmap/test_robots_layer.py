@@ -119,13 +119,13 @@ def test_navfn_plans_around_a_parked_robot_and_through_one_on_the_goal():
     assert np.hypot(*(path[-1, :2] - [5.5, 0.6])) < 0.1
 
 
-def test_a_local_costmap_marks_every_robot_as_it_is_with_pad_off():
+def test_a_local_costmap_marks_every_robot_with_its_own_padding():
     """A laser above the other robots' bodies does not see them: a local costmap marks them
-    from /position_share, moving ones too, lethal, and not padded (its planner checks the
-    footprint itself)."""
+    from /position_share, moving ones too, lethal, padded by ``padding`` m instead of this
+    robot's inscribed radius (its planner checks the footprint itself)."""
     rt = Runtime()
     node = Node(rt, "move_base", "/hunter1")
-    layer_params = {"cost": LETHAL_OBSTACLE, "still_speed": 100.0, "pad": False}
+    layer_params = {"cost": LETHAL_OBSTACLE, "still_speed": 100.0, "padding": 0.05}
     cm = LayeredCostmap.from_params({**PARAMS, "robots_layer": layer_params}, "lc")
     cm.layer("robots_layer").connect(SimpleNamespace(node=node, global_frame="map"))
     pub = Node(rt, "talker", "/").create_publisher(
@@ -135,5 +135,5 @@ def test_a_local_costmap_marks_every_robot_as_it_is_with_pad_off():
     rt.run(duration=0.05)
     cm.update_map(5.0, 5.0, 0.0)
     assert cost_at(cm, 3.0, 3.0) == LETHAL_OBSTACLE
-    assert cost_at(cm, 3.0 + 0.17, 3.0) == LETHAL_OBSTACLE  # inside 0.2 x 0.95
-    assert cost_at(cm, 3.0 + 0.26, 3.0) == INSCRIBED_INFLATED_OBSTACLE  # inflated, not marked
+    assert cost_at(cm, 3.0 + 0.22, 3.0) == LETHAL_OBSTACLE  # 0.2 x 0.95 + 0.05
+    assert cost_at(cm, 3.0 + 0.27, 3.0) == INSCRIBED_INFLATED_OBSTACLE  # inflated, not marked

@@ -7,10 +7,10 @@ only robots slower than ``still_speed`` are marked (moving robots are the local 
 business, and marking them would make the global planner chase their wake), each footprint
 scaled by ``static_scale`` and padded by this robot's inscribed radius (costmap_2d's
 padFootprint), so that a plan keeps this robot's body clear of theirs. In a local costmap whose
-planner checks the robot's footprint against lethal cells (TrajectoryPlannerROS), ``pad: false``
-with ``cost: 254`` and a ``still_speed`` above any robot's marks every other robot's body as it
-is: how a robot whose laser passes above the others' bodies sees them at all (slam_explore's
-two hunters).
+planner checks the robot's footprint against lethal cells (TrajectoryPlannerROS), ``padding``
+of a few cm (the shared poses' error) with ``cost: 254`` and a ``still_speed`` above any
+robot's marks every other robot's body: how a robot whose laser passes above the others'
+bodies sees them at all (slam_explore's two hunters).
 
 The cells get ``cost`` (default 252, just below costmap_2d's inscribed cost), not a lethal
 one: navfn then plans around a parked robot where there is room, and still finds a plan when a
@@ -60,10 +60,13 @@ class RobotsLayerParams:
     )
     robot_id: str = param("", help="this robot's id on /position_share (empty: tf_prefix)")
     cost: int = param(252, range=(1, 254), help="cost of the cells under a marked robot")
-    pad: bool = param(
-        True,
-        help="pad the marked footprints by this robot's inscribed radius (for a planner of "
-        "the robot's centre; off in a local costmap whose planner checks the footprint)",
+    padding: float = param(
+        -1.0,
+        unit="m",
+        range=(-1.0, None),
+        help="added round the marked footprints; -1: this robot's inscribed radius (for a "
+        "planner of the robot's centre); >= 0 in a local costmap whose planner checks the "
+        "footprint itself",
     )
 
 
@@ -123,8 +126,10 @@ class RobotsLayer(Layer):
         return out
 
     def on_footprint_changed(self) -> None:
-        grow = self.params.pad and self.layered is not None
-        self._grow = self.layered.inscribed_radius if grow else 0.0
+        pad = self.params.padding
+        if pad < 0:
+            pad = self.layered.inscribed_radius if self.layered is not None else 0.0
+        self._grow = pad
 
     def update_bounds(self, robot_x: float, robot_y: float, robot_yaw: float, bounds: Bounds):
         if not self.enabled:

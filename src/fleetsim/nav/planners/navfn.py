@@ -216,14 +216,10 @@ class NavFn(GlobalPlanner):
         of the whole window ``full``: (None, False) when a wavefront ran out of cycles or
         reached the part's cut edges (`_inside`), so that only a run the whole window would
         repeat bit for bit is kept."""
-        m, p = self.costmap, self.params
+        p = self.params
         x0, y0, xn, yn = self.window = window
         nx = xn - x0
-        costarr = navfn_costs(m.costs[y0:yn, x0:xn], p.allow_unknown)
-        start_idx = (s_cell[1] - y0) * nx + (s_cell[0] - x0)
-        if 0 < s_cell[0] - x0 < nx - 1 and 0 < s_cell[1] - y0 < yn - y0 - 1:
-            costarr[start_idx] = navfn_costs(np.zeros((3, 3), np.uint8), True)[4]  # clearRobotCell
-        goal_idx = (goal_cell[1] - y0) * nx + (goal_cell[0] - x0)
+        costarr, start_idx, goal_idx = self._costs(s_cell, goal_cell)
         if p.circumscribed_clearance and self.circumscribed[0] > 0:
             roomy = self._roomy_costs(costarr, s_cell, goal_cell)
             pot, finished = navfn_potential(roomy, nx, start_idx, goal_idx, True, cycles)
@@ -276,6 +272,25 @@ class NavFn(GlobalPlanner):
             edges.append(grid[-2, :])
         return all(bool((e >= POT_HIGH).all()) for e in edges)
 
+    def _costs(self, s_cell, goal_cell) -> tuple[np.ndarray, int, int]:
+        """navfn's cost array over ``self.window`` with the robot's cell cleared
+        (clearRobotCell), and the start's and the goal's flat indices in it."""
+        x0, y0, xn, yn = self.window
+        nx = xn - x0
+        costarr = navfn_costs(self.costmap.costs[y0:yn, x0:xn], self.params.allow_unknown)
+        start_idx = (s_cell[1] - y0) * nx + (s_cell[0] - x0)
+        if 0 < s_cell[0] - x0 < nx - 1 and 0 < s_cell[1] - y0 < yn - y0 - 1:
+            costarr[start_idx] = navfn_costs(np.zeros((3, 3), np.uint8), True)[4]
+        return costarr, start_idx, (goal_cell[1] - y0) * nx + (goal_cell[0] - x0)
+
+    def _within_reach(self, cell) -> np.ndarray:
+        """(ny, nx) bool over ``self.window``: the cells within the footprint's circumscribed
+        radius plus a cell of ``cell`` (x, y)."""
+        x0, y0, xn, yn = self.window
+        reach = self.circumscribed[1] / self.costmap.resolution + 1.0
+        ys, xs = np.ogrid[y0:yn, x0:xn]
+        return (xs - int(cell[0])) ** 2 + (ys - int(cell[1])) ** 2 <= reach * reach
+
     def _in_inscribed(self, s_cell) -> bool:
         """Whether the robot's cell is inscribed (not lethal) and the planner knows how far the
         footprint reaches (`set_circumscribed`)."""
@@ -295,20 +310,14 @@ class NavFn(GlobalPlanner):
         their padded outline, seeds 1-4 at stop 31). The body is where it is without touching,
         so the cells its centre crosses within the circumscribed radius lead out of that
         space; the local planner checks the footprint along the way as always."""
-        m, p = self.costmap, self.params
         x0, y0, xn, yn = self.window
         nx = xn - x0
-        window = m.costs[y0:yn, x0:xn]
-        costarr = navfn_costs(window, p.allow_unknown)
-        reach = self.circumscribed[1] / m.resolution + 1.0
-        ys, xs = np.ogrid[y0:yn, x0:xn]
-        near = (xs - int(s_cell[0])) ** 2 + (ys - int(s_cell[1])) ** 2 <= reach * reach
-        near &= window == INSCRIBED_INFLATED_OBSTACLE
+        costarr, start_idx, goal_idx = self._costs(s_cell, goal_cell)
+        near = self._within_reach(s_cell)
+        near &= self.costmap.costs[y0:yn, x0:xn] == INSCRIBED_INFLATED_OBSTACLE
         near[[0, -1], :] = False  # navfn's border stays an obstacle
         near[:, [0, -1]] = False
         costarr[near.ravel()] = COST_OBS - 1
-        start_idx = (s_cell[1] - y0) * nx + (s_cell[0] - x0)
-        goal_idx = (goal_cell[1] - y0) * nx + (goal_cell[0] - x0)
         pot, finished = navfn_potential(costarr, nx, start_idx, goal_idx, True, cycles)
         self.potential = pot.reshape(yn - y0, nx)
         return pot, finished
@@ -316,15 +325,10 @@ class NavFn(GlobalPlanner):
     def _roomy_costs(self, costarr: np.ndarray, s_cell, goal_cell) -> np.ndarray:
         """``costarr`` with the cells at or above the circumscribed cost made obstacles, except
         within the circumscribed radius (plus a cell) of the start and the goal cells."""
-        m = self.costmap
         x0, y0, xn, yn = self.window
-        cost, radius = self.circumscribed
-        window = m.costs[y0:yn, x0:xn]
-        tight = (window >= cost) & (window != NO_INFORMATION)  # unknown: allow_unknown's
-        reach = radius / m.resolution + 1.0
-        ys, xs = np.ogrid[y0:yn, x0:xn]
-        for cx, cy in (s_cell, goal_cell):
-            tight &= (xs - int(cx)) ** 2 + (ys - int(cy)) ** 2 > reach * reach
+        window = self.costmap.costs[y0:yn, x0:xn]
+        tight = (window >= self.circumscribed[0]) & (window != NO_INFORMATION)  # allow_unknown's
+        tight &= ~self._within_reach(s_cell) & ~self._within_reach(goal_cell)
         out = costarr.copy()
         out[tight.ravel()] = COST_OBS
         return out

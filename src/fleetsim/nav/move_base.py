@@ -41,6 +41,8 @@ import numpy as np
 
 from fleetsim.errors import TransformError
 from fleetsim.msgs import geometry_msgs, move_base_msgs, nav_msgs, std_msgs
+from fleetsim.nav.controllers.escape_guard import EscapeGuard
+from fleetsim.nav.controllers.trajectory_planner import TrajectoryPlanner
 from fleetsim.nav.costmap.costmap_ros import Costmap2DROS
 from fleetsim.nav.move_base_cycle import PLANNING, PLANNING_R, ExecuteCycle
 from fleetsim.nav.move_base_plugins import (
@@ -143,6 +145,11 @@ class MoveBase(ExecuteCycle, Node):
             self.local_costmap,
             f"{where}/{self.controller_name}",
         )
+        tp = self.controller
+        if isinstance(tp, TrajectoryPlanner) and tp.params.escape_global_check:
+            self.controller.escape_guard = EscapeGuard(
+                self.global_costmap, self.local_costmap, self.controller.footprint
+            )
         self.recoveries = recovery_behaviors(
             p,
             ns,

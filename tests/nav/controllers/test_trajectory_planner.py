@@ -339,3 +339,79 @@ def test_escaping_with_alignment_backs_on_rather_than_turn_away_from_the_path(al
         assert vx == -0.1 and tp.escaping
     else:  # base_local_planner: the escape ends and the robot turns away, the only legal way
         assert vx == 0.0 and vth > 0 and not tp.escaping
+
+
+class _CostmapROS:
+    """What `EscapeGuard` reads of a Costmap2DROS: the grid, its frame, the robot's pose."""
+
+    def __init__(self, costmap, pose, frame):
+        self.costmap, self._pose, self.global_frame = costmap, pose, frame
+
+    def robot_pose(self):
+        return self._pose
+
+
+def _wedged_box_robot():
+    """A 0.6 x 0.3 m robot at (1.5, 1.0) facing +x in a 0.4 m wide dead end of its local
+    costmap: forward moves hit the end wall, in-place rotations the side walls, so only the
+    escape is left; behind it the local costmap is free."""
+    m = Costmap2D(120, 40, 0.05)
+    m.costs[:16, :] = 254
+    m.costs[24:, :] = 254
+    m.costs[:, 37:] = 254  # the end wall, x >= 1.85
+    box = np.array([[0.3, 0.15], [0.3, -0.15], [-0.3, -0.15], [-0.3, 0.15]])
+    p = TrajectoryPlannerParams(holonomic_robot=False, escape_vel=-0.1, dwa=False)
+    tp = TrajectoryPlanner(m, box, p)
+    tp.set_plan(np.array([[x, 1.0, math.pi] for x in np.arange(1.5, 0.4, -0.05)]))
+    return tp
+
+
+def _escape_with_global_map(lethal_rows=(), lethal_cols=(), lethal_cell=None):
+    """Run one cycle of the wedged robot with an escape guard on a global costmap whose frame
+    differs from the local one: the robot is at (2.0, -1.0) facing +y there, so backing up
+    moves it toward -y."""
+    from fleetsim.nav.controllers.escape_guard import EscapeGuard
+
+    tp = _wedged_box_robot()
+    g = Costmap2D(200, 200, 0.05, origin_x=-5.0, origin_y=-5.0)
+    for r in lethal_rows:
+        g.costs[r, :] = 254
+    for c in lethal_cols:
+        g.costs[:, c] = 254
+    if lethal_cell is not None:
+        g.costs[lethal_cell] = 254
+    local = _CostmapROS(tp.costmap, (1.5, 1.0, 0.0), "odom")
+    tp.escape_guard = EscapeGuard(
+        _CostmapROS(g, (2.0, -1.0, math.pi / 2), "map"), local, tp.footprint
+    )
+    return tp, tp.compute_velocity_commands((1.5, 1.0, 0.0), (0.0, 0.0, 0.0))
+
+
+def test_the_escape_does_not_back_onto_what_the_global_costmap_knows():
+    # nothing behind in either map: a back-up (straight or on a curve, see `_escape_choice`)
+    tp, cmd = _escape_with_global_map()
+    assert cmd.vx == -0.1 and tp.escaping
+    # a wall 0.05-0.15 m behind the rear edge in the global costmap only (global y -1.45 to
+    # -1.35; the rear edge is at -1.30): every back-up refused, so no valid trajectory, and
+    # the error says why
+    why = r"lethal cell of the global costmap at \(.*\) in map"
+    with pytest.raises(NoValidTrajectory, match=why):
+        _escape_with_global_map(lethal_rows=(71, 72))
+    # the same wall where the local frame's -x would be without the frames' rotation (global x
+    # 1.55-1.65): not behind the robot, so the escape goes ahead
+    _, cmd = _escape_with_global_map(lethal_cols=(131, 132))
+    assert cmd.vx == -0.1
+    # a lethal cell the footprint covers already (the map a little off): no reason to refuse
+    _, cmd = _escape_with_global_map(lethal_cell=(80, 140))
+    assert cmd.vx == -0.1
+
+
+def test_a_blind_escape_publishes_only_the_poses_it_simulated():
+    tp = _wedged_box_robot()
+    tp.costmap.costs[:, :23] = 254  # a wall 0.05 m behind the rear edge in the local map too
+    tp.set_plan(np.array([[x, 1.0, math.pi] for x in (1.5, 1.45, 1.4, 1.35, 1.3)]))
+    cmd = tp.compute_velocity_commands((1.5, 1.0, 0.0), (0.0, 0.0, 0.0))
+    assert cmd.vx == -0.1  # ROS backs up even when the map says it is blocked
+    assert 0 < tp.local_plan.shape[0] < tp._steps.max()
+    assert np.isfinite(tp.local_plan).all()
+    assert np.abs(tp.local_plan[:, 0] - 1.5).max() < 0.06

@@ -242,7 +242,8 @@ def trajectory_costs(
     heading : (2,) heading_scoring (0/1), heading_scoring_timestep (s).
     plan_cells : (K, 2) int64 plan cells in the map, for heading scoring.
     simple_attractor : score by squared distance to ``final_goal`` (2,) instead of the maps.
-    poses_out : (S, T, 3) float64 written with each rollout's poses (T >= max num_steps).
+    poses_out : (S, T, 3) float64 written with each rollout's poses (T >= max num_steps); the
+        steps of a rollout cut short by a negative cost are NaN.
     bounds : (H, W) uint8 from `footprint_cost_bounds` for ``costs`` and ``outline``.
     alignment : (2,) weight (per cell of path distance; 0 = off) and forward distance (m) of
         the alignment cost: the path distance of the point that far ahead of the rollout's
@@ -267,6 +268,7 @@ def trajectory_costs(
         hdiff = 0.0
         t = 0.0
         cost = 0.0
+        written = 0
         for i in range(n):
             fx = (x - origin[0]) / resolution
             fy = (y - origin[1]) / resolution
@@ -303,6 +305,7 @@ def trajectory_costs(
             poses_out[s, i, 0] = x
             poses_out[s, i, 1] = y
             poses_out[s, i, 2] = th
+            written = i + 1
             vx = new_velocity(samples[s, 0], vx, acc[0], dt)
             vy = new_velocity(samples[s, 1], vy, acc[1], dt)
             vth = new_velocity(samples[s, 2], vth, acc[2], dt)
@@ -315,6 +318,12 @@ def trajectory_costs(
             th = th + vth * dt
             t += dt
         if cost < 0.0:
+            # the poses not simulated are NaN, not whatever the buffer held (the escape, taken
+            # blind, publishes its rollout as the local plan, and the escape guard reads it)
+            for k in range(written, n):
+                poses_out[s, k, 0] = np.nan
+                poses_out[s, k, 1] = np.nan
+                poses_out[s, k, 2] = np.nan
             out[s] = cost
             continue
         total = scales[0] * path_d + scales[1] * goal_d + scales[2] * occ

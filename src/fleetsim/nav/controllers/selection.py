@@ -266,7 +266,10 @@ def _escape_choice(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: floa
     axis) backs out straight, drives in again at the same slant and is wedged again; backing
     on a curve straightens it out of the gap as a driver's three-point turn does. With
     alignment, a look-ahead on an obstacle ties and the end heading against the path's
-    direction decides."""
+    direction decides.
+
+    With an escape guard (``escape_global_check``), rollouts it refuses are passed over; -1
+    when it refuses every one."""
     direction = path_heading(tp, tp._poses[g["escape"].start, 0]) if _aligning(tp) else None
 
     def key(i: int):
@@ -281,14 +284,21 @@ def _escape_choice(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: floa
         size = float(tp.goal_dist.size)
         return (min(ahead, size), abs(_wrap(tp._poses[i, n - 1, 2] - direction)))
 
+    guard = tp.escape_guard.checker() if tp.escape_guard is not None else None
+
+    def refused(i: int) -> bool:
+        return guard is not None and guard(tp._poses[i, : max(int(tp._steps[i]), 1)])
+
     best = g["escape"].start
     best_key = key(best) if costs[best] >= 0 else None
+    if refused(best):
+        best, best_key = -1, None
     raw = tp._in_place_raw
     for k, i in enumerate(range(g["escape_turn"].start, g["escape_turn"].stop)):
         if costs[i] < 0 or -dvth <= raw[k] <= dvth:
             continue
         ki = key(i)
-        if ki is not None and (best_key is None or ki < best_key):
+        if ki is not None and (best_key is None or ki < best_key) and not refused(i):
             best, best_key = i, ki
     return best
 
@@ -357,8 +367,11 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
     if best_cost >= 0:
         _bookkeep(tp, samples[best], pose)
         return tuple(samples[best]), float(best_cost), best
-    # back up slowly, even if the map says it is blocked
+    # back up slowly, even if the map says it is blocked (unless the global costmap knows
+    # better: `escape_guard`)
     i = _escape_choice(tp, costs, g, dvth)
+    if i < 0:
+        return (0.0, 0.0, 0.0), -1.0, g["escape"].start
     cost = float(costs[i])
     x, y, th = pose
     if math.hypot(x - tp.prev[0], y - tp.prev[1]) > tp.params.oscillation_reset_dist:

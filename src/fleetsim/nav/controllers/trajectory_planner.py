@@ -113,6 +113,8 @@ class TrajectoryPlanner(LocalPlanner):
         self.escaping = False
         self.prev = (0.0, 0.0)
         self.escape_pose = (0.0, 0.0, 0.0)
+        #: an `EscapeGuard` (move_base sets it with ``escape_global_check``), or None
+        self.escape_guard = None
 
     @classmethod
     def from_namespace(
@@ -193,9 +195,12 @@ class TrajectoryPlanner(LocalPlanner):
         best, cost = self._find_best((x, y, yaw), vel)
         if cost < 0:
             self.local_plan = np.zeros((0, 3))
+            why = "the footprint collides or leaves the local map on every sample"
+            if self.escape_guard is not None and self.escape_guard.refused:
+                why += f"; {self.escape_guard.refused}"
             raise NoValidTrajectory(
                 f"TrajectoryPlannerROS: no valid trajectory from ({x:.2f}, {y:.2f}, yaw "
-                f"{yaw:.2f}): the footprint collides or leaves the local map on every sample"
+                f"{yaw:.2f}): {why}"
             )
         return VelocityCommand(*best)
 
@@ -332,8 +337,13 @@ class TrajectoryPlanner(LocalPlanner):
         raise NoValidTrajectory("TrajectoryPlannerROS: cannot rotate to the goal yaw in place")
 
     def _find_best(self, pose, vel) -> tuple[tuple[float, float, float], float]:
+        if self.escape_guard is not None:
+            self.escape_guard.refused = ""
         (vx, vy, vth), cost, index = choose_trajectory(self, pose, vel)
-        self.local_plan = self._poses[index, : max(int(self._steps[index]), 0)].copy()
+        local = self._poses[index, : max(int(self._steps[index]), 0)]
+        # a blind escape's rollout may be cut short: its poses end at the first NaN
+        cut = np.flatnonzero(np.isnan(local[:, 0]))
+        self.local_plan = (local[: cut[0]] if cut.shape[0] else local).copy()
         if cost < 0:
             self.local_plan = np.zeros((0, 3))
         return (vx, vy, vth), cost

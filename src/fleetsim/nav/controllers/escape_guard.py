@@ -63,7 +63,6 @@ class EscapeGuard:
             return rows[hit] * grid.size_x + cols[hit]
 
         def refused(poses: np.ndarray) -> bool:
-            poses = poses[~np.isnan(poses[:, 0])]
             if poses.shape[0] < 2:
                 return False
             start = lethal_cells(*poses[0])

@@ -268,44 +268,47 @@ def trajectory_costs(
         hdiff = 0.0
         t = 0.0
         cost = 0.0
-        written = 0
         for i in range(n):
-            fx = (x - origin[0]) / resolution
-            fy = (y - origin[1]) / resolution
-            if fx < 0.0 or fy < 0.0 or fx >= w or fy >= h:
-                cost = -1.0
-                break
-            cx = int(fx)
-            cy = int(fy)
-            occ = max(occ, float(costs[cy, cx]))
-            bound = bounds[cy, cx]
-            if bound >= LETHAL_OBSTACLE or bound > occ:
-                fp = footprint_cost_at(costs, origin[0], origin[1], resolution, outline, x, y, th)
-                if fp < 0.0:
+            # a rollout found illegal is still followed to its end, unscored: the escape, taken
+            # blind, publishes it as the local plan, and the escape guard checks it
+            if cost >= 0.0:
+                fx = (x - origin[0]) / resolution
+                fy = (y - origin[1]) / resolution
+                if fx < 0.0 or fy < 0.0 or fx >= w or fy >= h:
                     cost = -1.0
-                    break
-                occ = max(occ, fp)
-            if simple_attractor:
-                goal_d = (x - final_goal[0]) ** 2 + (y - final_goal[1]) ** 2
-            else:
-                update = True
-                if heading[0] > 0.5:
-                    if t >= heading[1] and t < heading[1] + dt:
-                        hdiff = _heading_diff(
-                            costs, origin[0], origin[1], resolution, plan_cells, cx, cy, x, y, th
+                else:
+                    cx = int(fx)
+                    cy = int(fy)
+                    occ = max(occ, float(costs[cy, cx]))
+                    bound = bounds[cy, cx]
+                    if bound >= LETHAL_OBSTACLE or bound > occ:
+                        fp = footprint_cost_at(
+                            costs, origin[0], origin[1], resolution, outline, x, y, th
                         )
-                    else:
-                        update = False
-                if update:
-                    path_d = path_dist[cy, cx]
-                    goal_d = goal_dist[cy, cx]
-                    if impossible <= goal_d or impossible <= path_d:
-                        cost = -2.0
-                        break
+                        if fp < 0.0:
+                            cost = -1.0
+                        else:
+                            occ = max(occ, fp)
+                    if cost >= 0.0 and simple_attractor:
+                        goal_d = (x - final_goal[0]) ** 2 + (y - final_goal[1]) ** 2
+                    elif cost >= 0.0:
+                        update = True
+                        if heading[0] > 0.5:
+                            if t >= heading[1] and t < heading[1] + dt:
+                                hdiff = _heading_diff(
+                                    costs, origin[0], origin[1], resolution, plan_cells, cx, cy,
+                                    x, y, th,
+                                )  # fmt: skip
+                            else:
+                                update = False
+                        if update:
+                            path_d = path_dist[cy, cx]
+                            goal_d = goal_dist[cy, cx]
+                            if impossible <= goal_d or impossible <= path_d:
+                                cost = -2.0
             poses_out[s, i, 0] = x
             poses_out[s, i, 1] = y
             poses_out[s, i, 2] = th
-            written = i + 1
             vx = new_velocity(samples[s, 0], vx, acc[0], dt)
             vy = new_velocity(samples[s, 1], vy, acc[1], dt)
             vth = new_velocity(samples[s, 2], vth, acc[2], dt)
@@ -318,12 +321,6 @@ def trajectory_costs(
             th = th + vth * dt
             t += dt
         if cost < 0.0:
-            # the poses not simulated are NaN, not whatever the buffer held (the escape, taken
-            # blind, publishes its rollout as the local plan, and the escape guard reads it)
-            for k in range(written, n):
-                poses_out[s, k, 0] = np.nan
-                poses_out[s, k, 1] = np.nan
-                poses_out[s, k, 2] = np.nan
             out[s] = cost
             continue
         total = scales[0] * path_d + scales[1] * goal_d + scales[2] * occ

@@ -340,10 +340,7 @@ class TrajectoryPlanner(LocalPlanner):
         if self.escape_guard is not None:
             self.escape_guard.refused = ""
         (vx, vy, vth), cost, index = choose_trajectory(self, pose, vel)
-        local = self._poses[index, : max(int(self._steps[index]), 0)]
-        # a blind escape's rollout may be cut short: its poses end at the first NaN
-        cut = np.flatnonzero(np.isnan(local[:, 0]))
-        self.local_plan = (local[: cut[0]] if cut.shape[0] else local).copy()
+        self.local_plan = self._poses[index, : max(int(self._steps[index]), 0)].copy()
         if cost < 0:
             self.local_plan = np.zeros((0, 3))
         return (vx, vy, vth), cost

@@ -147,9 +147,7 @@ class MoveBase(ExecuteCycle, Node):
         )
         tp = self.controller
         if isinstance(tp, TrajectoryPlanner) and tp.params.escape_global_check:
-            self.controller.escape_guard = EscapeGuard(
-                self.global_costmap, self.local_costmap, self.controller.footprint
-            )
+            tp.escape_guard = EscapeGuard(self.global_costmap, self.local_costmap)
         self.recoveries = recovery_behaviors(
             p,
             ns,

@@ -2,6 +2,7 @@
 
 import logging
 import math
+import types
 
 import numpy as np
 import pytest
@@ -342,10 +343,15 @@ def test_escaping_with_alignment_backs_on_rather_than_turn_away_from_the_path(al
 
 
 class _CostmapROS:
-    """What `EscapeGuard` reads of a Costmap2DROS: the grid, its frame, the robot's pose."""
+    """What `EscapeGuard` reads of a Costmap2DROS: the grid, its frame, the robot's pose, the
+    (padded) footprint and its padding."""
 
-    def __init__(self, costmap, pose, frame):
+    def __init__(self, costmap, pose, frame, footprint=None, padding=0.0):
         self.costmap, self._pose, self.global_frame = costmap, pose, frame
+        self.footprint = footprint
+        self.layered = types.SimpleNamespace(
+            params=types.SimpleNamespace(footprint_padding=padding)
+        )
 
     def robot_pose(self):
         return self._pose
@@ -366,7 +372,7 @@ def _wedged_box_robot():
     return tp
 
 
-def _escape_with_global_map(lethal_rows=(), lethal_cols=(), lethal_cell=None):
+def _escape_with_global_map(lethal_rows=(), lethal_cols=(), lethal_cell=None, padding=0.0):
     """Run one cycle of the wedged robot with an escape guard on a global costmap whose frame
     differs from the local one: the robot is at (2.0, -1.0) facing +y there, so backing up
     moves it toward -y."""
@@ -380,10 +386,8 @@ def _escape_with_global_map(lethal_rows=(), lethal_cols=(), lethal_cell=None):
         g.costs[:, c] = 254
     if lethal_cell is not None:
         g.costs[lethal_cell] = 254
-    local = _CostmapROS(tp.costmap, (1.5, 1.0, 0.0), "odom")
-    tp.escape_guard = EscapeGuard(
-        _CostmapROS(g, (2.0, -1.0, math.pi / 2), "map"), local, tp.footprint
-    )
+    local = _CostmapROS(tp.costmap, (1.5, 1.0, 0.0), "odom", tp.footprint, padding)
+    tp.escape_guard = EscapeGuard(_CostmapROS(g, (2.0, -1.0, math.pi / 2), "map"), local)
     return tp, tp.compute_velocity_commands((1.5, 1.0, 0.0), (0.0, 0.0, 0.0))
 
 
@@ -394,9 +398,13 @@ def test_the_escape_does_not_back_onto_what_the_global_costmap_knows():
     # a wall 0.05-0.15 m behind the rear edge in the global costmap only (global y -1.45 to
     # -1.35; the rear edge is at -1.30): every back-up refused, so no valid trajectory, and
     # the error says why
-    why = r"lethal cell of the global costmap at \(.*\) in map"
+    why = r"robot on a lethal cell of the global costmap at \(.*\) in map"
     with pytest.raises(NoValidTrajectory, match=why):
         _escape_with_global_map(lethal_rows=(71, 72))
+    # the body is what counts, not the padded footprint: padded by 0.1 m, the body's rear edge
+    # is at -1.20 and backs to -1.30, clear of the wall
+    _, cmd = _escape_with_global_map(lethal_rows=(71, 72), padding=0.1)
+    assert cmd.vx == -0.1
     # the same wall where the local frame's -x would be without the frames' rotation (global x
     # 1.55-1.65): not behind the robot, so the escape goes ahead
     _, cmd = _escape_with_global_map(lethal_cols=(131, 132))

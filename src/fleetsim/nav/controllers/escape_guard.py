@@ -7,12 +7,16 @@ front laser) has not seen what is behind it since it turned, and a rolling local
 without a static layer (the manual's) keeps nothing of it: the hunter backed 0.3 m into a
 desk that gmapping's map, in the global costmap, held all along (the office, seed 6).
 
-With ``escape_global_check`` (default true) an escape rollout is refused when its footprint
-reaches a lethal cell of the global costmap that the footprint does not cover at the start of
-the rollout (cells it covers already are where the robot stands: refusing those would pin a
-robot that the map shows a little off). The other escapes (backing while turning) are tried
-in the usual order; when all are refused the planner has no valid trajectory and move_base's
-recoveries take over, as for any robot with no legal move. ``false`` is ROS's blind escape.
+With ``escape_global_check`` (default true) an escape rollout is refused when it puts the
+robot's body (its footprint without ``footprint_padding``) on a lethal cell of the global
+costmap that the body does not cover at the start of the rollout (cells it covers already are
+where the robot stands: refusing those would pin a robot that the map shows a little off). The
+body, not the padded footprint: a robot wedged within its padding of a desk has to back
+closer to something, and the padding is there to keep plans away from obstacles, not to stop
+a robot getting out (the padded footprint pinned a hunter by a desk for 900 s, office seed 6).
+The other escapes (backing while turning) are tried in the usual order; when all are refused
+the planner has no valid trajectory and move_base's recoveries take over, as for any robot
+with no legal move. ``false`` is ROS's blind escape.
 """
 
 from __future__ import annotations
@@ -23,21 +27,20 @@ from typing import Any
 import numpy as np
 
 from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
-from fleetsim.nav.costmap.footprint import footprint_at, polygon_cells
+from fleetsim.nav.costmap.footprint import footprint_at, padded_footprint, polygon_cells
 
 
 class EscapeGuard:
     """Checks escape rollouts (poses in the local costmap's frame) against the global costmap.
 
-    global_costmap, local_costmap : move_base's two `Costmap2DROS` (for the map and for the
-        robot's pose in each frame, which relates the frames).
-    footprint : (K, 2) the local planner's footprint, m.
+    global_costmap, local_costmap : move_base's two `Costmap2DROS` (the global one's map; the
+        robot's pose in each frame, which relates the frames; the local one's footprint and
+        padding give the body).
     """
 
-    def __init__(self, global_costmap: Any, local_costmap: Any, footprint: np.ndarray) -> None:
+    def __init__(self, global_costmap: Any, local_costmap: Any) -> None:
         self.global_costmap = global_costmap
         self.local_costmap = local_costmap
-        self.footprint = np.asarray(footprint, dtype=np.float64)
         self.refused = ""  # why the last refused rollout was refused, for the error
 
     def checker(self):
@@ -55,10 +58,12 @@ class EscapeGuard:
         tx = glob[0] - (c * local[0] - s * local[1])
         ty = glob[1] - (c * local[1] + s * local[0])
         grid = self.global_costmap.costmap
+        padding = self.local_costmap.layered.params.footprint_padding
+        body = padded_footprint(self.local_costmap.footprint, -padding)
 
         def lethal_cells(x: float, y: float, yaw: float) -> np.ndarray:
             gx, gy = tx + c * x - s * y, ty + s * x + c * y
-            rows, cols = polygon_cells(grid, footprint_at(self.footprint, gx, gy, yaw + dyaw))
+            rows, cols = polygon_cells(grid, footprint_at(body, gx, gy, yaw + dyaw))
             hit = grid.costs[rows, cols] == LETHAL_OBSTACLE
             return rows[hit] * grid.size_x + cols[hit]
 
@@ -73,7 +78,7 @@ class EscapeGuard:
                     wx = grid.origin_x + (col + 0.5) * grid.resolution
                     wy = grid.origin_y + (row + 0.5) * grid.resolution
                     self.refused = (
-                        f"backing up would put the footprint on a lethal cell of the global "
+                        f"backing up would put the robot on a lethal cell of the global "
                         f"costmap at ({wx:.2f}, {wy:.2f}) in {self.global_costmap.global_frame}"
                     )
                     return True

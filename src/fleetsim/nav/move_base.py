@@ -41,7 +41,7 @@ import numpy as np
 
 from fleetsim.errors import TransformError
 from fleetsim.msgs import geometry_msgs, move_base_msgs, nav_msgs, std_msgs
-from fleetsim.nav.controllers.escape_guard import EscapeGuard
+from fleetsim.nav.controllers.global_guard import GlobalCostmapGuard
 from fleetsim.nav.controllers.trajectory_planner import TrajectoryPlanner
 from fleetsim.nav.costmap.costmap_ros import Costmap2DROS
 from fleetsim.nav.move_base_cycle import PLANNING, PLANNING_R, ExecuteCycle
@@ -146,8 +146,8 @@ class MoveBase(ExecuteCycle, Node):
             f"{where}/{self.controller_name}",
         )
         tp = self.controller
-        if isinstance(tp, TrajectoryPlanner) and tp.params.escape_global_check:
-            tp.escape_guard = EscapeGuard(self.global_costmap, self.local_costmap)
+        if isinstance(tp, TrajectoryPlanner) and tp.params.global_costmap_check:
+            tp.global_guard = GlobalCostmapGuard(self.global_costmap, self.local_costmap)
         self.recoveries = recovery_behaviors(
             p,
             ns,

@@ -343,7 +343,7 @@ def test_escaping_with_alignment_backs_on_rather_than_turn_away_from_the_path(al
 
 
 class _CostmapROS:
-    """What `EscapeGuard` reads of a Costmap2DROS: the grid, its frame, the robot's pose, the
+    """What `GlobalCostmapGuard` reads of a Costmap2DROS: the grid, its frame, the robot's pose, the
     (padded) footprint and its padding."""
 
     def __init__(self, costmap, pose, frame, footprint=None, padding=0.0):
@@ -373,10 +373,11 @@ def _wedged_box_robot():
 
 
 def _escape_with_global_map(lethal_rows=(), lethal_cols=(), lethal_cell=None, padding=0.0):
-    """Run one cycle of the wedged robot with an escape guard on a global costmap whose frame
-    differs from the local one: the robot is at (2.0, -1.0) facing +y there, so backing up
-    moves it toward -y."""
-    from fleetsim.nav.controllers.escape_guard import EscapeGuard
+    """Run one cycle of the wedged robot with the global costmap guard on a global costmap
+    whose frame differs from the local one: the robot is at (2.02, -1.02) facing +y there, so
+    backing up moves it toward -y (its body's rear edge starts at y = -1.32, its sides at
+    x = 1.87 and 2.17)."""
+    from fleetsim.nav.controllers.global_guard import GlobalCostmapGuard
 
     tp = _wedged_box_robot()
     g = Costmap2D(200, 200, 0.05, origin_x=-5.0, origin_y=-5.0)
@@ -387,7 +388,8 @@ def _escape_with_global_map(lethal_rows=(), lethal_cols=(), lethal_cell=None, pa
     if lethal_cell is not None:
         g.costs[lethal_cell] = 254
     local = _CostmapROS(tp.costmap, (1.5, 1.0, 0.0), "odom", tp.footprint, padding)
-    tp.escape_guard = EscapeGuard(_CostmapROS(g, (2.0, -1.0, math.pi / 2), "map"), local)
+    glob = _CostmapROS(g, (2.02, -1.02, math.pi / 2), "map")
+    tp.global_guard = GlobalCostmapGuard(glob, local)
     return tp, tp.compute_velocity_commands((1.5, 1.0, 0.0), (0.0, 0.0, 0.0))
 
 
@@ -395,23 +397,51 @@ def test_the_escape_does_not_back_onto_what_the_global_costmap_knows():
     # nothing behind in either map: a back-up (straight or on a curve, see `_escape_choice`)
     tp, cmd = _escape_with_global_map()
     assert cmd.vx == -0.1 and tp.escaping
-    # a wall 0.05-0.15 m behind the rear edge in the global costmap only (global y -1.45 to
-    # -1.35; the rear edge is at -1.30): every back-up refused, so no valid trajectory, and
-    # the error says why
-    why = r"robot on a lethal cell of the global costmap at \(.*\) in map"
+    # a wall behind the rear edge in the global costmap only (rows 71-72: y -1.45 to -1.35):
+    # every back-up refused, so no valid trajectory, and the error says why
+    why = r"robot on a lethal cell of the global costmap at \(.*, -1\.3[78]\) in map"
     with pytest.raises(NoValidTrajectory, match=why):
         _escape_with_global_map(lethal_rows=(71, 72))
     # the body is what counts, not the padded footprint: padded by 0.1 m, the body's rear edge
-    # is at -1.20 and backs to -1.30, clear of the wall
+    # starts at -1.22 and backs to about -1.32, clear of the wall
     _, cmd = _escape_with_global_map(lethal_rows=(71, 72), padding=0.1)
     assert cmd.vx == -0.1
     # the same wall where the local frame's -x would be without the frames' rotation (global x
-    # 1.55-1.65): not behind the robot, so the escape goes ahead
-    _, cmd = _escape_with_global_map(lethal_cols=(131, 132))
+    # 1.60-1.75): not behind the robot, so the escape goes ahead
+    _, cmd = _escape_with_global_map(lethal_cols=(132, 133, 134))
     assert cmd.vx == -0.1
-    # a lethal cell the footprint covers already (the map a little off): no reason to refuse
-    _, cmd = _escape_with_global_map(lethal_cell=(80, 140))
+    # a lethal cell the body touches already (the map a little off, under its rear edge): no
+    # reason to refuse moving off it
+    _, cmd = _escape_with_global_map(lethal_cell=(73, 140))
     assert cmd.vx == -0.1
+
+
+def test_the_global_costmap_guard_passes_over_a_forward_move_onto_a_known_post():
+    """Open space in the local costmap; a post the global costmap knows 0.2 m ahead of the
+    robot's front, slightly left: the straight move at speed would touch it, so another is
+    taken (the local costmap alone gives the same choice with or without the post)."""
+    from fleetsim.nav.controllers.global_guard import GlobalCostmapGuard
+
+    m = Costmap2D(120, 120, 0.05)
+    box = np.array([[0.3, 0.15], [0.3, -0.15], [-0.3, -0.15], [-0.3, 0.15]])
+    p = TrajectoryPlannerParams(holonomic_robot=False, dwa=False, sim_time=1.5)
+    plan = np.array([[x, 3.0, 0.0] for x in np.arange(3.0, 5.5, 0.05)])
+    cmds = []
+    for post in (False, True):
+        tp = TrajectoryPlanner(m, box, p)
+        tp.set_plan(plan)
+        g = Costmap2D(120, 120, 0.05)
+        if post:
+            g.costs[60:63, 70:72] = 254  # x 3.50-3.60, y 3.00-3.15
+        frame = _CostmapROS(g, (3.0, 3.0, 0.0), "map")
+        tp.global_guard = GlobalCostmapGuard(frame, _CostmapROS(m, (3.0, 3.0, 0.0), "map", box))
+        cmd = tp.compute_velocity_commands((3.0, 3.0, 0.0), (0.3, 0.0, 0.0))
+        cmds.append(cmd)
+        n = int(tp._steps.max())
+        assert not tp.global_guard.refuses(tp.local_plan[:n])
+    assert cmds[0].vx > 0.3 and abs(cmds[0].vtheta) < 0.1  # straight at the goal
+    # another forward move (slower or turning away), whose rollout the guard accepts
+    assert cmds[1].vx > 0.0 and (cmds[1].vx, cmds[1].vtheta) != (cmds[0].vx, cmds[0].vtheta)
 
 
 def test_a_blind_escape_publishes_the_rollout_it_drives():

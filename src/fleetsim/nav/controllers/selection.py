@@ -268,8 +268,8 @@ def _escape_choice(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: floa
     alignment, a look-ahead on an obstacle ties and the end heading against the path's
     direction decides.
 
-    With an escape guard (``escape_global_check``), rollouts it refuses are passed over; -1
-    when it refuses every one."""
+    Rollouts the global costmap guard refuses (`global_guard`) are passed over; -1 when it
+    refuses every one."""
     direction = path_heading(tp, tp._poses[g["escape"].start, 0]) if _aligning(tp) else None
 
     def key(i: int):
@@ -284,23 +284,25 @@ def _escape_choice(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: floa
         size = float(tp.goal_dist.size)
         return (min(ahead, size), abs(_wrap(tp._poses[i, n - 1, 2] - direction)))
 
-    guard = tp.escape_guard.checker() if tp.escape_guard is not None else None
-
-    def refused(i: int) -> bool:
-        return guard is not None and guard(tp._poses[i, : max(int(tp._steps[i]), 1)])
-
     best = g["escape"].start
     best_key = key(best) if costs[best] >= 0 else None
-    if refused(best):
+    if _refused(tp, best):
         best, best_key = -1, None
     raw = tp._in_place_raw
     for k, i in enumerate(range(g["escape_turn"].start, g["escape_turn"].stop)):
         if costs[i] < 0 or -dvth <= raw[k] <= dvth:
             continue
         ki = key(i)
-        if ki is not None and (best_key is None or ki < best_key) and not refused(i):
+        if ki is not None and (best_key is None or ki < best_key) and not _refused(tp, i):
             best, best_key = i, ki
     return best
+
+
+def _refused(tp: TrajectoryPlanner, index: int) -> bool:
+    """Whether the global costmap guard (``global_costmap_check``, `global_guard`) refuses
+    rollout ``index``."""
+    guard = tp.global_guard
+    return guard is not None and guard.refuses(tp._poses[index, : max(int(tp._steps[index]), 1)])
 
 
 def _escape_can_turn(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, pose) -> bool:
@@ -325,9 +327,12 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
     if not tp.escaping:  # the first sample of least legal cost among forward and strafe
         first = costs[g["forward"].start : g["strafe"].stop]
         legal = first >= 0
-        if legal.any():
-            best = g["forward"].start + int(np.argmin(np.where(legal, first, np.inf)))
-            best_cost = costs[best]
+        while legal.any():
+            i = g["forward"].start + int(np.argmin(np.where(legal, first, np.inf)))
+            if not _refused(tp, i):
+                best, best_cost = i, costs[i]
+                break
+            legal[i - g["forward"].start] = False  # the next best, as if this one were illegal
     heading: tuple = (math.inf, 0)  # rotations: (goal distance, step) ahead
     raw = tp._in_place_raw
     direction = path_heading(tp, pose) if _aligning(tp) else None
@@ -347,7 +352,7 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
                 d, step = ahead
                 ahead = (min(d, size), _least_heading_error(tp, i, direction), step)
             free_side = (v < 0 and not tp.stuck_left) or (v > 0 and not tp.stuck_right)
-            if ahead is not None and ahead < heading and free_side:
+            if ahead is not None and ahead < heading and free_side and not _refused(tp, i):
                 best, best_cost = i, costs[i]
                 heading = ahead
     heading_dist = heading[0]
@@ -361,14 +366,14 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
             free_side = (vy > 0 and not tp.stuck_left_strafe) or (
                 vy < 0 and not tp.stuck_right_strafe
             )
-            if ahead is not None and ahead < heading_dist and free_side:
+            if ahead is not None and ahead < heading_dist and free_side and not _refused(tp, i):
                 best, best_cost = i, costs[i]
                 heading_dist = ahead
     if best_cost >= 0:
         _bookkeep(tp, samples[best], pose)
         return tuple(samples[best]), float(best_cost), best
     # back up slowly, even if the map says it is blocked (unless the global costmap knows
-    # better: `escape_guard`)
+    # better: `global_guard`)
     i = _escape_choice(tp, costs, g, dvth)
     if i < 0:
         return (0.0, 0.0, 0.0), -1.0, g["escape"].start

@@ -94,10 +94,10 @@ class TrajectoryPlannerParams:
     escape_reset_theta: float = param(
         math.pi / 4, unit="rad", range=(0.0, None), help="rotation that ends escaping"
     )
-    # fleetsim addition: ROS backs up blind (see `escape_guard`)
-    escape_global_check: bool = param(
+    # fleetsim addition: ROS judges moves on the local costmap alone (see `global_guard`)
+    global_costmap_check: bool = param(
         True,
-        help="refuse an escape that backs the footprint onto a lethal cell of the global "
-        "costmap (false: back up blind, as ROS)",
+        help="refuse a move that puts the robot's body on a lethal cell of the global "
+        "costmap (false: the local costmap alone, as ROS)",
     )
     prune_plan: bool = param(True, help="drop plan points more than 1 m behind the robot")

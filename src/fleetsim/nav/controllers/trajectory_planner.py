@@ -113,8 +113,8 @@ class TrajectoryPlanner(LocalPlanner):
         self.escaping = False
         self.prev = (0.0, 0.0)
         self.escape_pose = (0.0, 0.0, 0.0)
-        #: an `EscapeGuard` (move_base sets it with ``escape_global_check``), or None
-        self.escape_guard = None
+        #: a `GlobalCostmapGuard` (move_base sets it with ``global_costmap_check``), or None
+        self.global_guard = None
 
     @classmethod
     def from_namespace(
@@ -196,8 +196,8 @@ class TrajectoryPlanner(LocalPlanner):
         if cost < 0:
             self.local_plan = np.zeros((0, 3))
             why = "the footprint collides or leaves the local map on every sample"
-            if self.escape_guard is not None and self.escape_guard.refused:
-                why += f"; {self.escape_guard.refused}"
+            if self.global_guard is not None and self.global_guard.refused:
+                why += f"; {self.global_guard.refused}"
             raise NoValidTrajectory(
                 f"TrajectoryPlannerROS: no valid trajectory from ({x:.2f}, {y:.2f}, yaw "
                 f"{yaw:.2f}): {why}"
@@ -337,8 +337,8 @@ class TrajectoryPlanner(LocalPlanner):
         raise NoValidTrajectory("TrajectoryPlannerROS: cannot rotate to the goal yaw in place")
 
     def _find_best(self, pose, vel) -> tuple[tuple[float, float, float], float]:
-        if self.escape_guard is not None:
-            self.escape_guard.refused = ""
+        if self.global_guard is not None:
+            self.global_guard.begin_cycle()
         (vx, vy, vth), cost, index = choose_trajectory(self, pose, vel)
         self.local_plan = self._poses[index, : max(int(self._steps[index]), 0)].copy()
         if cost < 0:

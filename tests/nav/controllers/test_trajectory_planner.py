@@ -372,7 +372,9 @@ def _wedged_box_robot():
     return tp
 
 
-def _escape_with_global_map(lethal_rows=(), lethal_cols=(), lethal_cell=None, padding=0.0):
+def _escape_with_global_map(
+    lethal_rows=(), lethal_cols=(), lethal_cell=None, padding=0.0, local_wall=False
+):
     """Run one cycle of the wedged robot with the global costmap guard on a global costmap
     whose frame differs from the local one: the robot is at (2.02, -1.02) facing +y there, so
     backing up moves it toward -y (its body's rear edge starts at y = -1.32, its sides at
@@ -380,6 +382,8 @@ def _escape_with_global_map(lethal_rows=(), lethal_cols=(), lethal_cell=None, pa
     from fleetsim.nav.controllers.global_guard import GlobalCostmapGuard
 
     tp = _wedged_box_robot()
+    if local_wall:  # the global rows 71-72 in the local costmap (local x 1.07-1.17)
+        tp.costmap.costs[:, 21:24] = 254
     g = Costmap2D(200, 200, 0.05, origin_x=-5.0, origin_y=-5.0)
     for r in lethal_rows:
         g.costs[r, :] = 254
@@ -402,6 +406,9 @@ def test_the_escape_does_not_back_onto_what_the_global_costmap_knows():
     why = r"robot on a lethal cell of the global costmap at \(.*, -1\.3[78]\) in map"
     with pytest.raises(NoValidTrajectory, match=why):
         _escape_with_global_map(lethal_rows=(71, 72))
+    # a wall the local costmap holds too is the planner's to judge: ROS's blind escape
+    _, cmd = _escape_with_global_map(lethal_rows=(71, 72), local_wall=True)
+    assert cmd.vx == -0.1
     # the body is what counts, not the padded footprint: padded by 0.1 m, the body's rear edge
     # starts at -1.22 and backs to about -1.32, clear of the wall
     _, cmd = _escape_with_global_map(lethal_rows=(71, 72), padding=0.1)

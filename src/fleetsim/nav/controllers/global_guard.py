@@ -11,13 +11,16 @@ behind it and, turning out of a door, brushed the door's post beside it: both in
 map all along (held-out seed 6).
 
 With ``global_costmap_check`` (default true) the trajectory chosen each cycle is refused when
-it puts the robot's body (the footprint without ``footprint_padding``) on a lethal cell of
-the global costmap that the body does not touch at the rollout's start (cells it touches
-already are where the robot stands: refusing those would pin a robot the map shows a little
-off), and the next best is taken in base_local_planner's order; with all refused the planner
-has no valid trajectory and move_base's recoveries take over, as for any robot with no legal
-move. The body, not the padded footprint: the padding keeps plans away from obstacles, but a
-robot wedged within its padding of a desk has to get closer to something to get out (with
+it puts the robot's body (the footprint without ``footprint_padding``) on a lethal cell of the
+global costmap that the body does not touch at the rollout's start (cells it touches already
+are where the robot stands: refusing those would pin a robot the map shows a little off) and
+that the local costmap does not hold (no lethal cell there or beside it: what the local costmap
+holds the planner has judged already, by ROS's rules, blind escape included; in BARN's clutter,
+where the jackal's local costmap holds every post, refusing those escapes too aborted worlds
+117 and 123), and the next best is taken in base_local_planner's order; with all refused the
+planner has no valid trajectory and move_base's recoveries take over, as for any robot with no
+legal move. The body, not the padded footprint: the padding keeps plans away from obstacles,
+but a robot wedged within its padding of a desk has to get closer to something to get out (with
 the padded footprint a hunter was pinned by a desk for 900 s, office seed 6). ``false`` is
 ROS's planner.
 """
@@ -92,12 +95,16 @@ class GlobalCostmapGuard:
         frames = self._frames()
         if frames is None:
             return False
-        grid = self.global_costmap.costmap
+        grid, local = self.global_costmap.costmap, self.local_costmap.costmap
         k, cell = _new_lethal_cell(
             grid.costs,
             grid.origin_x,
             grid.origin_y,
             grid.resolution,
+            local.costs,
+            local.origin_x,
+            local.origin_y,
+            local.resolution,
             self._body_outline(grid.resolution),
             np.ascontiguousarray(poses, dtype=np.float64),
             *frames,
@@ -115,11 +122,30 @@ class GlobalCostmapGuard:
 
 
 @njit(cache=True)
-def _new_lethal_cell(costs, ox, oy, res, outline, poses, c, s, tx, ty, dyaw):
-    """(index of the first pose whose outline lies on a lethal cell that the first pose's does
-    not, that cell's flat index), or (-1, -1). Poses are moved into the grid's frame by the
-    rotation (c, s) = (cos dyaw, sin dyaw) and the translation (tx, ty). Compiled: it runs on
-    the chosen rollout of every control cycle."""
+def _lethal_near(costs, ox, oy, res, x, y):
+    """Whether the cell at (x, y) or one of its 8 neighbours is lethal (off the grid: no)."""
+    h, w = costs.shape
+    cx = math.floor((x - ox) / res)
+    cy = math.floor((y - oy) / res)
+    for j in range(max(cy - 1, 0), min(cy + 2, h)):
+        for i in range(max(cx - 1, 0), min(cx + 2, w)):
+            if costs[j, i] == LETHAL_OBSTACLE:
+                return True
+    return False
+
+
+@njit(cache=True)
+def _new_lethal_cell(costs, ox, oy, res, local, lox, loy, lres, outline, poses, c, s, tx, ty, dyaw):
+    """(index of the first pose whose outline lies on a lethal global cell that the first
+    pose's does not, and that the local costmap has no lethal cell at or beside; that cell's
+    flat index), or (-1, -1).
+
+    Poses are in the local costmap's frame and moved into the global one by the rotation
+    (c, s) = (cos dyaw, sin dyaw) and the translation (tx, ty). What the local costmap knows
+    (a lethal cell within a cell, the frames being a SLAM correction apart) the planner has
+    judged already, by base_local_planner's rules, blind escape included; the guard adds only
+    what the global costmap remembers and the local one does not. Compiled: it runs on the
+    chosen rollout of every control cycle."""
     h, w = costs.shape
     start = np.empty(outline.shape[0], np.int64)
     n_start = 0
@@ -127,11 +153,13 @@ def _new_lethal_cell(costs, ox, oy, res, outline, poses, c, s, tx, ty, dyaw):
         x, y = poses[k, 0], poses[k, 1]
         gx = tx + c * x - s * y
         gy = ty + s * x + c * y
-        ct = math.cos(poses[k, 2] + dyaw)
-        st = math.sin(poses[k, 2] + dyaw)
+        ct = math.cos(poses[k, 2])
+        st = math.sin(poses[k, 2])
+        gct = c * ct - s * st  # cos and sin of the heading in the global frame
+        gst = s * ct + c * st
         for j in range(outline.shape[0]):
-            px = gx + ct * outline[j, 0] - st * outline[j, 1]
-            py = gy + st * outline[j, 0] + ct * outline[j, 1]
+            px = gx + gct * outline[j, 0] - gst * outline[j, 1]
+            py = gy + gst * outline[j, 0] + gct * outline[j, 1]
             cx = math.floor((px - ox) / res)
             cy = math.floor((py - oy) / res)
             if cx < 0 or cy < 0 or cx >= w or cy >= h or costs[cy, cx] != LETHAL_OBSTACLE:
@@ -146,6 +174,10 @@ def _new_lethal_cell(costs, ox, oy, res, outline, poses, c, s, tx, ty, dyaw):
                 if start[q] == cell:
                     known = True
                     break
-            if not known:
+            if known:
+                continue
+            lx = x + ct * outline[j, 0] - st * outline[j, 1]
+            ly = y + st * outline[j, 0] + ct * outline[j, 1]
+            if not _lethal_near(local, lox, loy, lres, lx, ly):
                 return k, cell
     return -1, -1

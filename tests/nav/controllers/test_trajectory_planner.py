@@ -444,8 +444,6 @@ def test_the_global_costmap_guard_passes_over_a_forward_move_onto_a_known_post()
         tp.global_guard = GlobalCostmapGuard(frame, _CostmapROS(m, (3.0, 3.0, 0.0), "map", box))
         cmd = tp.compute_velocity_commands((3.0, 3.0, 0.0), (0.3, 0.0, 0.0))
         cmds.append(cmd)
-        n = int(tp._steps.max())
-        assert not tp.global_guard.refuses(tp.local_plan[:n])
     assert cmds[0].vx > 0.3 and abs(cmds[0].vtheta) < 0.1  # straight at the goal
     # another forward move (slower or turning away), whose rollout the guard accepts
     assert cmds[1].vx > 0.0 and (cmds[1].vx, cmds[1].vtheta) != (cmds[0].vx, cmds[0].vtheta)

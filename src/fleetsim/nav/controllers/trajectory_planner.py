@@ -267,6 +267,7 @@ class TrajectoryPlanner(LocalPlanner):
         )
         self._poses = np.empty((samples.shape[0], int(steps.max()), 3))
         self._steps = steps
+        self._samples = samples
         return trajectory_costs(
             samples,
             np.asarray(pose, dtype=np.float64),

@@ -148,3 +148,46 @@ def test_marking_points_match_the_numpy_filter_bit_for_bit():
         cells, inside = g.cells_of(want[:, :2])
         assert np.array_equal(got_pts.view(np.uint64), want[inside].view(np.uint64))
         assert np.array_equal(got_cells, cells[inside]) and got_cells.dtype == np.int64
+
+
+def test_clearing_matches_the_step_by_step_rays_bit_for_bit():
+    """`clear_along_rays` (one compiled pass) clears the cells that clipping the ends, taking
+    their cells and tracing the rays one step after another cleared: ends off the map on every
+    side, beyond raytrace_range, at the sensor."""
+    from fleetsim.nav.costmap.costmap_2d import Costmap2D
+    from fleetsim.nav.costmap.raytrace import clear_along_rays, ray_ends_clipped
+
+    rng = np.random.default_rng(8)
+    for _ in range(100):
+        g = Costmap2D(int(rng.integers(5, 90)), int(rng.integers(5, 90)), 0.05, -1.3, 0.7)
+        g.costs[:] = LETHAL_OBSTACLE
+        want = g.costs.copy()
+        lo = np.array(g.origin)
+        hi = lo + np.array([g.size_x, g.size_y]) * g.resolution
+        origin = np.r_[lo + rng.uniform(0.0, 1.0, 2) * (hi - lo), 0.3]
+        n = int(rng.integers(0, 400))
+        points = np.c_[origin[:2] + rng.uniform(-6.0, 6.0, (n, 2)), np.zeros(n)]
+        points = np.concatenate([points, [origin]])  # a zero-length ray
+        start = g.world_to_map(origin[0], origin[1])
+        ends = ray_ends_clipped(origin, points, lo, hi)
+        cells, inside = g.cells_of(ends)
+        trace_rays(want, start[0], start[1], np.ascontiguousarray(cells[inside]), 40, FREE_SPACE)
+        clear_along_rays(
+            g.costs, origin[0], origin[1], points, lo[0], lo[1], hi[0], hi[1], g.resolution,
+            start[0], start[1], 40, FREE_SPACE,
+        )  # fmt: skip
+        assert np.array_equal(g.costs, want)
+
+
+def test_height_band_keeps_the_numpy_selection():
+    from fleetsim.nav.costmap.obstacle_layer import _in_height_band
+
+    rng = np.random.default_rng(10)
+    for _ in range(50):
+        pts = rng.uniform(-1.0, 3.0, (int(rng.integers(0, 300)), 3))
+        pts[rng.random(pts.shape[0]) < 0.1, 2] = np.nan
+        pts[rng.random(pts.shape[0]) < 0.1, 2] = 2.0  # on the band's edge
+        want = pts[(pts[:, 2] <= 2.0) & (pts[:, 2] >= 0.0)]
+        got = _in_height_band(pts, 0.0, 2.0)
+        assert np.array_equal(got.view(np.uint64), want.view(np.uint64))
+        assert got.flags.c_contiguous

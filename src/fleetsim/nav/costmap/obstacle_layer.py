@@ -21,7 +21,7 @@ from numba import njit
 from fleetsim.nav.costmap.costmap_2d import FREE_SPACE, LETHAL_OBSTACLE, NO_INFORMATION
 from fleetsim.nav.costmap.footprint import footprint_at, polygon_cells
 from fleetsim.nav.costmap.layer import Bounds, CostmapLayer
-from fleetsim.nav.costmap.raytrace import ray_ends_clipped, trace_rays
+from fleetsim.nav.costmap.raytrace import clear_along_rays
 from fleetsim.nav.errors import CostmapError
 from fleetsim.runtime import load_params, param
 
@@ -148,8 +148,7 @@ class ObservationBuffer:
         pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         o = np.asarray(origin, dtype=np.float64).reshape(3)
         p = self.params
-        z = pts[:, 2]
-        pts = pts[(z <= p.max_obstacle_height) & (z >= p.min_obstacle_height)]
+        pts = _in_height_band(pts, float(p.min_obstacle_height), float(p.max_obstacle_height))
         obs = Observation(o, pts, p.obstacle_range, p.raytrace_range, stamp)
         if p.observation_persistence <= 0.0:
             self.observations = [obs]
@@ -287,20 +286,14 @@ class ObstacleLayer(CostmapLayer):
             return
         if obs.points.shape[0] == 0:
             return
-        lo = np.array(g.origin)
-        hi = lo + np.array([g.size_x, g.size_y]) * g.resolution
-        ends = ray_ends_clipped(obs.origin, obs.points, lo, hi)
-        cells, inside = g.cells_of(ends)
-        trace_rays(
-            g.costs,
-            start[0],
-            start[1],
-            np.ascontiguousarray(cells[inside]),
-            g.cell_distance(obs.raytrace_range),
-            FREE_SPACE,
-        )
+        lo = (g.origin_x, g.origin_y)
+        hi = (g.origin_x + g.size_x * g.resolution, g.origin_y + g.size_y * g.resolution)
+        ox, oy = float(obs.origin[0]), float(obs.origin[1])
+        clear_along_rays(
+            g.costs, ox, oy, obs.points, lo[0], lo[1], hi[0], hi[1], g.resolution,
+            start[0], start[1], g.cell_distance(obs.raytrace_range), FREE_SPACE,
+        )  # fmt: skip
         r = obs.raytrace_range
-        ox, oy = obs.origin[0], obs.origin[1]
         bounds.include(
             max(ox - r, lo[0]), max(oy - r, lo[1]), min(ox + r, hi[0]), min(oy + r, hi[1])
         )
@@ -344,3 +337,24 @@ def _marking(pts, origin, max_height, range2, ox, oy, res, size_x, size_y):
     for k in range(n):
         out[k] = pts[keep[k]]
     return out, cells[:n].copy()
+
+
+@njit(cache=True)
+def _in_height_band(pts, lo, hi):
+    """The points (N, 3) with ``lo <= z <= hi``, in order (a copy), compiled: every reading
+    of every robot's costmaps passes here."""
+    keep = np.empty(pts.shape[0], np.bool_)
+    n = 0
+    for i in range(pts.shape[0]):
+        z = pts[i, 2]
+        keep[i] = z <= hi and z >= lo
+        n += keep[i]
+    out = np.empty((n, 3))
+    k = 0
+    for i in range(pts.shape[0]):
+        if keep[i]:
+            out[k, 0] = pts[i, 0]
+            out[k, 1] = pts[i, 1]
+            out[k, 2] = pts[i, 2]
+            k += 1
+    return out

@@ -90,6 +90,47 @@ def test_latched_topic_reaches_late_subscribers():
     assert got == [7]
 
 
+def test_lazy_publish_builds_only_for_a_reader():
+    """`publish_lazily`: nothing built without a subscription; a latched one is built when a
+    subscription comes (the message of the last call, not of an earlier one); with a
+    subscription it is published as `publish` would."""
+    rt = Runtime()
+    n = Node(rt, "costmap")
+    built = []
+
+    def make(v):
+        return lambda: (built.append(v), Num(v))[1]
+
+    latched = n.create_publisher(Num, "grid", latch=True)
+    plain = n.create_publisher(Num, "footprint")
+    for v in (1, 2, 3):
+        latched.publish_lazily(make(v))
+        plain.publish_lazily(make(10 + v))
+    rt.spin_once()
+    assert built == []
+    got = []
+    n.create_subscription(Num, "grid", lambda m: got.append(m.data))
+    n.create_subscription(Num, "footprint", lambda m: got.append(m.data))
+    rt.spin_once()
+    assert got == [3] and built == [3]  # the plain topic had nothing to hand over
+    latched.publish_lazily(make(4))
+    plain.publish_lazily(make(14))
+    rt.spin_once()
+    assert got == [3, 4, 14] and built == [3, 4, 14]
+    assert latched.last.data == 4
+    latched.publish(Num(5))
+    assert latched.last.data == 5
+
+
+def test_lazy_publish_checks_the_type_when_built():
+    rt = Runtime()
+    n = Node(rt, "n")
+    pub = n.create_publisher(Num, "a", latch=True)
+    pub.publish_lazily(lambda: "not a Num")
+    with pytest.raises(GraphError, match="carries"):
+        _ = pub.last
+
+
 def test_delivery_order_is_fifo_across_subscriptions():
     rt = Runtime()
     n = Node(rt, "n")

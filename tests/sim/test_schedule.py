@@ -7,7 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from fleetsim.sim.plugins.base import Plugin
-from fleetsim.sim.schedule import SensorSchedule, due_times_advanced
+from fleetsim.sim.schedule import SensorSchedule, _advanced, due_times_advanced
 
 
 def due_time_reference(due: float, period: float, t: float) -> tuple[bool, float]:
@@ -39,6 +39,9 @@ def test_due_times_follow_the_one_plugin_rule(plugins, t):
     idx = due_times_advanced(due_at, period, t)
     assert idx.tolist() == [i for i, (due, _) in enumerate(want) if due]
     assert due_at.tolist() == [nxt for _, nxt in want]  # bit-identical
+    again = due_at.copy()
+    idx, earliest = _advanced(again, period, t)  # what the schedule calls: also the next due
+    assert earliest == min(again.tolist())
 
 
 class Named(Plugin):

@@ -123,6 +123,22 @@ def test_interpolates_linearly_and_by_slerp_between_bracketing_stamps():
     assert buf.lookup_tuple("odom", "base", 2.0)[:3] == (1.0, 2.0, 0.0)
 
 
+def test_latest_common_time_follows_the_tree_when_its_edges_change():
+    """The frame path kept between asks is dropped when an edge moves or the buffer clears:
+    the latest time is the new chain's."""
+    buf = Buffer()
+    buf.set_transform(msg("map", "odom", 3.0))
+    buf.set_transform(msg("odom", "base", 5.0))
+    buf.set_transform(msg("map", "other", 1.0))
+    assert buf.latest_common_time("map", "base") == pytest.approx(3.0)
+    assert buf.latest_common_time("map", "base") == pytest.approx(3.0)  # kept path
+    buf.set_transform(msg("other", "odom", 2.0))  # odom moves under other (at 1.0)
+    assert buf.latest_common_time("map", "base") == pytest.approx(1.0)
+    buf.clear()
+    with pytest.raises(ConnectivityError):
+        buf.latest_common_time("map", "base")
+
+
 def test_time_zero_uses_the_latest_common_time_and_static_edges_do_not_limit_it():
     buf = robot_buffer()
     assert buf.latest_common_time("map", "lizi1/laser_link") == pytest.approx(5.0)

@@ -192,14 +192,20 @@ class FakeLocalization(Node):
         self.tf_pub.send_transform(
             make_transform_stamped(self.global_frame, self.odom_frame, future, mo[:3], mo[3:])
         )
-        header = std_msgs.Header(stamp=stamp, frame_id=self.global_frame)
-        pose = _pose_msg(mb)
-        self.pose_pub.publish(
-            geometry_msgs.PoseWithCovarianceStamped(
-                header=header, pose=geometry_msgs.PoseWithCovariance(pose=pose)
+        # built only for a reader (nobody subscribes in a fleet's stack; both are latched, so a
+        # later subscription gets these)
+        frame = self.global_frame
+        self.pose_pub.publish_lazily(
+            lambda: geometry_msgs.PoseWithCovarianceStamped(
+                header=std_msgs.Header(stamp=stamp, frame_id=frame),
+                pose=geometry_msgs.PoseWithCovariance(pose=_pose_msg(mb)),
             )
         )
-        self.cloud_pub.publish(geometry_msgs.PoseArray(header=header, poses=[pose]))
+        self.cloud_pub.publish_lazily(
+            lambda: geometry_msgs.PoseArray(
+                header=std_msgs.Header(stamp=stamp, frame_id=frame), poses=[_pose_msg(mb)]
+            )
+        )
         return True
 
     def _newest_odom_time(self) -> float | None:

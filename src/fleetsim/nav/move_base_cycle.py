@@ -60,7 +60,9 @@ class ExecuteCycle:
             self.last_valid_plan = now
             self.planning_retries = 0
             self.new_plan = path
-            self.plan_pub.publish(path_msg(path, self.global_frame, self.now_msg()))
+            # the Path (a PoseStamped per cell, ~1 ms for a long plan) only for a subscriber
+            frame, stamp = self.global_frame, self.now_msg()
+            self.plan_pub.publish_lazily(lambda: path_msg(path, frame, stamp))
             if self.run_planner:
                 self.state = CONTROLLING
             if p.planner_frequency <= 0:

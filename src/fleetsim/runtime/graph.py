@@ -7,7 +7,8 @@ FIFO after every callback, so which callback runs next depends only on the order
 never on the wall clock. A message is shared by reference with every subscriber.
 
 Latched publishers keep their last message and hand it to subscriptions made later, the way
-``map`` and ``/tf_static`` behave in ROS 1.
+``map`` and ``/tf_static`` behave in ROS 1. `Publisher.publish_lazily` builds a message only
+for someone to read it: a latched one nobody subscribes to is built when a subscription comes.
 
 Topics and services may also have remote ends (the Zenoh bridge): `Graph.listeners` are told of
 every new publisher, subscription and service, and a bridge registers itself as an ordinary
@@ -89,28 +90,56 @@ class Subscription:
 class Publisher:
     """Publishes messages of one type on one topic."""
 
-    __slots__ = ("graph", "last", "latch", "msg_type", "node", "topic")
+    __slots__ = ("_last", "_make_last", "graph", "latch", "msg_type", "node", "topic")
 
     def __init__(self, graph: Graph, topic: Topic, latch: bool, node) -> None:
         self.graph = graph
         self.topic = topic
         self.msg_type = topic.type
         self.latch = latch
-        self.last: Any = None
+        self._last: Any = None
+        self._make_last: Callable[[], Any] | None = None
         self.node = node
 
     @property
     def name(self) -> str:
         return self.topic.name
 
-    def publish(self, msg: Any) -> None:
+    @property
+    def last(self) -> Any:
+        """The latched message (None: none yet, or not latched); one `publish_lazily` kept
+        unbuilt is built now."""
+        make = self._make_last
+        if make is not None:
+            self._make_last = None
+            self._last = self._checked(make())
+        return self._last
+
+    def _checked(self, msg: Any) -> Any:
         if type(msg) is not self.msg_type and message_class(msg) is not self.msg_type:
             raise GraphError(
                 f"topic {self.topic.name} carries {_type_name(self.msg_type)}, "
                 f"cannot publish {_type_name(type(msg))}"
             )
+        return msg
+
+    def publish_lazily(self, make: Callable[[], Any]) -> None:
+        """Publish ``make()``, built only for someone to read: with no subscription nothing is
+        built, and a latched publisher keeps ``make`` for a later subscription (or a reader of
+        `last`), which then gets the message as it would have been published now. ``make``
+        must not depend on state that changes after this call (copy what it reads)."""
+        if self.topic.subscriptions:
+            self.publish(make())
+        elif self.latch:
+            self._last = None
+            self._make_last = make
+
+    def publish(self, msg: Any) -> None:
+        if type(msg) is not self.msg_type and message_class(msg) is not self.msg_type:
+            self._checked(msg)
         if self.latch:
-            self.last = msg
+            self._last = msg
+            self._make_last = None
         pending = self.graph._pending
         if self.topic.with_publisher:
             for sub in self.topic.subscriptions:

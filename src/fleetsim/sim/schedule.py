@@ -18,6 +18,7 @@ from __future__ import annotations
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from fleetsim.sim.plugins import base
 
@@ -59,12 +60,27 @@ def due_times_advanced(due_at: np.ndarray, period: np.ndarray, t: float) -> np.n
     time is one period after the previous one (phase kept), or one period after ``t`` when
     that has already passed or the plugin never fired.
     """
-    idx = np.flatnonzero(t + 1e-9 >= due_at)
-    if len(idx):
-        before, per = due_at[idx], period[idx]
-        nxt = np.where(before > 0, before + per, t + per)
-        due_at[idx] = np.where(nxt <= t + 1e-9, t + per, nxt)
-    return idx
+    return _advanced(due_at, period, float(t))[0]
+
+
+@njit(cache=True)
+def _advanced(due_at, period, t):
+    """`due_times_advanced` and the earliest due time after it (inf for no plugin), compiled:
+    the simulator asks at every physics step something falls due (NumPy's half-dozen calls
+    cost ~10 us a step)."""
+    idx = np.empty(due_at.shape[0], np.int64)
+    k = 0
+    earliest = np.inf
+    for i in range(due_at.shape[0]):
+        if t + 1e-9 >= due_at[i]:
+            before, per = due_at[i], period[i]
+            nxt = before + per if before > 0 else t + per
+            due_at[i] = t + per if nxt <= t + 1e-9 else nxt
+            idx[k] = i
+            k += 1
+        if due_at[i] < earliest:
+            earliest = due_at[i]
+    return idx[:k].copy(), earliest
 
 
 class SensorSchedule:
@@ -105,8 +121,7 @@ class SensorSchedule:
     def readings(self, engine, t: float) -> list[Any]:
         """Readings of the plugins due at ``t``: one-by-one and ``measure_each`` ones in model
         order, then ``measure_batch`` classes in order of their first due plugin, then lasers."""
-        idx = due_times_advanced(self.due_at, self.period, t)
-        self.next = float(self.due_at.min()) if len(self.due_at) else np.inf
+        idx, self.next = _advanced(self.due_at, self.period, float(t))
         if not len(idx):
             return []
         due = np.zeros(len(self.plugins), bool)

@@ -315,18 +315,24 @@ class Buffer(TreeIntrospection):
 
         ``0.0`` when the chain holds only static transforms (or the frames are the same).
         """
-        down, up = self._chain(target_frame, source_frame)
+        down, up = self._path(target_frame, source_frame)
         return self._latest_ns(down, up) * 1e-9
+
+    def _path(
+        self, target_frame: str, source_frame: str
+    ) -> tuple[list[FrameCache], list[FrameCache]]:
+        """`_chain`, kept per frame pair while the tree's edges stay as they were (every
+        costmap's robot pose asks for its pose and then its latest time, several times a
+        cycle)."""
+        entry = self._paths.get((target_frame, source_frame))
+        if entry is not None and entry[0] == self._version:
+            return entry[1], entry[2]
+        return self._chain(target_frame, source_frame)
 
     def _lookup(
         self, target_frame: str, source_frame: str, time: Any
     ) -> tuple[int, Transform7, str, str]:
-        entry = self._paths.get((target_frame, source_frame))
-        if entry is not None and entry[0] == self._version:
-            down = entry[1]
-            up = entry[2]
-        else:
-            down, up = self._chain(target_frame, source_frame)
+        down, up = self._path(target_frame, source_frame)
         t_ns = 0 if time is None else ns_from_time(time)
         if t_ns == 0:
             t_ns = self._latest_ns(down, up)

@@ -1,5 +1,7 @@
 """Rollout kernels: the footprint bound map and the footprint skip against brute force."""
 
+import math
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -137,6 +139,85 @@ def test_skipping_footprints_changes_no_cost(seed):
             x, y, th = poses_a[i, k]
             assert footprint_cost_at(costs, origin[0], origin[1], res, outline, x, y, th) >= 0
     assert seen >= {-1.0, 1.0}  # both collisions and legal rollouts were compared
+
+
+def rollout_reference(samples, pose, vel, acc, sim_time, steps, costs, origin, res, outline, dist):
+    """generateTrajectory in plain Python, the footprint laid and the heading's cosine and
+    sine taken at every pose (vy = 0, no heading scoring, no alignment)."""
+    h, w = costs.shape
+    out, poses = np.empty(samples.shape[0]), np.zeros((samples.shape[0], int(steps.max()), 3))
+
+    def toward(vg, vi, a, dt):
+        return min(vg, vi + a * dt) if vg - vi >= 0 else max(vg, vi - a * dt)
+
+    for s in range(samples.shape[0]):
+        n = int(steps[s])
+        dt = sim_time / n
+        x, y, th = (float(v) for v in pose)
+        vx, vth = float(vel[0]), float(vel[2])
+        occ = path_d = goal_d = 0.0
+        cost = 0.0
+        for i in range(n):
+            fx, fy = (x - origin[0]) / res, (y - origin[1]) / res
+            if cost < 0.0:
+                pass  # found illegal: followed to its end, unscored
+            elif fx < 0.0 or fy < 0.0 or fx >= w or fy >= h:
+                cost = -1.0
+            else:
+                cx, cy = int(fx), int(fy)
+                occ = max(occ, float(costs[cy, cx]))
+                fp = footprint_cost_at(costs, origin[0], origin[1], res, outline, x, y, th)
+                if fp < 0.0:
+                    cost = -1.0
+                else:
+                    occ = max(occ, fp)
+                    path_d = goal_d = dist[cy, cx]
+            poses[s, i] = x, y, th
+            vx = toward(samples[s, 0], vx, acc[0], dt)
+            vth = toward(samples[s, 2], vth, acc[2], dt)
+            x = x + vx * math.cos(th) * dt
+            y = y + vx * math.sin(th) * dt
+            th = th + vth * dt
+        out[s] = cost if cost < 0.0 else 0.6 * path_d + 0.8 * goal_d + 0.01 * occ
+    return out, poses
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_rollouts_match_a_plain_reference_bit_for_bit(seed):
+    """The kernel's shortcuts (the first pose's footprint laid once, a heading's cosine and
+    sine kept while it does not change, no motion at rest, footprints skipped under the
+    bounds) give the costs and poses of the plain rollout exactly: rotations in place from
+    rest and from motion, straight rollouts, turning ones."""
+    rng = np.random.default_rng(seed)
+    costs = random_map(rng)
+    res, origin = 0.05, np.array([-0.5, 0.25])
+    outline = outline_points(footprint_from_radius(0.15), res)
+    vx = np.r_[np.zeros(20), rng.uniform(0.1, 0.8, 60), np.full(20, 0.4), -0.1]
+    vth = np.r_[rng.uniform(-1.0, 1.0, 80), np.zeros(20), 0.0]
+    samples = np.stack([vx, np.zeros(vx.shape[0]), vth], axis=1)
+    steps = num_steps_of(samples, 1.5, 0.025, 0.025, False)
+    dist = rng.integers(0, 50, costs.shape).astype(np.float64)
+    bounds = footprint_cost_bounds(costs, reach_offsets(outline, res))
+    compared = 0
+    for vel in ([0.0, 0.0, 0.0], [0.3, 0.0, 0.0], [0.2, 0.0, -0.4]):
+        pose = np.array([origin[0] + 0.5, origin[1] + 0.5, rng.uniform(-3.0, 3.0)])
+        while footprint_cost_at(costs, origin[0], origin[1], res, outline, *pose) < 0:
+            pose[:2] = origin + rng.uniform(0.3, 3.0, 2)
+        vel = np.array(vel)
+        acc = np.array([2.5, 2.5, 3.2])
+        poses = np.zeros((samples.shape[0], int(steps.max()), 3))
+        got = trajectory_costs(
+            samples, pose, vel, acc, 1.5, steps, costs, origin, res, outline, dist, dist,
+            np.array([0.6, 0.8, 0.01]), np.array([0.0, 0.8]), np.zeros((0, 2), np.int64), False,
+            np.zeros(2), poses, bounds, np.zeros(2),
+        )  # fmt: skip
+        want, want_poses = rollout_reference(
+            samples, pose, vel, acc, 1.5, steps, costs, origin, res, outline, dist
+        )
+        assert np.array_equal(got, want)
+        assert np.array_equal(poses.view(np.uint64), want_poses.view(np.uint64))
+        compared += int((got >= 0).sum())
+    assert compared > 0  # legal rollouts were compared, not only collisions
 
 
 def test_densified_plan_matches_per_segment_reference():

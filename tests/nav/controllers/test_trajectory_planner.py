@@ -459,3 +459,78 @@ def test_a_blind_escape_publishes_the_rollout_it_drives():
     plan = tp.local_plan
     assert plan.shape[0] >= 3 and np.isfinite(plan).all()
     assert plan[0, 0] == 1.5 and np.all(np.diff(plan[:, 0]) < 0) and plan[-1, 0] < 1.45
+
+
+def velocity_samples_reference(tp, pose, vel):
+    """The sample table as NumPy built it before it was compiled (createTrajectories' order)."""
+    p = tp.params
+    max_vx = p.max_vel_x
+    if tp.plan.shape[0]:
+        gx, gy = tp.plan[-1, 0], tp.plan[-1, 1]
+        max_vx = min(max_vx, math.hypot(gx - pose[0], gy - pose[1]) / p.sim_time)
+    window = tp.sim_period if p.dwa else p.sim_time
+    max_vx = max(min(max_vx, vel[0] + p.acc_lim_x * window), p.min_vel_x)
+    min_vx = max(p.min_vel_x, vel[0] - p.acc_lim_x * window)
+    max_vth = min(p.max_vel_theta, vel[2] + p.acc_lim_theta * window)
+    min_vth = max(p.min_vel_theta, vel[2] - p.acc_lim_theta * window)
+    dvx = (max_vx - min_vx) / (p.vx_samples - 1) if p.vx_samples > 1 else 0.0
+    dvth = (max_vth - min_vth) / (p.vtheta_samples - 1) if p.vtheta_samples > 1 else 0.0
+    vxs = min_vx + np.arange(p.vx_samples) * dvx
+    vths = min_vth + np.arange(p.vtheta_samples) * dvth
+    forward = np.zeros((p.vx_samples, p.vtheta_samples, 3))
+    forward[:, :, 0] = vxs[:, None]
+    forward[:, 1:, 2] = vths[None, :-1]
+    parts = [forward.reshape(-1, 3)]
+    if p.holonomic_robot:
+        parts.append(np.array([[0.1, 0.1, 0.0], [0.1, -0.1, 0.0]]))
+    in_place_vths, in_place_dvth = vths, dvth
+    if p.dwa:
+        lo = max(p.min_vel_theta, vel[2] - p.acc_lim_theta * p.sim_time)
+        hi = min(p.max_vel_theta, vel[2] + p.acc_lim_theta * p.sim_time)
+        in_place_dvth = (hi - lo) / (p.vtheta_samples - 1) if p.vtheta_samples > 1 else 0.0
+        in_place_vths = lo + np.arange(p.vtheta_samples) * in_place_dvth
+    in_place = np.zeros((p.vtheta_samples, 3))
+    mn = p.min_in_place_vel_theta
+    in_place[:, 2] = np.where(
+        in_place_vths > 0, np.maximum(in_place_vths, mn), np.minimum(in_place_vths, -mn)
+    )
+    parts.append(in_place)
+    if p.holonomic_robot:
+        sideways = np.zeros((len(p.y_vels), 3))
+        sideways[:, 1] = np.asarray(p.y_vels, dtype=np.float64)
+        parts.append(sideways)
+    parts.append(np.array([[p.escape_vel, 0.0, 0.0]]))
+    escape_turn = np.zeros((p.vtheta_samples, 3))
+    escape_turn[:, 0] = p.escape_vel
+    escape_turn[:, 2] = in_place_vths
+    parts.append(escape_turn)
+    return np.concatenate(parts, axis=0), in_place_vths, in_place_dvth
+
+
+def test_velocity_samples_match_the_numpy_table_bit_for_bit():
+    """The compiled sample table holds the values (signs of zero included) of the NumPy one,
+    over random limits, velocities and goal distances, holonomic or not, dwa or not, and
+    min_in_place_vel_theta 0."""
+    from fleetsim.nav.controllers.selection import velocity_samples
+
+    rng = np.random.default_rng(5)
+    for k in range(300):
+        kw = dict(
+            dwa=bool(k % 2),
+            vx_samples=int(rng.integers(1, 8)),
+            vtheta_samples=int(rng.integers(1, 25)),
+            min_in_place_vel_theta=0.0 if k % 5 == 0 else float(rng.uniform(0.0, 0.6)),
+            acc_lim_theta=float(rng.uniform(0.5, 4.0)),
+            sim_time=float(rng.uniform(0.5, 2.5)),
+        )
+        p = TrajectoryPlannerParams(holonomic_robot=bool(k % 3 == 0), **kw)
+        tp = TrajectoryPlanner(corridor(), footprint_from_radius(0.2), p)
+        tp.set_plan(np.array([[1.0, 1.0, 0.0], [1.0 + rng.uniform(0.0, 3.0), 1.0, 0.0]]))
+        vel = (float(rng.uniform(-0.2, 0.6)), 0.0, float(rng.choice([0.0, rng.uniform(-1, 1)])))
+        samples, groups, dvth = velocity_samples(tp, (1.0, 1.0, 0.0), vel)
+        want, raw, want_dvth = velocity_samples_reference(tp, (1.0, 1.0, 0.0), vel)
+        assert samples.view(np.uint64).tolist() == want.view(np.uint64).tolist(), kw
+        assert tp._in_place_raw.view(np.uint64).tolist() == raw.view(np.uint64).tolist()
+        assert dvth == want_dvth
+        assert sum(g.stop - g.start for g in groups.values()) == want.shape[0]
+        assert groups["escape_turn"].stop == want.shape[0]

@@ -154,3 +154,22 @@ def test_costs_from_published_inverts_the_costmap_publisher():
     published = occupancy_from_costs(costs)
     assert np.array_equal(occupancy_from_costs(costs_from_published(published)), published)
     assert costs_from_published(np.array([-1, 0, 99, 100], np.int8)).tolist() == [255, 0, 253, 254]
+
+
+def test_max_combination_in_place_matches_combined_max():
+    """`combine_max_into` (compiled, in place on a window of the master) leaves what
+    `combined_max` returns: unknown layer cells keep the master's, known ones win over an
+    unknown or lower master cell; cells outside the window untouched."""
+    from fleetsim.nav.costmap.costmap_2d import NO_INFORMATION
+    from fleetsim.nav.costmap.layer import combine_max_into, combined_max
+
+    rng = np.random.default_rng(9)
+    for _ in range(50):
+        master = rng.choice([0, 1, 100, 252, 253, 254, 255], (30, 40)).astype(np.uint8)
+        layer = rng.choice([0, 7, 128, 253, 254, 255], (30, 40)).astype(np.uint8)
+        y0, x0 = rng.integers(0, 15, 2)
+        y1, x1 = y0 + rng.integers(0, 15), x0 + rng.integers(0, 25)
+        want = master.copy()
+        want[y0:y1, x0:x1] = combined_max(master[y0:y1, x0:x1], layer[y0:y1, x0:x1])
+        combine_max_into(master[y0:y1, x0:x1], layer[y0:y1, x0:x1], NO_INFORMATION)
+        assert np.array_equal(master, want)

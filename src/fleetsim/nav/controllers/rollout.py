@@ -14,7 +14,7 @@ import numpy as np
 from numba import njit
 
 from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
-from fleetsim.nav.costmap.footprint import footprint_cost_at
+from fleetsim.nav.costmap.footprint import footprint_cost_rotated
 
 _SLACK = 1e-6  # cells: margin for rounding when bounding where an outline point can land
 
@@ -226,7 +226,10 @@ def trajectory_costs(
 
     The footprint is laid on the grid only where it can matter: when the cell's bound (see
     `footprint_cost_bounds`) is legal and no higher than the trajectory's highest cost so far,
-    the footprint cannot change the result, so it is skipped (the result is the same).
+    the footprint cannot change the result, so it is skipped (the result is the same). The
+    first pose is every sample's, so its footprint is laid once; a heading's cosine and sine
+    are computed once for its footprint and its step, and kept while the heading does not
+    change; a step at rest (vx = vy = 0) needs neither (the same results, bit for bit).
 
     Parameters
     ----------
@@ -257,6 +260,7 @@ def trajectory_costs(
     h, w = costs.shape
     impossible = float(h * w)
     out = np.empty(samples.shape[0])
+    fp0 = np.nan  # the footprint cost of the first pose, the same for every sample
     for s in range(samples.shape[0]):
         n = num_steps[s]
         dt = sim_time / n
@@ -268,6 +272,9 @@ def trajectory_costs(
         hdiff = 0.0
         t = 0.0
         cost = 0.0
+        th_cs = np.nan  # the heading whose cosine and sine c, sn hold
+        c = 1.0
+        sn = 0.0
         for i in range(n):
             # a rollout found illegal is still followed to its end, unscored: the escape, taken
             # blind, publishes it as the local plan, and the escape guard checks it
@@ -282,9 +289,18 @@ def trajectory_costs(
                     occ = max(occ, float(costs[cy, cx]))
                     bound = bounds[cy, cx]
                     if bound >= LETHAL_OBSTACLE or bound > occ:
-                        fp = footprint_cost_at(
-                            costs, origin[0], origin[1], resolution, outline, x, y, th
-                        )
+                        if i == 0 and fp0 == fp0:
+                            fp = fp0
+                        else:
+                            if th != th_cs:
+                                c = math.cos(th)
+                                sn = math.sin(th)
+                                th_cs = th
+                            fp = footprint_cost_rotated(
+                                costs, origin[0], origin[1], resolution, outline, x, y, c, sn
+                            )
+                            if i == 0:
+                                fp0 = fp
                         if fp < 0.0:
                             cost = -1.0
                         else:
@@ -315,9 +331,15 @@ def trajectory_costs(
             if vy != 0.0:
                 x = x + (vx * math.cos(th) + vy * math.cos(math.pi / 2.0 + th)) * dt
                 y = y + (vx * math.sin(th) + vy * math.sin(math.pi / 2.0 + th)) * dt
-            else:  # the same sums (a zero term adds nothing) without two of the four trig calls
-                x = x + vx * math.cos(th) * dt
-                y = y + vx * math.sin(th) * dt
+            elif vx != 0.0 or x == 0.0 or y == 0.0:
+                # the same sums (a zero term adds nothing) without two of the four trig calls;
+                # at rest x and y stay (adding a signed zero changes only a zero's sign)
+                if th != th_cs:
+                    c = math.cos(th)
+                    sn = math.sin(th)
+                    th_cs = th
+                x = x + vx * c * dt
+                y = y + vx * sn * dt
             th = th + vth * dt
             t += dt
         if cost < 0.0:

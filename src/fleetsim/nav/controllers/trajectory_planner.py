@@ -113,6 +113,7 @@ class TrajectoryPlanner(LocalPlanner):
         self.escaping = False
         self.prev = (0.0, 0.0)
         self.escape_pose = (0.0, 0.0, 0.0)
+        self._sample_layout: tuple | None = None  # see selection.velocity_samples
         #: a `GlobalCostmapGuard` (move_base sets it with ``global_costmap_check``), or None
         self.global_guard = None
 

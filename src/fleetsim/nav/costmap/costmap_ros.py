@@ -41,12 +41,13 @@ from fleetsim.errors import TransformError
 from fleetsim.msgs import geometry_msgs, nav_msgs, std_msgs
 from fleetsim.nav.costmap.footprint import footprint_at
 from fleetsim.nav.costmap.layer import Bounds, Layer
-from fleetsim.nav.costmap.layered_costmap import LayeredCostmap
+from fleetsim.nav.costmap.layered_costmap import LayeredCostmap, occupancy_from_costs
 from fleetsim.nav.costmap.obstacle_layer import ObstacleLayer
 from fleetsim.nav.costmap.readings import points_from_cloud2  # noqa: F401 (its old home)
 from fleetsim.nav.costmap.sources import ObservationSources
 from fleetsim.nav.costmap.static_layer import StaticLayer
 from fleetsim.nav.errors import CostmapError, MapError
+from fleetsim.nav.map_io import OccupancyMap
 from fleetsim.nav.map_server import grid_msg_from_map, map_from_grid_msg
 from fleetsim.tf import resolve_frame_once
 from fleetsim.tf.names import normalize_frame
@@ -267,12 +268,20 @@ class Costmap2DROS:
         )
 
     def publish(self) -> None:
-        """Publish the master grid on ``~<name>/costmap``."""
+        """Publish the master grid on ``~<name>/costmap`` (translated only when someone
+        subscribes: costmap_2d's publisher skips a grid without subscribers too; the latched
+        grid a later subscription gets is this one, from a copy of the costs)."""
         if not self.initialized or self.stopped:
             return
-        self.costmap_pub.publish(
-            grid_msg_from_map(self.layered.occupancy_grid(), self.global_frame, self.node.now_msg())
-        )
+        m = self.costmap
+        costs, res, origin = m.costs.copy(), m.resolution, (m.origin_x, m.origin_y, 0.0)
+        frame, stamp = self.global_frame, self.node.now_msg()
+
+        def make() -> nav_msgs.OccupancyGrid:
+            grid = OccupancyMap(data=occupancy_from_costs(costs), resolution=res, origin=origin)
+            return grid_msg_from_map(grid, frame, stamp)
+
+        self.costmap_pub.publish_lazily(make)
 
     def is_current(self) -> bool:
         """Updated, and every source with an ``expected_update_rate`` heard from within it."""

@@ -168,9 +168,16 @@ def outline_points(polygon: np.ndarray, spacing: float) -> np.ndarray:
 @njit(cache=True, inline="always")
 def footprint_cost_at(costs, origin_x, origin_y, resolution, outline, x, y, yaw):
     """Footprint cost of one pose (see `footprint_costs`); -1.0 when illegal."""
+    return footprint_cost_rotated(
+        costs, origin_x, origin_y, resolution, outline, x, y, math.cos(yaw), math.sin(yaw)
+    )
+
+
+@njit(cache=True, inline="always")
+def footprint_cost_rotated(costs, origin_x, origin_y, resolution, outline, x, y, c, s):
+    """`footprint_cost_at` with the heading given as its cosine ``c`` and sine ``s`` (a caller
+    that has them already saves the two trig calls)."""
     sy, sx = costs.shape
-    c = math.cos(yaw)
-    s = math.sin(yaw)
     worst = 0.0
     for k in range(outline.shape[0]):
         fx = (x + c * outline[k, 0] - s * outline[k, 1] - origin_x) / resolution

@@ -17,6 +17,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+from numba import njit
 
 from fleetsim.nav.costmap.costmap_2d import NO_INFORMATION, Costmap2D
 
@@ -84,6 +85,18 @@ def combined_max(master: np.ndarray, layer: np.ndarray) -> np.ndarray:
     return np.where(take, layer, master)
 
 
+@njit(cache=True)
+def combine_max_into(master, layer, unknown):
+    """`combined_max` written into ``master`` in place, compiled (every obstacle layer's update
+    of every robot; NumPy's five passes and a copy cost ~20 us a window)."""
+    for r in range(master.shape[0]):
+        for c in range(master.shape[1]):
+            v = layer[r, c]
+            m = master[r, c]
+            if v != unknown and (m == unknown or m < v):
+                master[r, c] = v
+
+
 def combined_overwrite(master: np.ndarray, layer: np.ndarray) -> np.ndarray:
     """costmap_2d's updateWithOverwrite: every known layer cell replaces the master's."""
     return np.where(layer != NO_INFORMATION, layer, master)
@@ -117,7 +130,7 @@ class CostmapLayer(Layer):
 
     def update_with_max(self, master: Costmap2D, x0: int, y0: int, xn: int, yn: int):
         w = np.s_[y0:yn, x0:xn]
-        master.costs[w] = combined_max(master.costs[w], self.grid.costs[w])
+        combine_max_into(master.costs[w], self.grid.costs[w], NO_INFORMATION)
 
     def clear_area(self, x0: int, y0: int, xn: int, yn: int, invert: bool = False) -> None:
         """Set cells to NO_INFORMATION outside (or, ``invert``, inside) the open box.

@@ -9,16 +9,19 @@ FREE). Clearing runs before marking, as in costmap_2d.
 
 from __future__ import annotations
 
+import functools
 import logging
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from numba import njit
 
 from fleetsim.nav.costmap.costmap_2d import FREE_SPACE, LETHAL_OBSTACLE, NO_INFORMATION
 from fleetsim.nav.costmap.footprint import footprint_at, polygon_cells
 from fleetsim.nav.costmap.layer import Bounds, CostmapLayer
-from fleetsim.nav.costmap.raytrace import ray_ends_clipped, trace_rays
+from fleetsim.nav.costmap.raytrace import clear_along_rays
 from fleetsim.nav.errors import CostmapError
 from fleetsim.runtime import load_params, param
 
@@ -97,12 +100,39 @@ def laser_scan_points(
     ranges : (B,) m. Returns (N, 3) m with z = 0.
     """
     r = np.asarray(ranges, dtype=np.float64)
-    angles = angle_min + angle_increment * np.arange(r.shape[0])
-    if inf_is_valid:
-        r = np.where(np.isposinf(r), range_max - 1e-4, r)
-    keep = np.isfinite(r) & (r >= range_min) & (r < range_max)
-    r, a = r[keep], angles[keep]
-    return np.stack((r * np.cos(a), r * np.sin(a), np.zeros_like(r)), axis=1)
+    cos_a, sin_a = _beam_directions(float(angle_min), float(angle_increment), r.shape[0])
+    inf_range = float(range_max - 1e-4)  # in the message's own float type, as before
+    inf_is_valid = bool(inf_is_valid)
+    return _projected(r, cos_a, sin_a, float(range_min), float(range_max), inf_is_valid, inf_range)
+
+
+@functools.lru_cache(maxsize=256)
+def _beam_directions(angle_min: float, angle_increment: float, n: int):
+    """Cosines and sines (B,) of a scan's beam angles ``angle_min + angle_increment * i``,
+    kept per scan geometry (a laser's is the same in every scan; NumPy's cos and sin of a
+    beam are the same whichever beams are taken with it)."""
+    angles = angle_min + angle_increment * np.arange(n)
+    cos_a, sin_a = np.cos(angles), np.sin(angles)
+    cos_a.flags.writeable = sin_a.flags.writeable = False
+    return cos_a, sin_a
+
+
+@njit(cache=True)
+def _projected(r, cos_a, sin_a, range_min, range_max, inf_is_valid, inf_range):
+    """`laser_scan_points`' points from ranges (B,) and beam directions, compiled (each
+    costmap reads a scan at its update; NumPy's dozen calls cost ~50 us a scan)."""
+    out = np.empty((r.shape[0], 3))
+    n = 0
+    for i in range(r.shape[0]):
+        v = r[i]
+        if inf_is_valid and v == np.inf:
+            v = inf_range
+        if np.isfinite(v) and v >= range_min and v < range_max:
+            out[n, 0] = v * cos_a[i]
+            out[n, 1] = v * sin_a[i]
+            out[n, 2] = 0.0
+            n += 1
+    return out[:n].copy()
 
 
 @dataclass
@@ -118,8 +148,7 @@ class ObservationBuffer:
         pts = np.asarray(points, dtype=np.float64).reshape(-1, 3)
         o = np.asarray(origin, dtype=np.float64).reshape(3)
         p = self.params
-        z = pts[:, 2]
-        pts = pts[(z <= p.max_obstacle_height) & (z >= p.min_obstacle_height)]
+        pts = _in_height_band(pts, float(p.min_obstacle_height), float(p.max_obstacle_height))
         obs = Observation(o, pts, p.obstacle_range, p.raytrace_range, stamp)
         if p.observation_persistence <= 0.0:
             self.observations = [obs]
@@ -221,11 +250,18 @@ class ObstacleLayer(CostmapLayer):
     def marking_points(self, obs: Observation) -> tuple[np.ndarray, np.ndarray]:
         """The points of ``obs`` that mark: within obstacle_range, under max_obstacle_height
         and on the grid; returns them (K, 3) and their cells (K, 2) (x, y indices)."""
-        pts = obs.points
-        d2 = ((pts - obs.origin) ** 2).sum(axis=1)
-        pts = pts[(pts[:, 2] <= self.params.max_obstacle_height) & (d2 < obs.obstacle_range**2)]
-        cells, inside = self.grid.cells_of(pts[:, :2])
-        return pts[inside], cells[inside]
+        g = self.grid
+        return _marking(
+            np.ascontiguousarray(obs.points, dtype=np.float64),
+            np.asarray(obs.origin, dtype=np.float64),
+            float(self.params.max_obstacle_height),
+            float(obs.obstacle_range**2),
+            g.origin_x,
+            g.origin_y,
+            g.resolution,
+            g.size_x,
+            g.size_y,
+        )
 
     def mark(self, obs: Observation, bounds: Bounds) -> None:
         """Set the cells of points within range and under max_obstacle_height to LETHAL."""
@@ -250,20 +286,14 @@ class ObstacleLayer(CostmapLayer):
             return
         if obs.points.shape[0] == 0:
             return
-        lo = np.array(g.origin)
-        hi = lo + np.array([g.size_x, g.size_y]) * g.resolution
-        ends = ray_ends_clipped(obs.origin, obs.points, lo, hi)
-        cells, inside = g.cells_of(ends)
-        trace_rays(
-            g.costs,
-            start[0],
-            start[1],
-            np.ascontiguousarray(cells[inside]),
-            g.cell_distance(obs.raytrace_range),
-            FREE_SPACE,
-        )
+        lo = (g.origin_x, g.origin_y)
+        hi = (g.origin_x + g.size_x * g.resolution, g.origin_y + g.size_y * g.resolution)
+        ox, oy = float(obs.origin[0]), float(obs.origin[1])
+        clear_along_rays(
+            g.costs, ox, oy, obs.points, lo[0], lo[1], hi[0], hi[1], g.resolution,
+            start[0], start[1], g.cell_distance(obs.raytrace_range), FREE_SPACE,
+        )  # fmt: skip
         r = obs.raytrace_range
-        ox, oy = obs.origin[0], obs.origin[1]
         bounds.include(
             max(ox - r, lo[0]), max(oy - r, lo[1]), min(ox + r, hi[0]), min(oy + r, hi[1])
         )
@@ -279,3 +309,52 @@ class ObstacleLayer(CostmapLayer):
             self.update_with_overwrite(master, x0, y0, xn, yn)
         else:
             self.update_with_max(master, x0, y0, xn, yn)
+
+
+@njit(cache=True)
+def _marking(pts, origin, max_height, range2, ox, oy, res, size_x, size_y):
+    """`ObstacleLayer.marking_points` compiled (every costmap update of every robot): points
+    (N, 3) with ``z <= max_height``, squared distance to ``origin`` (3,) below ``range2`` and a
+    cell on the grid, with their cells (K, 2) int64, in their order. The same floats as the
+    NumPy form: the squared distance summed x, y, z in turn, cells by `cells_from_points`."""
+    keep = np.empty(pts.shape[0], np.int64)
+    cells = np.empty((pts.shape[0], 2), np.int64)
+    n = 0
+    for i in range(pts.shape[0]):
+        dx = pts[i, 0] - origin[0]
+        dy = pts[i, 1] - origin[1]
+        dz = pts[i, 2] - origin[2]
+        if not (pts[i, 2] <= max_height and dx * dx + dy * dy + dz * dz < range2):
+            continue
+        mx = math.floor((pts[i, 0] - ox) / res)
+        my = math.floor((pts[i, 1] - oy) / res)
+        if mx >= 0 and my >= 0 and mx < size_x and my < size_y:
+            keep[n] = i
+            cells[n, 0] = mx
+            cells[n, 1] = my
+            n += 1
+    out = np.empty((n, 3))
+    for k in range(n):
+        out[k] = pts[keep[k]]
+    return out, cells[:n].copy()
+
+
+@njit(cache=True)
+def _in_height_band(pts, lo, hi):
+    """The points (N, 3) with ``lo <= z <= hi``, in order (a copy), compiled: every reading
+    of every robot's costmaps passes here."""
+    keep = np.empty(pts.shape[0], np.bool_)
+    n = 0
+    for i in range(pts.shape[0]):
+        z = pts[i, 2]
+        keep[i] = z <= hi and z >= lo
+        n += keep[i]
+    out = np.empty((n, 3))
+    k = 0
+    for i in range(pts.shape[0]):
+        if keep[i]:
+            out[k, 0] = pts[i, 0]
+            out[k, 1] = pts[i, 1]
+            out[k, 2] = pts[i, 2]
+            k += 1
+    return out

@@ -104,3 +104,29 @@ def _clip_ends(ox, oy, w, x0, y0, x1, y1):
             t = (y1 - oy) / (w[i, 1] - oy)
             w[i, 0] = ox + (w[i, 0] - ox) * t
             w[i, 1] = y1 - 0.001
+
+
+@njit(cache=True, error_model="numpy")  # a zero-length ray divides as NumPy did
+def clear_along_rays(grid, ox, oy, points, x0, y0, x1, y1, resolution, sx, sy, max_length, value):
+    """ObstacleLayer::raytraceFreespace's clearing in one compiled pass: each point's ray from
+    the sensor at (ox, oy) m is pulled back into the map box [x0, x1) x [y0, y1) m
+    (`ray_ends_clipped`), its end cell taken (`cells_from_points`, floor), and when that cell
+    is on the grid the line from the sensor's cell (sx, sy) to it is set to ``value``
+    (`trace_rays`, cut at ``max_length`` cells). points : (N, >= 2) m. The same cells as those
+    steps one after another."""
+    w = np.empty((points.shape[0], 2))
+    for i in range(points.shape[0]):
+        w[i, 0] = points[i, 0]
+        w[i, 1] = points[i, 1]
+    _clip_ends(ox, oy, w, x0, y0, x1, y1)
+    h, wd = grid.shape
+    ends = np.empty((w.shape[0], 2), np.int64)
+    n = 0
+    for i in range(w.shape[0]):
+        fx = (w[i, 0] - x0) / resolution
+        fy = (w[i, 1] - y0) / resolution
+        if fx >= 0.0 and fy >= 0.0 and fx < wd and fy < h:  # floor(f) in [0, n) (not NaN)
+            ends[n, 0] = math.floor(fx)
+            ends[n, 1] = math.floor(fy)
+            n += 1
+    trace_rays(grid, sx, sy, ends[:n], max_length, value)

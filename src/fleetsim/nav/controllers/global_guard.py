@@ -10,19 +10,22 @@ SLAM map, and its obstacle layer) does. In the office the hunter backed 0.3 m in
 behind it and, turning out of a door, brushed the door's post beside it: both in gmapping's
 map all along (held-out seed 6).
 
-With ``global_costmap_check`` (default true) the trajectory chosen each cycle is refused when
-it puts the robot's body (the footprint without ``footprint_padding``) on a lethal cell of the
-global costmap that the body does not touch at the rollout's start (cells it touches already
-are where the robot stands: refusing those would pin a robot the map shows a little off) and
-that the local costmap does not hold (no lethal cell there or beside it: what the local costmap
-holds the planner has judged already, by ROS's rules, blind escape included; in BARN's clutter,
-where the jackal's local costmap holds every post, refusing those escapes too aborted worlds
-117 and 123), and the next best is taken in base_local_planner's order; with all refused the
-planner has no valid trajectory and move_base's recoveries take over, as for any robot with no
-legal move. The body, not the padded footprint: the padding keeps plans away from obstacles,
-but a robot wedged within its padding of a desk has to get closer to something to get out (with
-the padded footprint a hunter was pinned by a desk for 900 s, office seed 6). ``false`` is
-ROS's planner.
+With ``global_costmap_check`` (off by default, as ROS; on in the hunter's parameters) the
+trajectory chosen each cycle is refused when it puts the robot's body (the footprint without
+``footprint_padding``) on a lethal cell of the global costmap that the body does not touch at
+the rollout's start (cells it touches already are where the robot stands: refusing those would
+pin a robot the map shows a little off) and that the local costmap does not hold (no lethal
+cell there or beside it: what the local costmap holds the planner has judged already, by ROS's
+rules, blind escape included; in BARN's clutter, where the jackal's local costmap holds every
+post, refusing those escapes too aborted worlds 117 and 123), and the next best is taken in
+base_local_planner's order; with all refused the planner has no valid trajectory and
+move_base's recoveries take over, as for any robot with no legal move. The body, not the padded
+footprint: the padding keeps plans away from obstacles, but a robot wedged within its padding
+of a desk has to get closer to something to get out (with the padded footprint a hunter was
+pinned by a desk for 900 s, office seed 6). Off by default: with amcl the global pose carries
+the filter's error; with the guard on for every robot the pioneer_multi scenario with amcl
+failed its test, and a lizi of the lesson's amcl run (seed 3) aborted where every back-up was
+refused, both of which ROS's planner gets through.
 """
 
 from __future__ import annotations

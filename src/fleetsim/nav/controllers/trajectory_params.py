@@ -96,8 +96,8 @@ class TrajectoryPlannerParams:
     )
     # fleetsim addition: ROS judges moves on the local costmap alone (see `global_guard`)
     global_costmap_check: bool = param(
-        True,
+        False,
         help="refuse a move that puts the robot's body on a lethal cell of the global "
-        "costmap (false: the local costmap alone, as ROS)",
+        "costmap (false, the default: the local costmap alone, as ROS)",
     )
     prune_plan: bool = param(True, help="drop plan points more than 1 m behind the robot")

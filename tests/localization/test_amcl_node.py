@@ -142,6 +142,26 @@ def test_tracks_under_a_namespace_and_publishes_tf_pose_and_cloud():
     assert abs(rt.params.get("/lizi1/amcl/initial_pose_x") - robot.true[0]) < 0.5
 
 
+def test_particlecloud_is_built_only_for_a_reader_and_kept_for_a_late_one():
+    rt = Runtime(seed=0)
+    rt.params.set("/lizi1/tf_prefix", "lizi1")
+    rt.params.set("/lizi1/amcl/initial_pose_x", 1.5)
+    rt.params.set("/lizi1/amcl/initial_pose_y", 5.0)
+    FakeMapServer(rt)
+    FakeRobot(rt, "/lizi1", ROUTE)
+    amcl = Amcl(rt, "amcl", "/lizi1", remaps={"static_map": "/static_map"})
+    rt.run(duration=4.0)
+    assert amcl.cloud_pub._last is None  # nobody subscribed: no PoseArray was built
+    particles = amcl.filter.particles.copy()  # as of the last update, which published
+    late = Listener(rt, "/lizi1")  # subscribes to the latched particlecloud now
+    rt.run(duration=0.01)
+    assert len(late.clouds) == 1
+    got = np.array([[p.position.x, p.position.y] for p in late.clouds[0].poses])
+    np.testing.assert_allclose(got, particles[:, :2])
+    yaw = [2 * np.arctan2(p.orientation.z, p.orientation.w) for p in late.clouds[0].poses]
+    np.testing.assert_allclose(np.cos(yaw), np.cos(particles[:, 2]), atol=1e-9)
+
+
 def test_initialpose_topic_and_services():
     rt, robot, amcl, out = robot_world(amcl_params={"initial_pose_x": 8.0, "initial_pose_y": 2.0})
     helper = Node(rt, "helper")

@@ -342,22 +342,34 @@ class Amcl(Node):
         if rate is not None and rate > 0 and now - self._last_cloud_time < 1.0 / rate:
             return
         self._last_cloud_time = now
-        if self.cloud_pub.get_num_connections() == 0:
-            return  # nobody listens: skip building thousands of Pose messages
-        parts = self.filter.particles
-        half = 0.5 * parts[:, 2]
-        Pose, Point, Quaternion = geometry_msgs.Pose, geometry_msgs.Point, geometry_msgs.Quaternion
-        poses = [
-            Pose(position=Point(x=x, y=y, z=0.0), orientation=Quaternion(x=0.0, y=0.0, z=z, w=w))
-            for x, y, z, w in zip(
-                parts[:, 0].tolist(),
-                parts[:, 1].tolist(),
-                np.sin(half).tolist(),
-                np.cos(half).tolist(),
+        # Built only for a reader (thousands of Pose messages): with nobody subscribed the
+        # latched publisher keeps the builder, so a later subscriber still gets this cloud.
+        parts = self.filter.particles.copy()
+        frame = self.global_frame
+
+        def make() -> geometry_msgs.PoseArray:
+            half = 0.5 * parts[:, 2]
+            Pose, Point, Quaternion = (
+                geometry_msgs.Pose,
+                geometry_msgs.Point,
+                geometry_msgs.Quaternion,
             )
-        ]
-        header = std_msgs.Header(stamp=stamp, frame_id=self.global_frame)
-        self.cloud_pub.publish(geometry_msgs.PoseArray(header=header, poses=poses))
+            poses = [
+                Pose(
+                    position=Point(x=x, y=y, z=0.0),
+                    orientation=Quaternion(x=0.0, y=0.0, z=z, w=w),
+                )
+                for x, y, z, w in zip(
+                    parts[:, 0].tolist(),
+                    parts[:, 1].tolist(),
+                    np.sin(half).tolist(),
+                    np.cos(half).tolist(),
+                )
+            ]
+            header = std_msgs.Header(stamp=stamp, frame_id=frame)
+            return geometry_msgs.PoseArray(header=header, poses=poses)
+
+        self.cloud_pub.publish_lazily(make)
 
     def _publish_pose(self, stamp: Time, odom_pose: np.ndarray) -> None:
         est = self.filter.estimate

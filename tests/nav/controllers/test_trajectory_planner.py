@@ -397,15 +397,24 @@ def _escape_with_global_map(
     return tp, tp.compute_velocity_commands((1.5, 1.0, 0.0), (0.0, 0.0, 0.0))
 
 
-def test_the_escape_does_not_back_onto_what_the_global_costmap_knows():
+def test_the_escape_does_not_back_onto_what_the_global_costmap_knows(monkeypatch):
     # nothing behind in either map: a back-up (straight or on a curve, see `_escape_choice`)
     tp, cmd = _escape_with_global_map()
     assert cmd.vx == -0.1 and tp.escaping
     # a wall behind the rear edge in the global costmap only (rows 71-72: y -1.45 to -1.35):
-    # every back-up refused, so no valid trajectory, and the error says why
+    # every back-up refused; the way out of the padding moves the robot on (a creep forward
+    # or a turn in place) as far as its body clears the walls (here the footprint is
+    # unpadded: the body is it), not back
+    _, cmd = _escape_with_global_map(lethal_rows=(71, 72))
+    assert cmd.vx >= 0.0 and (cmd.vx, cmd.vtheta) != (0.0, 0.0)
+    # without that way out: no valid trajectory, and the error says why
+    from fleetsim.nav.controllers import selection
+
+    monkeypatch.setattr(selection, "_padding_way_out", lambda *a: -1)
     why = r"robot on a lethal cell of the global costmap at \(.*, -1\.3[78]\) in map"
     with pytest.raises(NoValidTrajectory, match=why):
         _escape_with_global_map(lethal_rows=(71, 72))
+    monkeypatch.undo()
     # a wall the local costmap holds too is the planner's to judge: ROS's blind escape
     _, cmd = _escape_with_global_map(lethal_rows=(71, 72), local_wall=True)
     assert cmd.vx == -0.1

@@ -89,6 +89,32 @@ class GlobalCostmapGuard:
             self._body_key = key
         return self._outline
 
+    def body_clear(self, poses: np.ndarray) -> bool:
+        """Whether the rollout through ``poses`` ((T, 3), local frame) keeps the body off the
+        local costmap's lethal cells it does not touch at the first pose, and the guard does
+        not refuse it: a move the padding alone makes illegal (`selection._padding_way_out`)."""
+        if poses.shape[0] < 2:
+            return True
+        local = self.local_costmap.costmap
+        k, _ = _new_lethal_cell(
+            local.costs,
+            local.origin_x,
+            local.origin_y,
+            local.resolution,
+            _NOTHING,
+            0.0,
+            0.0,
+            1.0,
+            self._body_outline(local.resolution),
+            np.ascontiguousarray(poses, dtype=np.float64),
+            1.0,
+            0.0,
+            0.0,
+            0.0,
+            0.0,
+        )
+        return k < 0 and not self.refuses(poses)
+
     def refuses(self, poses: np.ndarray) -> bool:
         """Whether the rollout through ``poses`` ((T, 3) x, y, yaw in the local costmap's
         frame, the first the robot's) puts the body on a lethal global cell it does not touch
@@ -122,6 +148,10 @@ class GlobalCostmapGuard:
             f"({wx:.2f}, {wy:.2f}) in {self.global_costmap.global_frame}"
         )
         return True
+
+
+#: an empty "local costmap" for `_new_lethal_cell` checking a grid on its own
+_NOTHING = np.zeros((1, 1), dtype=np.uint8)
 
 
 @njit(cache=True)

@@ -351,13 +351,51 @@ def _refused(tp: TrajectoryPlanner, index: int) -> bool:
     guard = tp.global_guard
     if guard is None:
         return False
+    return guard.refuses(tp._poses[index, : _guard_steps(tp, index)])
+
+
+def _guard_steps(tp: TrajectoryPlanner, index: int) -> int:
+    """How many of rollout ``index``'s poses the guard checks (see `_refused`)."""
     p = tp.params
     n = max(int(tp._steps[index]), 1)
     vx, vy, vth = tp._samples[index]
     brake = max(math.hypot(vx, vy) / max(p.acc_lim_x, 1e-9), abs(vth) / max(p.acc_lim_theta, 1e-9))
     horizon = 2.0 * tp.sim_period + brake + GUARD_MARGIN
-    k = min(n, math.ceil(horizon / (p.sim_time / n)) + 1)
-    return guard.refuses(tp._poses[index, :k])
+    return min(n, math.ceil(horizon / (p.sim_time / n)) + 1)
+
+
+def _padding_way_out(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: float) -> int:
+    """With every escape refused by the global costmap guard: the in-place rotation or forward
+    move illegal only because of the padding (its rollout, as far as `_refused` looks, keeps
+    the body itself off the lethal cells of both costmaps) that looks best by in-place
+    rotation's rule (least goal distance ``heading_lookahead`` ahead); -1 if none.
+
+    A fleetsim addition, part of ``global_costmap_check``: a robot wedged within its padding
+    of obstacles in front, with the one behind known only to the global costmap, stood
+    pinned where ROS would have backed into it (office seed 6: a hunter by a desk for 126 s
+    until explore gave up), as navfn's way out frees a robot whose centre is inscribed."""
+    guard = tp.global_guard
+    if guard is None:
+        return -1
+    best, best_key = -1, None
+    raw = tp._in_place_raw
+    candidates = [
+        (i, True) for k, i in enumerate(range(g["in_place"].start, g["in_place"].stop))
+        if not -dvth <= raw[k] <= dvth
+    ] + [(i, False) for i in range(g["forward"].start, g["forward"].stop)]  # fmt: skip
+    for i, turning in candidates:
+        if costs[i] != -1.0:  # legal ones were refused already; -2: no way to the goal
+            continue
+        if turning:
+            ahead = _ahead_goal_dist_turning(tp, i)
+        else:
+            d = _ahead_goal_dist(tp, i)
+            ahead = None if d is None else (d, 0)
+        if ahead is None or (best_key is not None and ahead >= best_key):
+            continue
+        if guard.body_clear(tp._poses[i, : _guard_steps(tp, i)]):
+            best, best_key = i, ahead
+    return best
 
 
 def _escape_can_turn(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, pose) -> bool:
@@ -431,7 +469,11 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
     # better: `global_guard`)
     i = _escape_choice(tp, costs, g, dvth)
     if i < 0:
-        return (0.0, 0.0, 0.0), -1.0, g["escape"].start
+        j = _padding_way_out(tp, costs, g, dvth)
+        if j < 0:
+            return (0.0, 0.0, 0.0), -1.0, g["escape"].start
+        _bookkeep(tp, samples[j], pose)
+        return tuple(samples[j]), 1.0, j
     cost = float(costs[i])
     x, y, th = pose
     if math.hypot(x - tp.prev[0], y - tp.prev[1]) > tp.params.oscillation_reset_dist:

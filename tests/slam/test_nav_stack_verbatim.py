@@ -45,6 +45,7 @@ FLEETSIM_DIFFERENCES = {
     "TrajectoryPlannerROS/alignment_scale": (None, 0.6),
     "TrajectoryPlannerROS/forward_point_distance": (None, 0.325),
     "TrajectoryPlannerROS/escape_vel": (None, -0.1),
+    "TrajectoryPlannerROS/global_costmap_check": (None, True),
     # TrajectoryPlannerROS does not read these
     "TrajectoryPlannerROS/max_vel_y": (0.0, None),
     "TrajectoryPlannerROS/min_vel_y": (0.0, None),
@@ -61,6 +62,7 @@ SAYS_WHY = {
         "the manual says 5.0",
         "the manual says false",
         "max_vel_y 0.0, min_vel_y 0.0 and vy_samples",
+        "checked against gmapping's map",
     ],
     "costmap_common_params.yaml": ["the manual says robot_radius 0.15"],
 }

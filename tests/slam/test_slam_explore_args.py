@@ -72,3 +72,18 @@ def test_hunter_run_passes_x_y_to_the_spawn_and_to_amcl():
     assert spawns(p) == {"robocluedo_robot": (6.0, 9.0)}
     params = p.param_tree()
     assert (params.get("/amcl/initial_pose_x"), params.get("/amcl/initial_pose_y")) == (6, 9)
+
+
+def test_the_global_costmap_check_is_on_only_for_a_robot_on_its_own_slam_map():
+    key = "move_base/TrajectoryPlannerROS/global_costmap_check"
+    # the hunter mapping alone (slam_explore, hunter_run's nav stack): on, from params/hunter
+    assert plan().param_tree().get(f"/{key}") is True
+    nav = load_plan(resolve_launch_file("hunter_run"), {"launch_nav_stack": "true"})
+    assert nav.param_tree().get(f"/{key}") is True
+    # on the merged map of two SLAM estimates, and on amcl's pose: off
+    pair = plan(robots="2").param_tree()
+    assert pair.get(f"/hunter1/{key}") is False and pair.get(f"/hunter2/{key}") is False
+    amcl = load_plan(
+        resolve_launch_file("hunter_run"), {"launch_nav_stack": "false", "launch_amcl": "true"}
+    )
+    assert amcl.param_tree().get(f"/{key}") is False

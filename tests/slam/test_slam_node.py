@@ -100,8 +100,17 @@ def test_maps_the_room_in_a_namespace_with_its_own_frames(caplog):
 def test_transform_publish_period_is_capped_at_the_simulator_rate(caplog):
     with caplog.at_level(logging.INFO):
         rt, robot, slam, out = world(params={"transform_publish_period": 0.0005})
-    assert slam.tf_period == pytest.approx(0.01)
+    assert slam.tf_period == pytest.approx(0.01)  # no simulator node: its default period
     assert "faster than the simulator publishes" in caplog.text
+    # with a simulator that publishes every 0.02 s: that period, and a slower one as it is
+    from fleetsim.sim.node import Simulator
+
+    for asked, expected in ((0.0005, 0.02), (0.05, 0.05)):
+        rt = Runtime(seed=0)
+        rt.params.set("/gazebo/update_period", 0.02)
+        Simulator(rt, "gazebo")
+        rt.params.set("/slam_gmapping/transform_publish_period", asked)
+        assert SlamGmapping(rt, "slam_gmapping").tf_period == pytest.approx(expected)
 
 
 def test_updates_gated_by_linear_angular_and_temporal_update():

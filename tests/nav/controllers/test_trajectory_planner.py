@@ -422,6 +422,16 @@ def test_the_escape_does_not_back_onto_what_the_global_costmap_knows(monkeypatch
     # starts at -1.22 and backs to about -1.32, clear of the wall
     _, cmd = _escape_with_global_map(lethal_rows=(71, 72), padding=0.1)
     assert cmd.vx == -0.1
+    # padded, with the wall 3 cm behind the body (row 74: y -1.30 to -1.25): every back-up
+    # refused, and every forward move and turn illegal on the padded footprint; the turn its
+    # body clears (0.15 m from the side walls) is the way out, where without it the robot
+    # would stand with no valid trajectory
+    tp, cmd = _escape_with_global_map(lethal_rows=(74,), padding=0.1)
+    assert cmd.vx == 0.0 and cmd.vtheta != 0.0 and not tp.escaping
+    monkeypatch.setattr(selection, "_padding_way_out", lambda *a: -1)
+    with pytest.raises(NoValidTrajectory, match=r"global costmap at \(.*, -1\.27\) in map"):
+        _escape_with_global_map(lethal_rows=(74,), padding=0.1)
+    monkeypatch.undo()
     # the same wall where the local frame's -x would be without the frames' rotation (global x
     # 1.60-1.75): not behind the robot, so the escape goes ahead
     _, cmd = _escape_with_global_map(lethal_cols=(132, 133, 134))

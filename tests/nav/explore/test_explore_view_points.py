@@ -4,11 +4,13 @@ view point observed as far as it can be, not given up; one whose view point move
 not reach still given up."""
 
 import numpy as np
+import pytest
 from test_explore_blacklist import MoveBase, World, room
 from test_path_costs import rooms
 
+from fleetsim.msgs import geometry_msgs, std_msgs
 from fleetsim.nav.explore import Explore
-from fleetsim.runtime import Runtime
+from fleetsim.runtime import Node, Runtime
 from fleetsim.tf import make_transform_stamped
 
 
@@ -182,3 +184,77 @@ def test_a_frontier_given_up_twice_is_given_up():
     rt.run(duration=6.0)
     assert ex.finished and ex.gave_up and ex.retries == 1
     assert len(mb.goals) == 4 and len(set(mb.goals)) == 2
+
+
+class Peer(Node):
+    """A peer explorer's announcements: a goal far away, and its observed points."""
+
+    def __init__(self, rt):
+        super().__init__(rt, "peer")
+        self.goal = self.create_publisher(
+            geometry_msgs.PointStamped, "/peer/explore/goal", 1, latch=True
+        )
+        self.goal.publish(geometry_msgs.PointStamped(point=geometry_msgs.Point(x=50.0, y=50.0)))
+        self.observed = self.create_publisher(
+            geometry_msgs.PoseArray, "/peer/explore/observed", 1, latch=True
+        )
+        self.heard = []
+        self.create_subscription(geometry_msgs.PoseArray, "/explore/observed", self.heard.append)
+
+    def announce(self, points):
+        self.observed.publish(
+            geometry_msgs.PoseArray(
+                header=std_msgs.Header(stamp=self.now_msg(), frame_id="map"),
+                poses=[
+                    geometry_msgs.Pose(position=geometry_msgs.Point(x=x, y=y)) for x, y in points
+                ],
+            )
+        )
+
+
+def test_with_peers_a_frontier_closed_in_its_own_costmap_is_told_to_them_as_observed():
+    # the frontier it heads for vanishes from its own costmap (its laser saw it) before it got
+    # there: a peer, whose costmap reads the merged map, may still see it, so it is told
+    data = room()
+    rt = Runtime(seed=0)
+    world = republishing(rt, data)
+    mb = MoveBase(rt, lambda g: None)  # accepted, never reached
+    peer = Peer(rt)
+    ex = explorer(
+        rt, potential_scale=0.0, peer_goals=["/peer/explore/goal"],
+        peer_observed=["/peer/explore/observed"],
+    )  # fmt: skip
+    rt.run(duration=1.5)
+    goal = ex.goal  # the frontier it heads for (move_base got it, rounded: mb.goals)
+    assert mb.goals and not ex.closed_at
+    world.data[:, :] = 0  # everything known now: every frontier closed
+    world.data[0, :] = 100
+    rt.run(duration=2.0)
+    assert ex.closed_at == [goal]
+    told = [(p.position.x, p.position.y) for p in peer.heard[-1].poses]
+    assert told == [goal]
+    # without peers nothing is told (explore_lite's own behaviour)
+    rt = Runtime(seed=0)
+    world = republishing(rt, room())
+    MoveBase(rt, lambda g: None)
+    ex = explorer(rt, potential_scale=0.0)
+    rt.run(duration=1.5)
+    world.data[:, :] = 0
+    rt.run(duration=2.0)
+    assert not ex.closed_at
+
+
+def test_a_peers_observed_point_keeps_the_time_it_was_first_heard_of():
+    # a peer republishes its whole list, stamped anew, as it grows: the points it had already
+    # told keep their first time, so they do not wait observe_delay again
+    rt = Runtime(seed=0)
+    republishing(rt, room())
+    MoveBase(rt, lambda g: None)
+    peer = Peer(rt)
+    ex = explorer(rt, peer_goals=["/peer/explore/goal"], peer_observed=["/peer/explore/observed"])
+    peer.announce([(1.0, 1.0)])
+    rt.run(duration=3.0)
+    peer.announce([(1.0, 1.0), (2.0, 0.5)])
+    rt.run(duration=0.5)
+    (heard,) = ex.peer_stood_at.values()
+    assert heard == [(1.0, 1.0, 0.0), (2.0, 0.5, pytest.approx(3.0))]

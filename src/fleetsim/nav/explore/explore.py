@@ -99,6 +99,9 @@ class Explore(Node):
         #: view points move_base reached (view_points), and the peers' (peer_observed), with
         #: when (sim s; a peer's list at the time it was published)
         self.stood_at: list[tuple[float, float, float]] = []
+        #: with peers: goals whose frontier closed in this robot's own costmap on the way (told
+        #: to the peers with the view points stood at; see `make_plan`)
+        self.closed_at: list[tuple[float, float]] = []
         self._grid_time = 0.0
         #: frontiers left when it stopped that were observed as far as they can be
         self.observed = 0
@@ -117,7 +120,18 @@ class Explore(Node):
         # what the peers tell it, by topic: their goals, blacklists and view points stood at
         self.peers = self._listen(geometry_msgs.PointStamped, p.peer_goals, _goal, None)
         self.peer_blacklists = self._listen(geometry_msgs.PoseArray, p.peer_blacklists, _points)
-        self.peer_stood_at = self._listen(geometry_msgs.PoseArray, p.peer_observed, _stamped)
+        # the peers' observed points, each with the time it was first heard of: a peer
+        # republishes its whole list, stamped anew, whenever the list grows
+        self.peer_stood_at: dict[str, list[tuple[float, float, float]]] = {
+            str(t): [] for t in p.peer_observed
+        }
+        for topic in self.peer_stood_at:
+            self.create_subscription(
+                geometry_msgs.PoseArray,
+                topic,
+                lambda m, t=topic: self._on_peer_observed(t, m),
+                1,
+            )
         _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now
         self.create_subscription(nav_msgs.OccupancyGrid, p.costmap_topic, self.on_costmap, 1)
         self.move_base = self.create_action_client(move_base_msgs.MoveBase, "move_base")
@@ -150,6 +164,14 @@ class Explore(Node):
                 kind, topic, lambda m, t=topic: latest.__setitem__(t, read(m)), 1
             )
         return latest
+
+    def _publish_observed(self) -> None:
+        stood = [(x, y) for x, y, _ in self.stood_at]
+        self._publish_points(self.observed_pub, [*stood, *self.closed_at])
+
+    def _on_peer_observed(self, topic: str, msg: geometry_msgs.PoseArray) -> None:
+        heard = {(x, y): t for x, y, t in self.peer_stood_at[topic]}
+        self.peer_stood_at[topic] = [(x, y, heard.get((x, y), t)) for x, y, t in _stamped(msg)]
 
     def _blacklist(self, goal: tuple[float, float]) -> None:
         """Blacklist a goal and tell the peers (~blacklist)."""
@@ -251,6 +273,20 @@ class Explore(Node):
         )
         if self.marker_pub is not None:
             self._publish_markers(frame)
+        if (
+            self.goal is not None
+            and self.peers
+            and self.goal not in self.closed_at
+            and tracked_frontier(self.frontiers, self.goal) is None
+        ):
+            # the frontier it heads for closed in its own costmap, whose obstacle layer clears
+            # and marks from its own laser; the merged map a peer's costmap reads may never
+            # show it (gmapping's map), and the peer then drove to it (office pair, seed 7:
+            # hunter2's last two desk-strip frontiers closed for it at 344 and 356 s, stayed
+            # open for hunter1, which drove 12 m to them at 392 s and ended the run at 468 s).
+            # Told to the peers as observed, as a view point stood at is
+            self.closed_at.append(self.goal)
+            self._publish_observed()
         field = None
         if p.view_points:
             field = path_distance_field(data, info.resolution, origin, robot, allow_unknown=True)
@@ -401,7 +437,7 @@ class Explore(Node):
             self._blacklist(goal)
         elif status == SUCCEEDED and self.params.view_points:
             self.stood_at.append((*goal, self.now()))  # what it sees from here is observed
-            self._publish_points(self.observed_pub, [(x, y) for x, y, _ in self.stood_at])
+            self._publish_observed()
         self.goal = None
         self._announce(None)
         self.runtime.call_later(0.0, self.make_plan)  # explore_lite replans on reaching a goal

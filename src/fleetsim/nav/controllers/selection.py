@@ -333,40 +333,16 @@ def _escape_choice(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: floa
     return best
 
 
-#: s: what the global costmap guard checks of a rollout beyond two control periods and the
-#: time to stop (at 0.1 m/s 2.5 cm, at 0.5 m/s 12 cm)
-GUARD_MARGIN = 0.25
-
-
 def _refused(tp: TrajectoryPlanner, index: int) -> bool:
     """Whether the global costmap guard (``global_costmap_check``, `global_guard`) refuses
-    rollout ``index``.
-
-    It checks the rollout only as far as the robot can go before a later cycle checks again
-    and still stop: two control periods, the time to brake from the sample's speeds and
-    ``GUARD_MARGIN``. The whole rollout (sim_time ahead) refused a hunter backing out of a
-    desk strip, whose first centimetres were clear, for the contact 0.1 m back, and pinned it
-    for 550 s (office seed 4); each cycle's check stops the robot short of the contact all
-    the same."""
+    rollout ``index`` (as far as `GlobalCostmapGuard.checked_poses` looks)."""
     guard = tp.global_guard
-    if guard is None:
-        return False
-    return guard.refuses(tp._poses[index, : _guard_steps(tp, index)])
-
-
-def _guard_steps(tp: TrajectoryPlanner, index: int) -> int:
-    """How many of rollout ``index``'s poses the guard checks (see `_refused`)."""
-    p = tp.params
-    n = max(int(tp._steps[index]), 1)
-    vx, vy, vth = tp._samples[index]
-    brake = max(math.hypot(vx, vy) / max(p.acc_lim_x, 1e-9), abs(vth) / max(p.acc_lim_theta, 1e-9))
-    horizon = 2.0 * tp.sim_period + brake + GUARD_MARGIN
-    return min(n, math.ceil(horizon / (p.sim_time / n)) + 1)
+    return guard is not None and guard.refuses(guard.checked_poses(tp, index))
 
 
 def _padding_way_out(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: float) -> int:
     """With every escape refused by the global costmap guard: the in-place rotation or forward
-    move illegal only because of the padding (its rollout, as far as `_refused` looks, keeps
+    move illegal only because of the padding (its rollout, as far as the guard looks, keeps
     the body itself off the lethal cells of both costmaps) that looks best by in-place
     rotation's rule (least goal distance ``heading_lookahead`` ahead); -1 if none.
 
@@ -393,7 +369,7 @@ def _padding_way_out(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: fl
             ahead = None if d is None else (d, 0)
         if ahead is None or (best_key is not None and ahead >= best_key):
             continue
-        if guard.body_clear(tp._poses[i, : _guard_steps(tp, i)]):
+        if guard.body_clear(guard.checked_poses(tp, i)):
             best, best_key = i, ahead
     return best
 

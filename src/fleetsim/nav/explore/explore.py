@@ -120,18 +120,11 @@ class Explore(Node):
         # what the peers tell it, by topic: their goals, blacklists and view points stood at
         self.peers = self._listen(geometry_msgs.PointStamped, p.peer_goals, _goal, None)
         self.peer_blacklists = self._listen(geometry_msgs.PoseArray, p.peer_blacklists, _points)
-        # the peers' observed points, each with the time it was first heard of: a peer
+        # the peers' observed points, each kept at the time it was first heard of: a peer
         # republishes its whole list, stamped anew, whenever the list grows
-        self.peer_stood_at: dict[str, list[tuple[float, float, float]]] = {
-            str(t): [] for t in p.peer_observed
-        }
-        for topic in self.peer_stood_at:
-            self.create_subscription(
-                geometry_msgs.PoseArray,
-                topic,
-                lambda m, t=topic: self._on_peer_observed(t, m),
-                1,
-            )
+        self.peer_stood_at = self._listen(
+            geometry_msgs.PoseArray, p.peer_observed, _stamped, [], merge=_first_heard
+        )
         _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now
         self.create_subscription(nav_msgs.OccupancyGrid, p.costmap_topic, self.on_costmap, 1)
         self.move_base = self.create_action_client(move_base_msgs.MoveBase, "move_base")
@@ -155,23 +148,22 @@ class Explore(Node):
         self.grid = msg
         self._grid_time = self.now()
 
-    def _listen(self, kind, topics, read, empty: Any = ()) -> dict[str, Any]:
+    def _listen(self, kind, topics, read, empty: Any = (), merge=None) -> dict[str, Any]:
         """Subscribe to each of ``topics``; the dict returned holds each one's latest message
-        as ``read`` gives it (``empty`` until one arrives)."""
+        as ``read`` gives it (``empty`` until one arrives), or ``merge(held, read(msg))``."""
         latest = {str(t): empty for t in topics}
+
+        def on(topic: str, msg: Any) -> None:
+            new = read(msg)
+            latest[topic] = new if merge is None else merge(latest[topic], new)
+
         for topic in latest:
-            self.create_subscription(
-                kind, topic, lambda m, t=topic: latest.__setitem__(t, read(m)), 1
-            )
+            self.create_subscription(kind, topic, lambda m, t=topic: on(t, m), 1)
         return latest
 
     def _publish_observed(self) -> None:
         stood = [(x, y) for x, y, _ in self.stood_at]
         self._publish_points(self.observed_pub, [*stood, *self.closed_at])
-
-    def _on_peer_observed(self, topic: str, msg: geometry_msgs.PoseArray) -> None:
-        heard = {(x, y): t for x, y, t in self.peer_stood_at[topic]}
-        self.peer_stood_at[topic] = [(x, y, heard.get((x, y), t)) for x, y, t in _stamped(msg)]
 
     def _blacklist(self, goal: tuple[float, float]) -> None:
         """Blacklist a goal and tell the peers (~blacklist)."""
@@ -471,6 +463,14 @@ def _stamped(msg: geometry_msgs.PoseArray) -> list[tuple[float, float, float]]:
     """The points with the message's time (sim s)."""
     t = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
     return [(x, y, t) for x, y in _points(msg)]
+
+
+def _first_heard(
+    held: list[tuple[float, float, float]], new: list[tuple[float, float, float]]
+) -> list[tuple[float, float, float]]:
+    """``new`` (x, y, t) points, each one already ``held`` at the time it was held with."""
+    heard = {(x, y): t for x, y, t in held}
+    return [(x, y, heard.get((x, y), t)) for x, y, t in new]
 
 
 def _goal(msg: geometry_msgs.PointStamped) -> tuple[float, float] | None:

@@ -87,3 +87,17 @@ def test_the_global_costmap_check_is_on_only_for_a_robot_on_its_own_slam_map():
         resolve_launch_file("hunter_run"), {"launch_nav_stack": "false", "launch_amcl": "true"}
     )
     assert amcl.param_tree().get(f"/{key}") is False
+
+
+def test_an_exploring_lizi_weighs_its_plan_direction_where_the_lessons_lizi_does_not():
+    key = "move_base/TrajectoryPlannerROS/alignment_scale"
+    # slam_explore's lizi, alone or paired: the alignment cost (and with it backing along the
+    # plan where it cannot turn), as the hunter's own file has it
+    assert plan(robot="lizi").param_tree().get(f"/lizi1/{key}") == 0.6
+    pair = plan(robot="lizi", robots="2").param_tree()
+    assert pair.get(f"/lizi1/{key}") == 0.6 and pair.get(f"/lizi2/{key}") == 0.6
+    assert plan().param_tree().get(f"/{key}") == 0.6  # the hunter's, from params/hunter
+    # the lesson's lizis keep their file as typed: no alignment cost
+    lesson = load_plan(resolve_launch_file("navigation_multi"), {}).param_tree()
+    assert lesson.get("/lizi1/move_base_node/TrajectoryPlannerROS/pdist_scale") == 0.6
+    assert lesson.get("/lizi1/move_base_node/TrajectoryPlannerROS/alignment_scale", None) is None

@@ -553,3 +553,61 @@ def test_velocity_samples_match_the_numpy_table_bit_for_bit():
         assert dvth == want_dvth
         assert sum(g.stop - g.start for g in groups.values()) == want.shape[0]
         assert groups["escape_turn"].stop == want.shape[0]
+
+
+def _lizi_along_a_wall(alignment_scale: float) -> tuple[list, bool]:
+    """The office's two-lizi wedge (seed 1), drawn: a room whose north wall (y >= 3.0) has a
+    1 m door at x 6-7; a lizi (the lesson's TrajectoryPlannerROS set) 0.22 m from that wall
+    at (4.0, 2.78), facing west along it, too near it to turn in place; its plan goes east
+    along the wall, then north through the door. Driven kinematically for 90 s; returns
+    the poses and whether the goal was reached."""
+    m = Costmap2D(160, 100, 0.05)
+    m.costs[60:62, :120] = 254  # the north wall, with the door at x 6.0-7.0
+    m.costs[60:62, 140:] = 254
+    m.costs[:62, :2] = 254  # the room's west wall
+    p = TrajectoryPlannerParams(
+        holonomic_robot=False, max_vel_x=0.5, min_vel_x=0.1, max_vel_theta=1.0,
+        min_in_place_vel_theta=0.4, acc_lim_theta=3.2, acc_lim_x=2.5, xy_goal_tolerance=0.2,
+        yaw_goal_tolerance=3.14, sim_time=1.5, vx_samples=6, vtheta_samples=20,
+        meter_scoring=True, pdist_scale=0.6, gdist_scale=0.8, occdist_scale=0.02,
+        dwa=True, alignment_scale=alignment_scale,
+    )  # fmt: skip
+    box = np.array([[-0.19, -0.16], [-0.19, 0.16], [0.19, 0.16], [0.19, -0.16]])
+    tp = TrajectoryPlanner(m, box, p)
+    east = [[x, 2.78, 0.0] for x in np.arange(4.0, 6.5, 0.05)]
+    north = [[6.5, y, math.pi / 2] for y in np.arange(2.78, 4.5, 0.05)]
+    tp.set_plan(np.array(east + north))
+    x, y, th, v, dt = 4.0, 2.78, math.pi, (0.0, 0.0, 0.0), 0.1
+    poses = []
+    for _ in range(900):
+        try:
+            cmd = tp.compute_velocity_commands((x, y, th), v)
+            v = (cmd.vx, 0.0, cmd.vtheta)
+        except NoValidTrajectory:
+            v = (0.0, 0.0, 0.0)
+        x += v[0] * math.cos(th) * dt
+        y += v[0] * math.sin(th) * dt
+        th += v[2] * dt
+        poses.append((x, y, th))
+        if tp.is_goal_reached():
+            return poses, True
+    return poses, False
+
+
+def test_a_robot_that_cannot_turn_backs_along_its_plan_rather_than_drive_away():
+    from fleetsim.nav.costmap.footprint import footprint_costs, outline_points
+
+    poses, reached = _lizi_along_a_wall(alignment_scale=0.6)
+    assert reached, poses[-1]
+    tp_box = np.array([[-0.19, -0.16], [-0.19, 0.16], [0.19, 0.16], [0.19, -0.16]])
+    m = Costmap2D(160, 100, 0.05)
+    m.costs[60:62, :120] = 254
+    m.costs[60:62, 140:] = 254
+    m.costs[:62, :2] = 254
+    fc = footprint_costs(m.costs, 0.0, 0.0, 0.05, outline_points(tp_box, 0.025), np.array(poses))
+    assert np.all(fc >= 0)  # it never drove its body onto the wall
+    assert min(p[0] for p in poses) > 3.9  # it never drove off west, away from its plan
+    # base_local_planner's choice (no alignment): any legal forward move first, so west along
+    # the wall into the corner, back 0.1 m, and west again
+    poses, reached = _lizi_along_a_wall(alignment_scale=0.0)
+    assert not reached and min(p[0] for p in poses) < 3.0

@@ -425,6 +425,10 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
                 best, best_cost = i, costs[i]
                 heading = ahead
     heading_dist = heading[0]
+    if best_cost >= 0 and _drives_away(tp, samples, best, pose, direction):
+        i = _escape_choice(tp, costs, g, dvth)
+        if i >= 0 and costs[i] >= 0:
+            return _escape(tp, costs, g, dvth, samples, pose, i)
     if best_cost >= 0:
         _bookkeep(tp, samples[best], pose)
         return tuple(samples[best]), float(best_cost), best
@@ -450,6 +454,33 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
             return (0.0, 0.0, 0.0), -1.0, g["escape"].start
         _bookkeep(tp, samples[j], pose)
         return tuple(samples[j]), 1.0, j
+    return _escape(tp, costs, g, dvth, samples, pose, i)
+
+
+def _drives_away(tp: TrajectoryPlanner, samples: np.ndarray, best: int, pose, direction) -> bool:
+    """With alignment: whether the chosen sample drives forward away from the plan, the
+    robot facing more than a quarter turn off the path's direction and its rollout not
+    turning it within a quarter turn of it (no in-place rotation was legal, or cheaper).
+
+    Departure from base_local_planner, which takes any legal forward rollout before backing
+    up. A lizi that had come along a room's wall, its centre 0.25 m from it (the
+    circumscribed radius: no room to turn in place), with its plan turning back through the
+    door behind it, drove 2 m forward along the wall into the room's corner, backed out
+    0.5 m, and did so again for 1000 s (office, two lizis, seed 1). Backing along the plan,
+    while the backward rollout is legal, until a rotation toward it is legal
+    (`_escape_can_turn`) turns it round where there is room."""
+    if direction is None or not samples[best, 0] > 0:
+        return False
+    quarter = 0.5 * math.pi
+    return (
+        abs(_wrap(pose[2] - direction)) > quarter
+        and _least_heading_error(tp, best, direction) > quarter
+    )
+
+
+def _escape(tp: TrajectoryPlanner, costs, g: dict, dvth: float, samples, pose, i: int):
+    """Take escape sample ``i`` (`_escape_choice`): enter or keep escape mode, end it when
+    clear; returns the sample, its cost (1.0 for a blind one) and ``i``."""
     cost = float(costs[i])
     x, y, th = pose
     if math.hypot(x - tp.prev[0], y - tp.prev[1]) > tp.params.oscillation_reset_dist:

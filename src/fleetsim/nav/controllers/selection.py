@@ -7,7 +7,9 @@ flags (``stuck_left`` / ``stuck_right`` ...) and escape mode, kept on the planne
 With ``alignment_scale`` > 0 (a fleetsim addition, off by default) rotations and escapes also
 weigh the path's direction (`path_heading`): an in-place rotation whose look-ahead lands on an
 obstacle is judged by how near it comes to that direction, and an escaping robot turns only
-toward it, else backs on (`_escape_can_turn`). With 0 every choice is base_local_planner's.
+toward it, else backs on (`_escape_can_turn`); and a robot facing away from its plan turns
+toward it where it can turn all the way, else backs along it (`_toward_the_plan`). With 0
+every choice is base_local_planner's.
 """
 
 from __future__ import annotations
@@ -17,6 +19,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
+
+from fleetsim.nav.costmap.footprint import footprint_costs
 
 if TYPE_CHECKING:
     from fleetsim.nav.controllers.trajectory_planner import TrajectoryPlanner
@@ -291,7 +295,9 @@ def _bookkeep(tp: TrajectoryPlanner, sample, pose) -> None:
     _end_escape_when_clear(tp, x, y, th)
 
 
-def _escape_choice(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: float) -> int:
+def _escape_choice(
+    tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: float, clear=None
+) -> int:
     """The escape sample: ROS's straight back-up, or a legal back-up that turns the robot
     to face the way to the goal better (chosen by in-place rotation's rule: the least goal
     distance a heading_lookahead ahead of the rollout's end).
@@ -304,7 +310,8 @@ def _escape_choice(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: floa
     direction decides.
 
     Rollouts the global costmap guard refuses (`global_guard`) are passed over; -1 when it
-    refuses every one."""
+    refuses every one. With ``clear`` (a test of a sample's index) only legal back-ups it
+    passes count, the straight one too; -1 when none does."""
     direction = path_heading(tp, tp._poses[g["escape"].start, 0]) if _aligning(tp) else None
 
     def key(i: int):
@@ -321,11 +328,11 @@ def _escape_choice(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: floa
 
     best = g["escape"].start
     best_key = key(best) if costs[best] >= 0 else None
-    if _refused(tp, best):
+    if _refused(tp, best) or (clear is not None and (best_key is None or not clear(best))):
         best, best_key = -1, None
     raw = tp._in_place_raw
     for k, i in enumerate(range(g["escape_turn"].start, g["escape_turn"].stop)):
-        if costs[i] < 0 or -dvth <= raw[k] <= dvth:
+        if costs[i] < 0 or -dvth <= raw[k] <= dvth or (clear is not None and not clear(i)):
             continue
         ki = key(i)
         if ki is not None and (best_key is None or ki < best_key) and not _refused(tp, i):
@@ -425,10 +432,9 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
                 best, best_cost = i, costs[i]
                 heading = ahead
     heading_dist = heading[0]
-    if best_cost >= 0 and _drives_away(tp, samples, best, pose, direction):
-        i = _escape_choice(tp, costs, g, dvth)
-        if i >= 0 and costs[i] >= 0:
-            return _escape(tp, costs, g, dvth, samples, pose, i)
+    if best_cost >= 0 and _facing_away(pose, direction):
+        best = _toward_the_plan(tp, samples, costs, g, dvth, pose, direction, best)
+        best_cost = costs[best]
     if best_cost >= 0:
         _bookkeep(tp, samples[best], pose)
         return tuple(samples[best]), float(best_cost), best
@@ -457,25 +463,97 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
     return _escape(tp, costs, g, dvth, samples, pose, i)
 
 
-def _drives_away(tp: TrajectoryPlanner, samples: np.ndarray, best: int, pose, direction) -> bool:
-    """With alignment: whether the chosen sample drives forward away from the plan, the
-    robot facing more than a quarter turn off the path's direction and its rollout not
-    turning it within a quarter turn of it (no in-place rotation was legal, or cheaper).
+def _facing_away(pose, direction: float | None) -> bool:
+    """With alignment: whether the robot faces more than a quarter turn off the path's
+    direction (see `_toward_the_plan`)."""
+    return direction is not None and abs(_wrap(pose[2] - direction)) > 0.5 * math.pi
 
-    Departure from base_local_planner, which takes any legal forward rollout before backing
-    up. A lizi that had come along a room's wall, its centre 0.25 m from it (the
-    circumscribed radius: no room to turn in place), with its plan turning back through the
+
+def _toward_the_plan(
+    tp: TrajectoryPlanner, samples, costs, g: dict, dvth: float, pose, direction: float, best: int
+) -> int:
+    """For a robot facing away from its plan (`_facing_away`), in place of ``best``,
+    base_local_planner's choice, when that is a forward move that does not turn it within a
+    quarter turn of the path's direction or an in-place rotation the way it cannot turn all
+    the way (`_turn_room`): where it can turn all the way, the legal in-place rotation that
+    way that looks best (in-place rotation's rule); else the back-up that looks best by the
+    escape's rule (`_escape_choice`) among those that bring its centre no nearer an obstacle
+    (`_no_nearer`). ``best`` when there is neither, or it needs no replacing.
+
+    Departure from base_local_planner, which takes any legal forward rollout before turning
+    or backing up. A lizi that had come along a room's wall, its centre 0.25 m from it (the
+    circumscribed radius: no room to turn in place), with its plan going back through the
     door behind it, drove 2 m forward along the wall into the room's corner, backed out
-    0.5 m, and did so again for 1000 s (office, two lizis, seed 1). Backing along the plan,
-    while the backward rollout is legal, until a rotation toward it is legal
-    (`_escape_can_turn`) turns it round where there is room."""
-    if direction is None or not samples[best, 0] > 0:
-        return False
+    0.5 m, and did so again for 1000 s (office, two lizis, seed 1). Backing along the plan
+    until it can turn all the way toward it turns it round where there is room; stopping
+    where the first rollout of a turn is legal, it turns a little, at a door's post, and
+    backs again, to and fro. A back-up that brings it nearer the wall is not taken: the
+    footprint check lets the outline sit on the cell next to a wall's, and a lizi backing
+    along a corridor wall at a slant scraped it (office, one lizi, seed 1)."""
+    vx, vy, vth = samples[best]
     quarter = 0.5 * math.pi
-    return (
-        abs(_wrap(pose[2] - direction)) > quarter
-        and _least_heading_error(tp, best, direction) > quarter
-    )
+    turning = vx == 0.0 and vy == 0.0 and vth != 0.0
+    if not turning and not (vx > 0.0 and _least_heading_error(tp, best, direction) > quarter):
+        return best
+    way = _turn_room(tp, pose, direction)
+    if turning and way and (vth > 0) == (way > 0):
+        return best
+    if way:
+        raw = tp._in_place_raw
+        chosen, chosen_key = -1, None
+        for k, i in enumerate(range(g["in_place"].start, g["in_place"].stop)):
+            v = raw[k]
+            if costs[i] < 0 or -dvth <= v <= dvth or (v > 0) != (way > 0):
+                continue
+            ahead = _ahead_goal_dist_turning(tp, i)
+            if ahead is None:
+                continue
+            key = (min(ahead[0], float(tp.goal_dist.size)), _least_heading_error(tp, i, direction))
+            if (chosen_key is None or key < chosen_key) and not _refused(tp, i):
+                chosen, chosen_key = i, key
+        if chosen >= 0:
+            return chosen
+    i = _escape_choice(tp, costs, g, dvth, clear=lambda i: _no_nearer(tp, i, pose))
+    return best if i < 0 else i
+
+
+def _no_nearer(tp: TrajectoryPlanner, index: int, pose) -> bool:
+    """Whether rollout ``index`` keeps the robot's centre on cells of no higher cost than
+    the one it is on (inflation falls with the distance from obstacles) all along."""
+    m = tp.costmap
+    n = max(int(tp._steps[index]), 1)
+    poses = tp._poses[index, :n]
+    cx = np.floor((poses[:, 0] - m.origin_x) / m.resolution).astype(np.int64)
+    cy = np.floor((poses[:, 1] - m.origin_y) / m.resolution).astype(np.int64)
+    h, w = m.costs.shape
+    if cx.min() < 0 or cy.min() < 0 or cx.max() >= w or cy.max() >= h:
+        return False
+    here = m.costs[
+        math.floor((pose[1] - m.origin_y) / m.resolution),
+        math.floor((pose[0] - m.origin_x) / m.resolution),
+    ]
+    return bool(np.all(m.costs[cy, cx] <= here))
+
+
+#: rad: the heading step of `_turn_room`'s check
+TURN_STEP = 0.05
+
+
+def _turn_room(tp: TrajectoryPlanner, pose, direction: float) -> int:
+    """Which way the robot can turn in place from its heading to ``direction`` with its
+    footprint legal on the local costmap all the way: +1 (counter-clockwise) or -1, the
+    shorter way first; 0 when neither."""
+    m = tp.costmap
+    x, y, th = pose
+    short = _wrap(direction - th)
+    for turn in (short, short - math.copysign(2.0 * math.pi, short)):
+        n = max(math.ceil(abs(turn) / TURN_STEP), 1)
+        headings = th + turn * np.arange(1, n + 1) / n
+        poses = np.column_stack([np.full(n, x), np.full(n, y), headings])
+        fc = footprint_costs(m.costs, m.origin_x, m.origin_y, m.resolution, tp.outline, poses)
+        if np.all(fc >= 0):
+            return 1 if turn > 0 else -1
+    return 0
 
 
 def _escape(tp: TrajectoryPlanner, costs, g: dict, dvth: float, samples, pose, i: int):

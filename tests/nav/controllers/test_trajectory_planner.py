@@ -556,7 +556,7 @@ def test_velocity_samples_match_the_numpy_table_bit_for_bit():
 
 
 def _lizi_along_a_wall(
-    alignment_scale: float, th0: float = math.pi, y0: float = 2.78
+    alignment_scale: float, th0: float = math.pi, y0: float = 2.78, steps: int = 900, post=None
 ) -> tuple[list, bool]:
     """The office's two-lizi wedge (seed 1), drawn: a room whose north wall (y >= 3.0) has a
     1 m door at x 6-7; a lizi (the lesson's TrajectoryPlannerROS set) 0.22 m from that wall
@@ -568,6 +568,8 @@ def _lizi_along_a_wall(
     m.costs[60:62, :120] = 254  # the north wall, with the door at x 6.0-7.0
     m.costs[60:62, 140:] = 254
     m.costs[:62, :2] = 254  # the room's west wall
+    if post is not None:  # a post at x = post (m), along the wall, 0.3 m deep
+        m.costs[54:60, int(post / 0.05) : int(post / 0.05) + 2] = 254
     p = TrajectoryPlannerParams(
         holonomic_robot=False, max_vel_x=0.5, min_vel_x=0.1, max_vel_theta=1.0,
         min_in_place_vel_theta=0.4, acc_lim_theta=3.2, acc_lim_x=2.5, xy_goal_tolerance=0.2,
@@ -582,7 +584,7 @@ def _lizi_along_a_wall(
     tp.set_plan(np.array(east + north))
     x, y, th, v, dt = 4.0, y0, th0, (0.0, 0.0, 0.0), 0.1
     poses = []
-    for _ in range(900):
+    for _ in range(steps):
         try:
             cmd = tp.compute_velocity_commands((x, y, th), v)
             v = (cmd.vx, 0.0, cmd.vtheta)
@@ -597,23 +599,25 @@ def _lizi_along_a_wall(
     return poses, False
 
 
-def test_a_robot_that_cannot_turn_backs_along_its_plan_rather_than_drive_away():
+def _past_the_wall(poses) -> float:
+    """m, how far `_lizi_along_a_wall`'s lizi reached past the north wall's face (y = 3.0),
+    beside the door excepted."""
     box = np.array([[-0.19, -0.16], [-0.19, 0.16], [0.19, 0.16], [0.19, -0.16]])
+    worst = -np.inf
+    for x, y, th in poses:
+        if 5.75 < x < 7.25:
+            continue
+        c, s = math.cos(th), math.sin(th)
+        worst = max(worst, max(y + s * bx + c * by for bx, by in box) - 3.0)
+    return worst
 
-    def overlap(poses):  # m, how far the body reaches past the north wall's face, y = 3.0
-        worst = -np.inf
-        for x, y, th in poses:
-            if 5.75 < x < 7.25:  # beside the door, where there is no wall
-                continue
-            c, s = math.cos(th), math.sin(th)
-            worst = max(worst, max(y + s * bx + c * by for bx, by in box) - 3.0)
-        return worst
 
+def test_a_robot_that_cannot_turn_backs_along_its_plan_rather_than_drive_away():
     poses, reached = _lizi_along_a_wall(alignment_scale=0.6)
     assert reached, poses[-1]
     # its body kept off the wall (the outline may sit on the cell next to it, as ROS's
     # footprint check allows; a millimetre between the rollout and this integration)
-    assert overlap(poses) < 0.005
+    assert _past_the_wall(poses) < 0.005
     assert min(p[0] for p in poses) > 3.9  # it never drove off west, away from its plan
     # base_local_planner's choice (no alignment): any legal forward move first, so west along
     # the wall into the corner, back 0.1 m, and west again
@@ -627,3 +631,15 @@ def test_a_robot_facing_away_along_a_wall_turns_round_where_it_has_room(th0, y0)
     along the plan to the door, where it turns round, and goes through, well within 30 s."""
     poses, reached = _lizi_along_a_wall(alignment_scale=0.6, th0=th0, y0=3.0 - y0)
     assert reached and len(poses) < 300, poses[-1]
+    assert _past_the_wall(poses) < 0.005  # backing toward the wall at a slant, it kept off
+
+
+def test_a_robot_facing_away_with_no_room_behind_drives_on_as_ros_does():
+    """A post 0.25 m behind the lizi (its back 0.06 m from it): no back-up is legal, so
+    base_local_planner's forward move stands, and keeps standing until the robot is 0.5 m
+    away (backing a few centimetres and driving as far forward by turns held a lizi for
+    240 s in the office's corridor end, seed 1)."""
+    poses, _ = _lizi_along_a_wall(alignment_scale=0.6, post=4.25, steps=60)
+    xs = [p[0] for p in poses]
+    assert max(xs) <= 4.0 + 1e-6  # never backed
+    assert xs[-1] < 3.6  # drove on west, 0.4 m or more in 6 s

@@ -295,9 +295,7 @@ def _bookkeep(tp: TrajectoryPlanner, sample, pose) -> None:
     _end_escape_when_clear(tp, x, y, th)
 
 
-def _escape_choice(
-    tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: float, clear=None
-) -> int:
+def _escape_choice(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: float) -> int:
     """The escape sample: ROS's straight back-up, or a legal back-up that turns the robot
     to face the way to the goal better (chosen by in-place rotation's rule: the least goal
     distance a heading_lookahead ahead of the rollout's end).
@@ -310,34 +308,35 @@ def _escape_choice(
     direction decides.
 
     Rollouts the global costmap guard refuses (`global_guard`) are passed over; -1 when it
-    refuses every one. With ``clear`` (a test of a sample's index) only legal back-ups it
-    passes count, the straight one too; -1 when none does."""
+    refuses every one."""
     direction = path_heading(tp, tp._poses[g["escape"].start, 0]) if _aligning(tp) else None
-
-    def key(i: int):
-        ahead = _ahead_goal_dist(tp, i)
-        if ahead is None:
-            return None
-        if direction is None:
-            return (ahead,)
-        # with alignment: a look-ahead onto an obstacle tells the headings nothing apart, the
-        # heading at the end against the path's direction does
-        n = max(int(tp._steps[i]), 1)
-        size = float(tp.goal_dist.size)
-        return (min(ahead, size), abs(_wrap(tp._poses[i, n - 1, 2] - direction)))
-
     best = g["escape"].start
-    best_key = key(best) if costs[best] >= 0 else None
-    if _refused(tp, best) or (clear is not None and (best_key is None or not clear(best))):
+    best_key = _escape_key(tp, best, direction) if costs[best] >= 0 else None
+    if _refused(tp, best):
         best, best_key = -1, None
     raw = tp._in_place_raw
     for k, i in enumerate(range(g["escape_turn"].start, g["escape_turn"].stop)):
-        if costs[i] < 0 or -dvth <= raw[k] <= dvth or (clear is not None and not clear(i)):
+        if costs[i] < 0 or -dvth <= raw[k] <= dvth:
             continue
-        ki = key(i)
+        ki = _escape_key(tp, i, direction)
         if ki is not None and (best_key is None or ki < best_key) and not _refused(tp, i):
             best, best_key = i, ki
     return best
+
+
+def _escape_key(tp: TrajectoryPlanner, i: int, direction: float | None):
+    """How `_escape_choice` ranks back-up ``i`` (least first); None when its look-ahead is
+    off the map."""
+    ahead = _ahead_goal_dist(tp, i)
+    if ahead is None:
+        return None
+    if direction is None:
+        return (ahead,)
+    # with alignment: a look-ahead onto an obstacle tells the headings nothing apart, the
+    # heading at the end against the path's direction does
+    n = max(int(tp._steps[i]), 1)
+    size = float(tp.goal_dist.size)
+    return (min(ahead, size), abs(_wrap(tp._poses[i, n - 1, 2] - direction)))
 
 
 def _refused(tp: TrajectoryPlanner, index: int) -> bool:
@@ -399,6 +398,12 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
     samples, g, dvth = velocity_samples(tp, pose, vel)
     costs = tp._score(samples, pose, vel)
     best, best_cost = -1, -1.0
+    direction = path_heading(tp, pose) if _aligning(tp) else None
+    if tp.backing_from is not None:
+        i = _backing_on(tp, costs, g, dvth, pose, direction)
+        if i >= 0:
+            _bookkeep(tp, samples[i], pose)
+            return tuple(samples[i]), float(costs[i]), i
 
     if not tp.escaping:  # the first sample of least legal cost among forward and strafe
         first = costs[g["forward"].start : g["strafe"].stop]
@@ -411,7 +416,6 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
             legal[i - g["forward"].start] = False  # the next best, as if this one were illegal
     heading: tuple = (math.inf, 0)  # rotations: (goal distance, step) ahead
     raw = tp._in_place_raw
-    direction = path_heading(tp, pose) if _aligning(tp) else None
     size = float(tp.goal_dist.size)
     for k, i in enumerate(range(g["in_place"].start, g["in_place"].stop)):
         v = raw[k]
@@ -432,9 +436,11 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
                 best, best_cost = i, costs[i]
                 heading = ahead
     heading_dist = heading[0]
-    if best_cost >= 0 and _facing_away(pose, direction):
-        best = _toward_the_plan(tp, samples, costs, g, dvth, pose, direction, best)
-        best_cost = costs[best]
+    if best_cost >= 0 and _facing_away(pose, direction) and not _blocked_here(tp, pose):
+        i = _toward_the_plan(tp, samples, costs, g, dvth, pose, direction, best)
+        if i != best and samples[i, 0] < 0:
+            tp.backing_from = (pose[0], pose[1])
+        best, best_cost = i, costs[i]
     if best_cost >= 0:
         _bookkeep(tp, samples[best], pose)
         return tuple(samples[best]), float(best_cost), best
@@ -513,26 +519,90 @@ def _toward_the_plan(
                 chosen, chosen_key = i, key
         if chosen >= 0:
             return chosen
-    i = _escape_choice(tp, costs, g, dvth, clear=lambda i: _no_nearer(tp, i, pose))
-    return best if i < 0 else i
+    i = _clearest_back_up(tp, costs, g, dvth)
+    if i < 0:
+        tp.backing_blocked_at = (pose[0], pose[1])
+        return best
+    return i
 
 
-def _no_nearer(tp: TrajectoryPlanner, index: int, pose) -> bool:
-    """Whether rollout ``index`` keeps the robot's centre on cells of no higher cost than
-    the one it is on (inflation falls with the distance from obstacles) all along."""
-    m = tp.costmap
-    n = max(int(tp._steps[index]), 1)
-    poses = tp._poses[index, :n]
-    cx = np.floor((poses[:, 0] - m.origin_x) / m.resolution).astype(np.int64)
-    cy = np.floor((poses[:, 1] - m.origin_y) / m.resolution).astype(np.int64)
-    h, w = m.costs.shape
-    if cx.min() < 0 or cy.min() < 0 or cx.max() >= w or cy.max() >= h:
+#: m: how far a robot facing away from its plan backs along it at most in one go
+BACKING_ROOM = 3.0
+
+
+def _backing_on(tp: TrajectoryPlanner, costs, g: dict, dvth: float, pose, direction) -> int:
+    """For a robot backing along its plan (``backing_from``, set by `_toward_the_plan`): the
+    back-up to go on with (`_clearest_back_up`), or -1 (and the backing ends) once it faces
+    the plan, can turn all the way to it (`_turn_room`), has backed ``BACKING_ROOM`` m, or
+    has no legal back-up. Backing a cycle at a time and deciding afresh, the robot went back
+    and forth a centimetre a cycle between the forward move and the back-up (office, two
+    lizis, seed 1, in a door)."""
+    bx, by = tp.backing_from
+    if (
+        not _facing_away(pose, direction)
+        or math.hypot(pose[0] - bx, pose[1] - by) > BACKING_ROOM
+        or _turn_room(tp, pose, direction)
+    ):
+        tp.backing_from = None
+        return -1
+    i = _clearest_back_up(tp, costs, g, dvth)
+    if i < 0:
+        tp.backing_from = None
+        tp.backing_blocked_at = (pose[0], pose[1])
+    return i
+
+
+#: m: how far a robot whose backing along its plan was blocked moves base_local_planner's
+#: way before it backs along its plan again
+BLOCKED_ROOM = 0.5
+
+
+def _blocked_here(tp: TrajectoryPlanner, pose) -> bool:
+    """Whether backing along the plan was blocked within ``BLOCKED_ROOM`` of the robot: then
+    base_local_planner's choice stands. In a corner with no room behind (office, one lizi,
+    seed 1: the west end of the corridor), backing 2 cm and driving 2 cm forward by turns
+    held a lizi for 240 s; driving on base_local_planner's way it turns round where there is
+    room."""
+    at = tp.backing_blocked_at
+    if at is None:
         return False
-    here = m.costs[
-        math.floor((pose[1] - m.origin_y) / m.resolution),
-        math.floor((pose[0] - m.origin_x) / m.resolution),
+    if math.hypot(pose[0] - at[0], pose[1] - at[1]) > BLOCKED_ROOM:
+        tp.backing_blocked_at = None
+        return False
+    return True
+
+
+def _clearest_back_up(tp: TrajectoryPlanner, costs, g: dict, dvth: float) -> int:
+    """Among the legal back-ups (straight, or turning as the escape's), the one whose
+    rollout keeps the robot's centre on the cheapest cells (the highest inflation cost it
+    meets: inflation falls with the distance from obstacles), then as the escape ranks them
+    (`_escape_choice`); -1 when none is legal. The footprint check lets the outline sit on the
+    cell next to a wall's: a lizi backing straight along a corridor wall at a slant scraped it
+    (office, one lizi, seed 1), where a back-up that turns parallel to it keeps clear."""
+    m = tp.costmap
+    h, w = m.costs.shape
+    candidates = [g["escape"].start] + [
+        i
+        for k, i in enumerate(range(g["escape_turn"].start, g["escape_turn"].stop))
+        if not -dvth <= tp._in_place_raw[k] <= dvth
     ]
-    return bool(np.all(m.costs[cy, cx] <= here))
+    direction = path_heading(tp, tp._poses[g["escape"].start, 0])
+    best, best_key = -1, None
+    for i in candidates:
+        if costs[i] < 0 or _refused(tp, i):
+            continue
+        n = max(int(tp._steps[i]), 1)
+        cx = np.floor((tp._poses[i, :n, 0] - m.origin_x) / m.resolution).astype(np.int64)
+        cy = np.floor((tp._poses[i, :n, 1] - m.origin_y) / m.resolution).astype(np.int64)
+        if cx.min() < 0 or cy.min() < 0 or cx.max() >= w or cy.max() >= h:
+            continue
+        rank = _escape_key(tp, i, direction)
+        if rank is None:
+            continue
+        key = (int(m.costs[cy, cx].max()), rank)
+        if best_key is None or key < best_key:
+            best, best_key = i, key
+    return best
 
 
 #: rad: the heading step of `_turn_room`'s check

@@ -113,6 +113,11 @@ class TrajectoryPlanner(LocalPlanner):
         self.escaping = False
         self.prev = (0.0, 0.0)
         self.escape_pose = (0.0, 0.0, 0.0)
+        #: (x, y) where a robot facing away from its plan began backing along it, or None
+        #: (selection's `_toward_the_plan`, with alignment)
+        self.backing_from: tuple[float, float] | None = None
+        #: (x, y) where such backing found no legal back-up, or None
+        self.backing_blocked_at: tuple[float, float] | None = None
         self._sample_layout: tuple | None = None  # see selection.velocity_samples
         #: a `GlobalCostmapGuard` (move_base sets it with ``global_costmap_check``), or None
         self.global_guard = None
@@ -159,6 +164,7 @@ class TrajectoryPlanner(LocalPlanner):
             # goal keeps them.
             self.reached_goal = False
             self.xy_tolerance_latch = False
+            self.backing_from = self.backing_blocked_at = None
 
     def is_goal_reached(self) -> bool:
         return self.reached_goal

@@ -469,10 +469,18 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
     return _escape(tp, costs, g, dvth, samples, pose, i)
 
 
-def _facing_away(pose, direction: float | None) -> bool:
-    """With alignment: whether the robot faces more than a quarter turn off the path's
-    direction (see `_toward_the_plan`)."""
-    return direction is not None and abs(_wrap(pose[2] - direction)) > 0.5 * math.pi
+#: rad: a robot this far off the path's direction faces away from its plan (and backs along
+#: it, `_toward_the_plan`), until it is less than a quarter turn off (`_backing_on`)
+FACING_AWAY = 2.0 * math.pi / 3.0
+
+
+def _facing_away(pose, direction: float | None, limit: float = FACING_AWAY) -> bool:
+    """With alignment: whether the robot faces more than ``limit`` off the path's direction
+    (see `_toward_the_plan`). The band between a quarter turn and ``FACING_AWAY`` keeps a
+    robot square to its plan from alternating: with one limit, a quarter turn, a lizi across
+    the corridor's end (office, one lizi, seed 1) backed 2 cm, crossed it, drove 2 cm forward,
+    and did so again for 240 s."""
+    return direction is not None and abs(_wrap(pose[2] - direction)) > limit
 
 
 def _toward_the_plan(
@@ -481,7 +489,7 @@ def _toward_the_plan(
     """For a robot facing away from its plan (`_facing_away`), in place of ``best``,
     base_local_planner's choice, when that is a forward move that does not turn it within a
     quarter turn of the path's direction or an in-place rotation the way it cannot turn all
-    the way (`_turn_room`): where it can turn all the way, the legal in-place rotation that
+    the way (`_turning_way`): where it can turn all the way, the legal in-place rotation that
     way that looks best (in-place rotation's rule); else the back-up that looks best by the
     escape's rule (`_escape_choice`) among those that bring its centre no nearer an obstacle
     (`_no_nearer`). ``best`` when there is neither, or it needs no replacing.
@@ -501,24 +509,11 @@ def _toward_the_plan(
     turning = vx == 0.0 and vy == 0.0 and vth != 0.0
     if not turning and not (vx > 0.0 and _least_heading_error(tp, best, direction) > quarter):
         return best
-    way = _turn_room(tp, pose, direction)
+    way, rotation = _turning_way(tp, costs, g, dvth, pose, direction)
     if turning and way and (vth > 0) == (way > 0):
         return best
     if way:
-        raw = tp._in_place_raw
-        chosen, chosen_key = -1, None
-        for k, i in enumerate(range(g["in_place"].start, g["in_place"].stop)):
-            v = raw[k]
-            if costs[i] < 0 or -dvth <= v <= dvth or (v > 0) != (way > 0):
-                continue
-            ahead = _ahead_goal_dist_turning(tp, i)
-            if ahead is None:
-                continue
-            key = (min(ahead[0], float(tp.goal_dist.size)), _least_heading_error(tp, i, direction))
-            if (chosen_key is None or key < chosen_key) and not _refused(tp, i):
-                chosen, chosen_key = i, key
-        if chosen >= 0:
-            return chosen
+        return rotation
     i = _clearest_back_up(tp, costs, g, dvth)
     if i < 0:
         tp.backing_blocked_at = (pose[0], pose[1])
@@ -533,15 +528,15 @@ BACKING_ROOM = 3.0
 def _backing_on(tp: TrajectoryPlanner, costs, g: dict, dvth: float, pose, direction) -> int:
     """For a robot backing along its plan (``backing_from``, set by `_toward_the_plan`): the
     back-up to go on with (`_clearest_back_up`), or -1 (and the backing ends) once it faces
-    the plan, can turn all the way to it (`_turn_room`), has backed ``BACKING_ROOM`` m, or
+    the plan, can turn all the way to it (`_turning_way`), has backed ``BACKING_ROOM`` m, or
     has no legal back-up. Backing a cycle at a time and deciding afresh, the robot went back
     and forth a centimetre a cycle between the forward move and the back-up (office, two
     lizis, seed 1, in a door)."""
     bx, by = tp.backing_from
     if (
-        not _facing_away(pose, direction)
+        not _facing_away(pose, direction, 0.5 * math.pi)
         or math.hypot(pose[0] - bx, pose[1] - by) > BACKING_ROOM
-        or _turn_room(tp, pose, direction)
+        or _turning_way(tp, costs, g, dvth, pose, direction)[0]
     ):
         tp.backing_from = None
         return -1
@@ -605,25 +600,50 @@ def _clearest_back_up(tp: TrajectoryPlanner, costs, g: dict, dvth: float) -> int
     return best
 
 
+def _turning_way(tp: TrajectoryPlanner, costs, g: dict, dvth: float, pose, direction: float):
+    """The way the robot turns toward the path's direction, and the in-place rotation to do
+    it with: a way a full turn is legal (`_turn_room`) in which some in-place rotation's
+    rollout is legal too, the one that looks best by in-place rotation's rule; (0, -1) when
+    there is none (a full turn can be legal where every rollout of the sampled rates, 0.6 rad
+    or more, overshoots into an obstacle: turning that way would never start)."""
+    raw = tp._in_place_raw
+    for way in _turn_room(tp, pose, direction):
+        chosen, chosen_key = -1, None
+        for k, i in enumerate(range(g["in_place"].start, g["in_place"].stop)):
+            v = raw[k]
+            if costs[i] < 0 or -dvth <= v <= dvth or (v > 0) != (way > 0):
+                continue
+            ahead = _ahead_goal_dist_turning(tp, i)
+            if ahead is None:
+                continue
+            key = (min(ahead[0], float(tp.goal_dist.size)), _least_heading_error(tp, i, direction))
+            if (chosen_key is None or key < chosen_key) and not _refused(tp, i):
+                chosen, chosen_key = i, key
+        if chosen >= 0:
+            return way, chosen
+    return 0, -1
+
+
 #: rad: the heading step of `_turn_room`'s check
 TURN_STEP = 0.05
 
 
-def _turn_room(tp: TrajectoryPlanner, pose, direction: float) -> int:
-    """Which way the robot can turn in place from its heading to ``direction`` with its
-    footprint legal on the local costmap all the way: +1 (counter-clockwise) or -1, the
-    shorter way first; 0 when neither."""
+def _turn_room(tp: TrajectoryPlanner, pose, direction: float) -> list[int]:
+    """The ways the robot can turn in place from its heading to ``direction`` with its
+    footprint legal on the local costmap all the way: +1 (counter-clockwise), -1, the
+    shorter way first."""
     m = tp.costmap
     x, y, th = pose
     short = _wrap(direction - th)
+    ways = []
     for turn in (short, short - math.copysign(2.0 * math.pi, short)):
         n = max(math.ceil(abs(turn) / TURN_STEP), 1)
         headings = th + turn * np.arange(1, n + 1) / n
         poses = np.column_stack([np.full(n, x), np.full(n, y), headings])
         fc = footprint_costs(m.costs, m.origin_x, m.origin_y, m.resolution, tp.outline, poses)
         if np.all(fc >= 0):
-            return 1 if turn > 0 else -1
-    return 0
+            ways.append(1 if turn > 0 else -1)
+    return ways
 
 
 def _escape(tp: TrajectoryPlanner, costs, g: dict, dvth: float, samples, pose, i: int):

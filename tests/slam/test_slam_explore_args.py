@@ -97,6 +97,10 @@ def test_an_exploring_lizi_weighs_its_plan_direction_where_the_lessons_lizi_does
     pair = plan(robot="lizi", robots="2").param_tree()
     assert pair.get(f"/lizi1/{key}") == 0.6 and pair.get(f"/lizi2/{key}") == 0.6
     assert plan().param_tree().get(f"/{key}") == 0.6  # the hunter's, from params/hunter
+    back = "move_base/TrajectoryPlannerROS/back_along_plan"
+    assert plan(robot="lizi").param_tree().get(f"/lizi1/{back}") is True
+    assert pair.get(f"/lizi1/{back}") is True and pair.get(f"/lizi2/{back}") is True
+    assert plan().param_tree().get(f"/{back}", None) is None  # the hunter: ROS's choice
     # the lesson's lizis keep their file as typed: no alignment cost
     lesson = load_plan(resolve_launch_file("navigation_multi"), {}).param_tree()
     assert lesson.get("/lizi1/move_base_node/TrajectoryPlannerROS/pdist_scale") == 0.6

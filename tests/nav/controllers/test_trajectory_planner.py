@@ -556,9 +556,10 @@ def test_velocity_samples_match_the_numpy_table_bit_for_bit():
 
 
 def _lizi_along_a_wall(
-    alignment_scale: float, th0: float = math.pi, y0: float = 2.78, steps: int = 900, post=None
+    back_along_plan: bool, th0: float = math.pi, y0: float = 2.78, steps: int = 900, post=None
 ) -> tuple[list, bool]:
-    """The office's two-lizi wedge (seed 1), drawn: a room whose north wall (y >= 3.0) has a
+    """The office's two-lizi wedge (seed 1), drawn (the lizi's slam_explore set, alignment
+    cost included, with ``back_along_plan`` or without): a room whose north wall (y >= 3.0) has a
     1 m door at x 6-7; a lizi (the lesson's TrajectoryPlannerROS set) 0.22 m from that wall
     at (4.0, 2.78), facing west along it (``th0``, ``y0``: another heading or distance),
     too near it to turn in place; its plan goes east along the wall, then north through the
@@ -575,7 +576,7 @@ def _lizi_along_a_wall(
         min_in_place_vel_theta=0.4, acc_lim_theta=3.2, acc_lim_x=2.5, xy_goal_tolerance=0.2,
         yaw_goal_tolerance=3.14, sim_time=1.5, vx_samples=6, vtheta_samples=20,
         meter_scoring=True, pdist_scale=0.6, gdist_scale=0.8, occdist_scale=0.02,
-        dwa=True, alignment_scale=alignment_scale,
+        dwa=True, alignment_scale=0.6, back_along_plan=back_along_plan,
     )  # fmt: skip
     box = np.array([[-0.19, -0.16], [-0.19, 0.16], [0.19, 0.16], [0.19, -0.16]])
     tp = TrajectoryPlanner(m, box, p)
@@ -613,15 +614,15 @@ def _past_the_wall(poses) -> float:
 
 
 def test_a_robot_that_cannot_turn_backs_along_its_plan_rather_than_drive_away():
-    poses, reached = _lizi_along_a_wall(alignment_scale=0.6)
+    poses, reached = _lizi_along_a_wall(back_along_plan=True)
     assert reached, poses[-1]
     # its body kept off the wall (the outline may sit on the cell next to it, as ROS's
     # footprint check allows; a millimetre between the rollout and this integration)
     assert _past_the_wall(poses) < 0.005
     assert min(p[0] for p in poses) > 3.9  # it never drove off west, away from its plan
-    # base_local_planner's choice (no alignment): any legal forward move first, so west along
-    # the wall into the corner, back 0.1 m, and west again
-    poses, reached = _lizi_along_a_wall(alignment_scale=0.0)
+    # without back_along_plan, base_local_planner's choice: any legal forward move first, so
+    # west along the wall into the corner, back 0.1 m, and west again
+    poses, reached = _lizi_along_a_wall(back_along_plan=False)
     assert not reached and min(p[0] for p in poses) < 3.0
 
 
@@ -629,7 +630,7 @@ def test_a_robot_that_cannot_turn_backs_along_its_plan_rather_than_drive_away():
 def test_a_robot_facing_away_along_a_wall_turns_round_where_it_has_room(th0, y0):
     """Nearly parallel to the wall (slanted toward it or away), 0.22-0.24 m from it: it backs
     along the plan to the door, where it turns round, and goes through, well within 30 s."""
-    poses, reached = _lizi_along_a_wall(alignment_scale=0.6, th0=th0, y0=3.0 - y0)
+    poses, reached = _lizi_along_a_wall(back_along_plan=True, th0=th0, y0=3.0 - y0)
     assert reached and len(poses) < 300, poses[-1]
     assert _past_the_wall(poses) < 0.005  # backing toward the wall at a slant, it kept off
 
@@ -639,7 +640,7 @@ def test_a_robot_facing_away_with_no_room_behind_drives_on_as_ros_does():
     base_local_planner's forward move stands, and keeps standing until the robot is 0.5 m
     away (backing a few centimetres and driving as far forward by turns held a lizi for
     240 s in the office's corridor end, seed 1)."""
-    poses, _ = _lizi_along_a_wall(alignment_scale=0.6, post=4.25, steps=60)
+    poses, _ = _lizi_along_a_wall(back_along_plan=True, post=4.25, steps=60)
     xs = [p[0] for p in poses]
     assert max(xs) <= 4.0 + 1e-6  # never backed
     assert xs[-1] < 3.6  # drove on west, 0.4 m or more in 6 s

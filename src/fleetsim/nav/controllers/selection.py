@@ -7,9 +7,10 @@ flags (``stuck_left`` / ``stuck_right`` ...) and escape mode, kept on the planne
 With ``alignment_scale`` > 0 (a fleetsim addition, off by default) rotations and escapes also
 weigh the path's direction (`path_heading`): an in-place rotation whose look-ahead lands on an
 obstacle is judged by how near it comes to that direction, and an escaping robot turns only
-toward it, else backs on (`_escape_can_turn`); and a robot facing away from its plan turns
-toward it where it can turn all the way, else backs along it (`_toward_the_plan`). With 0
-every choice is base_local_planner's.
+toward it, else backs on (`_escape_can_turn`); with ``back_along_plan`` too (another fleetsim
+addition, off by default) a robot facing away from its plan turns toward it where it can turn
+all the way, else backs along it (`_toward_the_plan`). With 0 every choice is
+base_local_planner's.
 """
 
 from __future__ import annotations
@@ -399,6 +400,7 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
     costs = tp._score(samples, pose, vel)
     best, best_cost = -1, -1.0
     direction = path_heading(tp, pose) if _aligning(tp) else None
+    backs = direction is not None and tp.params.back_along_plan
     if tp.backing_from is not None:
         i = _backing_on(tp, costs, g, dvth, pose, direction)
         if i >= 0:
@@ -436,7 +438,7 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
                 best, best_cost = i, costs[i]
                 heading = ahead
     heading_dist = heading[0]
-    if best_cost >= 0 and _facing_away(pose, direction) and not _blocked_here(tp, pose):
+    if backs and best_cost >= 0 and _facing_away(pose, direction) and not _blocked_here(tp, pose):
         i = _toward_the_plan(tp, samples, costs, g, dvth, pose, direction, best)
         if i != best and samples[i, 0] < 0:
             tp.backing_from = (pose[0], pose[1])

@@ -79,6 +79,11 @@ class TrajectoryPlannerParams:
     forward_point_distance: float = param(
         0.325, unit="m", range=(0.0, None), help="how far ahead that point is (dwa_local_planner)"
     )
+    back_along_plan: bool = param(
+        False,
+        help="with alignment_scale: a robot facing away from its plan turns to it where it can "
+        "turn all the way, else backs along it (false, the default: ROS's forward move first)",
+    )
     # base_local_planner reads "dwa" with default true (trajectory_planner_ros.cpp; its wiki too)
     dwa: bool = param(True, help="Dynamic Window Approach (velocity window of one cycle)")
     simple_attractor: bool = param(False, help="follow the goal blindly (testing)")

@@ -168,3 +168,29 @@ def test_send_goals_succeeded_only_when_it_reached_every_goal(goals, succeeded):
     assert not sg.succeeded
     rt.run(until=lambda: sg.done, duration=30.0)
     assert sg.done and sg.succeeded is succeeded
+
+
+def test_an_aborted_goal_the_explorer_moved_on_from_does_not_fail_a_finished_exploration():
+    """move_base aborts the goal; explore blacklists its frontier and would go on, but the map
+    has filled in meanwhile (mapped from elsewhere), the blacklisted frontier with it:
+    exploration finished, so the run succeeds (explore's doc: exit status 0), the abort still
+    counted as the goal's failure."""
+    rt = Runtime(seed=0)
+    world = World(rt)
+
+    def on_goal(n, server):
+        world.data[:] = 0
+        world.publish()
+        server.set_aborted(text="no valid plan")
+
+    MoveBase(rt, on_goal)
+    ex = Explore(rt)
+    monitor = RunMonitor(rt, PLAN, {"/explore": ex})
+    run(rt, monitor)
+    r = monitor.robots["/"]
+    assert ex.finished and ex.succeeded and len(ex.handled_goals) == 1
+    assert r.goals_failed == 1 and not r.ok
+    assert monitor.all_goals_done() and monitor.success()
+    # the same abort with no sender that moved on from it fails the run
+    ex.handled_goals.clear()
+    assert not monitor.success()

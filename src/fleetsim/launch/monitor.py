@@ -21,7 +21,10 @@ sender also ``succeeded`` (send_goals: every goal reached; explore: it stopped w
 left, not with frontiers it had blacklisted). A goal a sender cancels itself because it no
 longer wants it (explore_lite cancels its active goal when it stops) is listed in the sender's
 ``withdrawn_goals`` and counts as neither a goal nor a failure, like a goal replaced by
-another; any other cancel fails the goal.
+another; any other cancel fails the goal. A goal move_base aborted that its sender moved on
+from (``handled_goals``: explore blacklists its frontier and takes the next) fails the goal
+but not the run: the sender's own ``succeeded`` says whether it got there in the end (explore:
+the frontier was mapped from elsewhere, or it gave up on it).
 """
 
 from __future__ import annotations
@@ -56,7 +59,8 @@ class GoalSender(Protocol):
     ``sends_goals`` (True) is how the monitor finds it; ``done``: it will send no more goals
     and has the results of those it sent; ``succeeded`` (read once done): it achieved what it
     sent the goals for, False when it gave up. Optional: ``withdrawn_goals``, the ids of goals
-    it canceled itself as no longer wanted (their PREEMPTED result is no failure); a node
+    it canceled itself as no longer wanted (their PREEMPTED result is no failure);
+    ``handled_goals``, the ids of failed goals it moved on from (they do not fail the run); a node
     without ``succeeded`` counts as succeeded once done (its goals' results still count).
     """
 
@@ -100,6 +104,8 @@ class RobotResult:
     #: m, map -> base tf against ground truth, where a localizer publishes map (else None)
     localization_error: float | None = None
     goals_by_id: dict[str, tuple[float, float] | None] = field(default_factory=dict, repr=False)
+    #: the ids of the failed goals, in order
+    failed_ids: list[str] = field(default_factory=list, repr=False)
 
     @property
     def all_done(self) -> bool:
@@ -216,7 +222,21 @@ class RunMonitor:
             r.last_text = f"withdrawn by {sender}"
         else:
             r.goals_failed += 1
+            r.failed_ids.append(msg.status.goal_id.id)
         r.time_of_last_result = self.runtime.now()
+
+    def _only_failures_moved_on_from(self, r: RobotResult) -> bool:
+        """Whether ``r`` is ok but for failed goals their senders moved on from
+        (``handled_goals``)."""
+        handled = set()
+        for s in self.senders:
+            handled.update(getattr(s, "handled_goals", ()))
+        return (
+            all(i in handled for i in r.failed_ids)
+            and r.goals_unconfirmed == 0
+            and r.collisions == 0
+            and r.all_done
+        )
 
     def _withdrawn_by(self, goal_id: str) -> str:
         """The name of the sender that withdrew goal ``goal_id`` ("" if none did)."""
@@ -341,7 +361,7 @@ class RunMonitor:
         rs = [r for r in self.results() if r.goals_sent > 0]
         return (
             (bool(rs) or bool(self.senders))
-            and all(r.ok for r in rs)
+            and all(r.ok or self._only_failures_moved_on_from(r) for r in rs)
             and not self.senders_failed()
             and all(r.collisions == 0 for r in self.results())
         )

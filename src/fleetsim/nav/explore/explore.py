@@ -18,7 +18,8 @@ goal, or no progress for ``progress_timeout``). A frontier blacklisted on the wa
 robot's laser later maps from elsewhere is no longer a frontier and does not count.
 explore_lite stops either way; a goal it cancels itself (on stopping, or to wait while a peer
 takes the frontiers left) is listed in ``withdrawn_goals``, so that the run monitor does not
-count it as a failed goal.
+count it as a failed goal, and one move_base aborted (its frontier blacklisted) in
+``handled_goals``, so that it does not fail a run whose exploration finished.
 
 Explorers sharing one map (slam_explore ``robots:=2``) would all head for the same frontier;
 fleetsim's additions share the frontiers out (`fleetsim.nav.explore.peers` gives the rules and
@@ -93,6 +94,7 @@ class Explore(Node):
         #: ids of the goals it canceled itself: on stopping, or to wait while a peer takes the
         #: frontiers left (for the run monitor, which does not count them as failed)
         self.withdrawn_goals: set[str] = set()
+        self.handled_goals: set[str] = set()  # aborted by move_base, blacklisted, moved on
         self.goals_sent = 0
         #: times the blacklist was cleared (blacklist_retries)
         self.retries = 0
@@ -426,6 +428,7 @@ class Explore(Node):
         self._handle = None
         if status == ABORTED:
             self.get_logger().info(f"move_base aborted the goal {goal}; blacklisting it")
+            self.handled_goals.add(handle.id)
             self._blacklist(goal)
         elif status == SUCCEEDED and self.params.view_points:
             self.stood_at.append((*goal, self.now()))  # what it sees from here is observed

@@ -492,9 +492,9 @@ def _toward_the_plan(
     base_local_planner's choice, when that is a forward move that does not turn it within a
     quarter turn of the path's direction or an in-place rotation the way it cannot turn all
     the way (`_turning_way`): where it can turn all the way, the legal in-place rotation that
-    way that looks best (in-place rotation's rule); else the back-up that looks best by the
-    escape's rule (`_escape_choice`) among those that bring its centre no nearer an obstacle
-    (`_no_nearer`). ``best`` when there is neither, or it needs no replacing.
+    way that looks best (in-place rotation's rule); else the clearest legal back-up
+    (`_clearest_back_up`), which starts backing along the plan (`_backing_on`). ``best``
+    when there is neither, or it needs no replacing.
 
     Departure from base_local_planner, which takes any legal forward rollout before turning
     or backing up. A lizi that had come along a room's wall, its centre 0.25 m from it (the
@@ -503,9 +503,9 @@ def _toward_the_plan(
     0.5 m, and did so again for 1000 s (office, two lizis, seed 1). Backing along the plan
     until it can turn all the way toward it turns it round where there is room; stopping
     where the first rollout of a turn is legal, it turns a little, at a door's post, and
-    backs again, to and fro. A back-up that brings it nearer the wall is not taken: the
-    footprint check lets the outline sit on the cell next to a wall's, and a lizi backing
-    along a corridor wall at a slant scraped it (office, one lizi, seed 1)."""
+    backs again, to and fro. The back-up kept clearest of obstacles is taken: the footprint
+    check lets the outline sit on the cell next to a wall's, and a lizi backing straight along
+    a corridor wall at a slant scraped it (office, one lizi, seed 1)."""
     vx, vy, vth = samples[best]
     quarter = 0.5 * math.pi
     turning = vx == 0.0 and vy == 0.0 and vth != 0.0

@@ -644,3 +644,19 @@ def test_a_robot_facing_away_with_no_room_behind_drives_on_as_ros_does():
     xs = [p[0] for p in poses]
     assert max(xs) <= 4.0 + 1e-6  # never backed
     assert xs[-1] < 3.6  # drove on west, 0.4 m or more in 6 s
+
+
+def test_back_along_plan_without_the_alignment_cost_is_warned_about(caplog):
+    with caplog.at_level(logging.WARNING, logger="fleetsim.nav"):
+        TrajectoryPlanner.from_namespace(
+            corridor(), footprint_from_radius(0.2), {"back_along_plan": True}, "lizi1/tp"
+        )
+    assert "lizi1/tp: back_along_plan is true but alignment_scale is 0" in caplog.text
+    caplog.clear()
+    with caplog.at_level(logging.WARNING, logger="fleetsim.nav"):
+        TrajectoryPlanner.from_namespace(
+            corridor(),
+            footprint_from_radius(0.2),
+            {"back_along_plan": True, "alignment_scale": 0.6},
+        )
+    assert "back_along_plan" not in caplog.text

@@ -134,6 +134,13 @@ class TrajectoryPlanner(LocalPlanner):
         hint = circling_hint(params)
         if hint:
             logging.getLogger("fleetsim.nav").warning("%s: %s", where, hint)
+        if params.back_along_plan and params.alignment_scale <= 0.0:
+            logging.getLogger("fleetsim.nav").warning(
+                "%s: back_along_plan is true but alignment_scale is 0: it has no effect (it "
+                "judges the robot's heading by the path's direction, which the alignment cost "
+                "defines); set alignment_scale > 0 (e.g. 0.6, as the hunter's file)",
+                where,
+            )
         return cls(costmap, footprint, params)
 
     def _reset_oscillation_flags(self) -> None:

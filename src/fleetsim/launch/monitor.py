@@ -114,8 +114,12 @@ class RobotResult:
 
     @property
     def ok(self) -> bool:
+        return self.ok_but_for(frozenset())
+
+    def ok_but_for(self, handled: set[str] | frozenset[str]) -> bool:
+        """`ok`, with the failed goals whose ids are in ``handled`` counted as no failure."""
         return (
-            self.goals_failed == 0
+            all(i in handled for i in self.failed_ids)
             and self.goals_unconfirmed == 0
             and self.collisions == 0
             and self.all_done
@@ -225,18 +229,12 @@ class RunMonitor:
             r.failed_ids.append(msg.status.goal_id.id)
         r.time_of_last_result = self.runtime.now()
 
-    def _only_failures_moved_on_from(self, r: RobotResult) -> bool:
-        """Whether ``r`` is ok but for failed goals their senders moved on from
-        (``handled_goals``)."""
-        handled = set()
+    def _handled_goals(self) -> set[str]:
+        """The ids of the failed goals the senders moved on from (``handled_goals``)."""
+        handled: set[str] = set()
         for s in self.senders:
             handled.update(getattr(s, "handled_goals", ()))
-        return (
-            all(i in handled for i in r.failed_ids)
-            and r.goals_unconfirmed == 0
-            and r.collisions == 0
-            and r.all_done
-        )
+        return handled
 
     def _withdrawn_by(self, goal_id: str) -> str:
         """The name of the sender that withdrew goal ``goal_id`` ("" if none did)."""
@@ -359,9 +357,10 @@ class RunMonitor:
         """Every goal reached (confirmed by ground truth), every goal sender done and
         succeeded, no collision; a run with neither goals nor senders did not succeed."""
         rs = [r for r in self.results() if r.goals_sent > 0]
+        handled = self._handled_goals()
         return (
             (bool(rs) or bool(self.senders))
-            and all(r.ok or self._only_failures_moved_on_from(r) for r in rs)
+            and all(r.ok_but_for(handled) for r in rs)
             and not self.senders_failed()
             and all(r.collisions == 0 for r in self.results())
         )

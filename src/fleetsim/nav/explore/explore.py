@@ -65,7 +65,14 @@ from .frontier_search import Frontier, frontiers_from_grid, known_window
 from .markers import frontier_markers
 from .params import ExploreParams
 from .path_costs import by_path, path_distance_field
-from .peers import frontier_for_robot, tracked_frontier
+from .peers import (
+    first_heard,
+    frontier_for_robot,
+    peer_goal,
+    points,
+    stamped_points,
+    tracked_frontier,
+)
 from .view_points import cell_value, view_point
 
 BLACKLIST_RADIUS_CELLS = 5  # explore_lite's goalOnBlacklist tolerance
@@ -120,12 +127,12 @@ class Explore(Node):
             geometry_msgs.PoseArray, "~observed", 1, latch=True
         )
         # what the peers tell it, by topic: their goals, blacklists and view points stood at
-        self.peers = self._listen(geometry_msgs.PointStamped, p.peer_goals, _goal, None)
-        self.peer_blacklists = self._listen(geometry_msgs.PoseArray, p.peer_blacklists, _points)
+        self.peers = self._listen(geometry_msgs.PointStamped, p.peer_goals, peer_goal, None)
+        self.peer_blacklists = self._listen(geometry_msgs.PoseArray, p.peer_blacklists, points)
         # the peers' observed points, each kept at the time it was first heard of: a peer
         # republishes its whole list, stamped anew, whenever the list grows
         self.peer_stood_at = self._listen(
-            geometry_msgs.PoseArray, p.peer_observed, _stamped, [], merge=_first_heard
+            geometry_msgs.PoseArray, p.peer_observed, stamped_points, [], merge=first_heard
         )
         _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now
         self.create_subscription(nav_msgs.OccupancyGrid, p.costmap_topic, self.on_costmap, 1)
@@ -456,27 +463,3 @@ class Explore(Node):
     def _publish_markers(self, frame: str) -> None:
         header = std_msgs.Header(stamp=self.now_msg(), frame_id=frame)
         self.marker_pub.publish(frontier_markers(self.frontiers, header))
-
-
-def _points(msg: geometry_msgs.PoseArray) -> list[tuple[float, float]]:
-    return [(q.position.x, q.position.y) for q in msg.poses]
-
-
-def _stamped(msg: geometry_msgs.PoseArray) -> list[tuple[float, float, float]]:
-    """The points with the message's time (sim s)."""
-    t = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
-    return [(x, y, t) for x, y in _points(msg)]
-
-
-def _first_heard(
-    held: list[tuple[float, float, float]], new: list[tuple[float, float, float]]
-) -> list[tuple[float, float, float]]:
-    """``new`` (x, y, t) points, each one already ``held`` at the time it was held with."""
-    heard = {(x, y): t for x, y, t in held}
-    return [(x, y, heard.get((x, y), t)) for x, y, t in new]
-
-
-def _goal(msg: geometry_msgs.PointStamped) -> tuple[float, float] | None:
-    """A peer's announced goal; None (NaN announced): it has none."""
-    x, y = msg.point.x, msg.point.y
-    return (x, y) if math.isfinite(x) and math.isfinite(y) else None

@@ -39,6 +39,8 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from fleetsim.msgs import geometry_msgs
+
 from .frontier_search import Frontier
 
 #: m: the frontier nearest the current goal (centroid or a cell this near) is still "the same"
@@ -116,3 +118,30 @@ def tracked_frontier(frontiers: Sequence[Frontier], goal: tuple[float, float]) -
         < TRACK_RADIUS**2
     ]
     return min(near, key=lambda f: math.dist(f.centroid, goal), default=None)
+
+
+# -- what the peers publish, read (explore subscribes to these) -------------------------------
+def points(msg: geometry_msgs.PoseArray) -> list[tuple[float, float]]:
+    """A peer's points (its blacklist, its view points stood at), x, y in m."""
+    return [(q.position.x, q.position.y) for q in msg.poses]
+
+
+def stamped_points(msg: geometry_msgs.PoseArray) -> list[tuple[float, float, float]]:
+    """The points with the message's time (sim s)."""
+    t = msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
+    return [(x, y, t) for x, y in points(msg)]
+
+
+def first_heard(
+    held: list[tuple[float, float, float]], new: list[tuple[float, float, float]]
+) -> list[tuple[float, float, float]]:
+    """``new`` (x, y, t) points, each one already ``held`` at the time it was held with: a peer
+    republishes its whole list, stamped anew, whenever the list grows."""
+    heard = {(x, y): t for x, y, t in held}
+    return [(x, y, heard.get((x, y), t)) for x, y, t in new]
+
+
+def peer_goal(msg: geometry_msgs.PointStamped) -> tuple[float, float] | None:
+    """A peer's announced goal; None (NaN announced): it has none."""
+    x, y = msg.point.x, msg.point.y
+    return (x, y) if math.isfinite(x) and math.isfinite(y) else None

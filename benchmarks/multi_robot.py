@@ -99,6 +99,19 @@ def jittered_plan(path: Path, args: dict[str, str], seed: int, jitter: float):
     return plan
 
 
+def scenario_item(item: str) -> tuple[str, int, dict[str, str]]:
+    """``NAME:ROBOTS[:arg=value...]`` of ``--scenarios`` as (name, robots, launch args)."""
+    name, _, rest = item.partition(":")
+    count, *args = rest.split(":") if rest else [""]
+    bad = [kv for kv in args if "=" not in kv]
+    if not name or not count.isdigit() or int(count) < 1 or bad:
+        raise SystemExit(
+            f"--scenarios: {item!r} is not NAME:ROBOTS[:arg=value...] "
+            "(e.g. circle:16, willow_swap:3, swap_corridor:2:localization=amcl)"
+        )
+    return name, int(count), dict(kv.split("=", 1) for kv in args)
+
+
 def run_once(name: str, robots: int, planner: str, seed: int, limit: float, jitter: float,
              solo: str = "", extra: dict[str, str] | None = None) -> Run:  # fmt: skip
     args = {"robots": str(robots), "planner": planner, "gui": "false", **(extra or {})}
@@ -259,6 +272,7 @@ def main() -> None:
         help="per seed, the slowest robot's time for each metre to its goal against its time alone",
     )
     a = ap.parse_args()
+    items = [scenario_item(item) for item in a.scenarios.split(",")]  # bad ones before any run
     logging.basicConfig(level=logging.ERROR)
     med, p95, cmed, cp95 = cycle_time()
     print(
@@ -274,9 +288,7 @@ def main() -> None:
     seeds = range(a.first_seed, a.first_seed + a.seeds)
     print(f"seeds {seeds.start}-{seeds.stop - 1} (collvoid tuned on 0-4; 5-9 held out)")
     print(header)
-    for item in a.scenarios.split(","):
-        name, n, *rest = item.split(":")
-        n, launch_args = int(n), dict(kv.split("=", 1) for kv in rest)
+    for name, n, launch_args in items:
         for planner in a.planners.split(","):
             alone = [run_once(name, n, planner, 0, a.limit, 0.0, f"lizi{k}", launch_args) for k in
                      range(1, n + 1)]  # fmt: skip

@@ -316,7 +316,10 @@ def main() -> None:
     elif a.all:
         worlds = available_worlds(a.barn_dir)
     elif a.worlds:
-        worlds = [int(w) for w in a.worlds.split(",") if w.strip()]
+        parts = [w.strip() for w in a.worlds.split(",") if w.strip()]
+        if not all(w.isdigit() for w in parts):
+            ap.error(f"--worlds: BARN world numbers, comma separated; got {a.worlds!r}")
+        worlds = [int(w) for w in parts]
     else:
         worlds = list(DEFAULT_WORLDS)
     print(f"BARN: jackal + move_base ({a.controller}), {len(worlds)} worlds from {a.barn_dir}")

@@ -494,7 +494,10 @@ def main() -> int:
         ap.error(f"unknown layers {unknown}; choose from {', '.join(LAYERS)}")
     if "robots" not in layers:
         layers.insert(0, "robots")
-    sizes = [int(x) for x in args.sizes.split(",") if x]
+    parts = [x.strip() for x in args.sizes.split(",") if x.strip()]
+    if not all(x.isdigit() for x in parts):
+        ap.error(f"--sizes: fleet sizes are whole numbers, comma separated; got {args.sizes!r}")
+    sizes = [int(x) for x in parts]
     if not sizes or min(sizes) < 1:
         ap.error(f"--sizes: fleet sizes must be >= 1, got {args.sizes!r}")
     return 0 if table(sizes, layers, args.duration, args.seed, max(1, args.repeats)) else 1

@@ -422,7 +422,10 @@ def main() -> None:
         "--only", choices=["update", "office", "office1", "office2", "willow"], default=None
     )
     a = ap.parse_args()
-    seeds = [int(x) for x in a.seeds.split(",")]
+    parts = [x.strip() for x in a.seeds.split(",") if x.strip()]
+    if not parts or not all(x.isdigit() for x in parts):
+        ap.error(f"--seeds: whole numbers, comma separated; got {a.seeds!r}")
+    seeds = [int(x) for x in parts]
     if a.only in (None, "update"):
         update_30x360()
     for seed in seeds:

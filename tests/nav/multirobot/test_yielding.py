@@ -162,7 +162,7 @@ def test_retreat_keeps_the_way_it_came_and_cuts_the_retreat_off_after_a_yield():
         r.extend(np.array([x, 0.0]))
     steps = np.hypot(*np.diff(np.array(r.trail), axis=0).T)
     assert np.all((steps >= 0.1) & (steps < 0.13)) and r.trail[0] == (-5.0, 0.0)
-    v = r.velocity(cm, np.array([0.0, 0.0]), 0.31, 0.25, 0.5, 0.6)
+    v = r.velocity(args(cm), np.array([0.0, 0.0]), 0.31, 0.25, 0.5, 0.6)
     assert v[0] < 0  # back west, into the narrow part's wide end
     # REFUGE_SETBACK (0.6 m) past the bay's mouth at x = -3, aside (south: robot1 faces east)
     assert r.refuge_final and -3.9 < r.refuge[0] < -3.5 and r.refuge[1] < -0.3
@@ -192,7 +192,7 @@ def test_a_yielder_replanned_every_cycle_still_backs_out_along_the_way_it_came()
         r.reset()  # a replan under amcl
         r.extend(np.array([x, 0.0]))
     r.reset()
-    v = r.velocity(cm, np.array([0.0, 0.0]), 0.31, 0.25, 0.5, 0.6)
+    v = r.velocity(args(cm), np.array([0.0, 0.0]), 0.31, 0.25, 0.5, 0.6)
     assert v[0] < -0.4 and r.refuge_final and r.refuge[0] < -3.4
 
 
@@ -204,7 +204,7 @@ def test_a_replan_during_the_yield_still_cuts_the_trail_where_the_robot_backed_t
     r = Retreat()
     for x in np.arange(-5.0, 0.01, 0.02):
         r.extend(np.array([x, 0.0]))
-    r.velocity(cm, np.array([0.0, 0.0]), 0.31, 0.25, 0.5, 0.6)  # backing out
+    r.velocity(args(cm), np.array([0.0, 0.0]), 0.31, 0.25, 0.5, 0.6)  # backing out
     r.reset()
     r.extend(np.array([-1.5, 0.0]))  # a cycle not yielding, 1.5 m back
     assert r.trail[-1] == pytest.approx((-1.5, 0.0), abs=0.06)

@@ -128,7 +128,7 @@ class CollvoidDrive:
                 holo,
                 tuple(float(a) for a in pose),
                 (float(velocity[0]), float(velocity[2])),
-                (cm.costs, (cm.origin_x, cm.origin_y), cm.resolution),
+                self.grid or (cm.costs, (cm.origin_x, cm.origin_y), cm.resolution),
                 self.outline,
                 (-caps[1], caps[0], p.min_vel_theta, p.max_vel_theta, p.acc_lim_x, p.acc_lim_theta),
                 horizon,

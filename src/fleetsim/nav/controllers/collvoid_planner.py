@@ -78,6 +78,7 @@ from fleetsim.nav.multirobot.holonomic import (
     plan_carrot,
     preferred_velocity,
     rotated,
+    without_robots,
 )
 from fleetsim.nav.multirobot.orca import orca_halfplanes, orca_velocity
 from fleetsim.nav.multirobot.position_share import PositionShare
@@ -97,6 +98,9 @@ WALLS_BLOCK = 0.25
 #: amcl map -> odom correction moves the goal by a few cm; taken as a new goal each time (~1 Hz)
 #: the no-progress clock restarted and the deadlock rule could never fire under amcl
 SAME_GOAL_SHIFT = 0.5
+#: s; how old another robot's image in the local costmap can be against its shared pose (a
+#: 5 Hz costmap update and a 10 Hz /position_share message), and the most it moves meanwhile, m
+SEEN_LAG, SEEN_LAG_MAX = 0.3, 0.2
 
 
 class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive, LocalPlanner):
@@ -167,6 +171,7 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         self.plan_index = 0
         self.retreat = Retreat()  # the way back and the refuge of a yield
         self.lines = (np.zeros((0, 2)), np.zeros((0, 2)), 0)  # this cycle's half-planes
+        self.grid = None  # this cycle's local costmap without the other robots (`_walls`)
         self.feasible = True
         #: robot id -> the side (0 right, 1 left) a robot standing in the way is gone round on
         self.detour_sides: dict[str, int] = {}
@@ -234,14 +239,14 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         map_xy, ids, pos, nvel, radii, resp, controlled, yaws, wide = self._neighbours(
             xy, own_r, vel
         )
+        self.grid = self._walls(pos, nvel, wide)
         dist = np.hypot(pos[:, 0] - xy[0], pos[:, 1] - xy[1])
         pair = self.pair_radii(own_r, radii, dist)
         active = {k: d for k, d, c in zip(ids, dist.tolist(), controlled) if c}
         narrow: list[str] = []
         if active and self.yielding_to is None:
-            cm = self.costmap
             meet = narrow_meetings(
-                (cm.costs, (cm.origin_x, cm.origin_y), cm.resolution),
+                self.grid,
                 xy,
                 carrot - xy,
                 pos - xy,
@@ -275,6 +280,19 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
             )
         return self._orca(xy, vel, pref, pos - xy, nvel, pair, resp)
 
+    def _walls(self, pos, nvel, wide) -> tuple[np.ndarray, tuple[float, float], float]:
+        """The local costmap as (costs, origin, resolution) without the other robots' images
+        (`without_robots`): each neighbour at ``pos`` (N, 2) m moving at ``nvel`` (N, 2) m/s,
+        its body ``wide`` (N,) m grown by how far it moves in ``SEEN_LAG`` (at most
+        ``SEEN_LAG_MAX``) and two cells. What this cycle's wall half-planes, footprint check,
+        passage widths and refuge read."""
+        cm = self.costmap
+        origin, res = (cm.origin_x, cm.origin_y), cm.resolution
+        if not pos.shape[0]:
+            return cm.costs, origin, res
+        lag = np.minimum(SEEN_LAG * np.hypot(nvel[:, 0], nvel[:, 1]), SEEN_LAG_MAX)
+        return without_robots(cm.costs, origin, res, pos, wide + lag + 2.0 * res), origin, res
+
     def _orca(self, xy, vel, pref, rel, nvel, radii, resp) -> np.ndarray:
         """The velocity nearest ``pref`` (2,) m/s that the half-planes of the local costmap's
         walls and of the robots (``rel`` (N, 2) m, ``nvel`` (N, 2) m/s, combined ``radii`` (N,)
@@ -282,9 +300,7 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         p = self.params
         lines_p, lines_d = [], []
         obst = obstacle_points(
-            self.costmap.costs,
-            (self.costmap.origin_x, self.costmap.origin_y),
-            self.costmap.resolution,
+            *self.grid,
             xy,
             self.body_radius + p.max_vel_x * self.horizon_obst + 0.3,
             OBSTACLE_SECTORS,

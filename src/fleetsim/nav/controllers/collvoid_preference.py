@@ -49,7 +49,7 @@ class CollvoidPreference:
             self.yielding_to = None
             return pref
         decel = DECELERATION * p.acc_lim_x
-        return self.retreat.velocity(self.costmap, xy, own_r, other_r, p.max_vel_x, decel)
+        return self.retreat.velocity(self.grid, xy, own_r, other_r, p.max_vel_x, decel)
 
     def _around_still(self, pref, xy, vel, rel, nvel, radii, controlled, ids) -> np.ndarray:
         """``pref`` turned round the nearest robot standing in its way (`detour_velocity`) on a
@@ -64,9 +64,8 @@ class CollvoidPreference:
         free = np.hypot(*(rel[still] - to_goal).T) > r
         idx = np.flatnonzero(still)[free]
         r = radii[idx] + DETOUR_MARGIN
-        cm = self.costmap
-        grid = (cm.costs, (cm.origin_x, cm.origin_y), cm.resolution)
-        closed = gaps_closed(grid, xy, rel[idx], r, self.body_radius + cm.resolution * 0.71)
+        grid = self.grid
+        closed = gaps_closed(grid, xy, rel[idx], r, self.body_radius + grid[2] * 0.71)
         near = [ids[k] for k in idx]
         sides = self.detour_sides
         for k in [k for k in sides if k not in near]:

@@ -22,7 +22,7 @@ import math
 
 import numpy as np
 
-from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
+from fleetsim.nav.costmap.costmap_2d import FREE_SPACE, LETHAL_OBSTACLE
 from fleetsim.nav.multirobot.yielding import clear_distance
 
 #: m/s: a robot faster than this goes round a disc on the tangent nearest its direction
@@ -209,6 +209,44 @@ def obstacle_points(
     pick = order[first]
     pick = pick[np.argsort(d[pick], kind="stable")]
     return np.stack([px[pick], py[pick]], axis=1)
+
+
+def without_robots(
+    costs: np.ndarray,
+    origin: tuple[float, float],
+    resolution: float,
+    centres: np.ndarray,
+    radii: np.ndarray,
+) -> np.ndarray:
+    """``costs`` with the LETHAL cells inside the discs ``centres`` (K, 2) m, ``radii`` (K,) m
+    cleared to free space: the other robots as this robot's laser sees them.
+
+    A robot whose laser sweeps another robot's body has that body in its local costmap as a
+    lethal obstacle, and the planner's wall half-planes then count it a second time, with all
+    the responsibility and as if it stood still: two pioneer3ats (whose lasers see each other,
+    where the lizis' sweep above each other) stopped face to face on the circle of 8 for
+    40-55 s. The robot half-planes from /position_share already cover them. NO_INFORMATION
+    cells stay. Returns ``costs`` itself when nothing is cleared, else a copy.
+    """
+    out = costs
+    h, w = costs.shape
+    ox, oy = origin
+    for (cx, cy), r in zip(np.asarray(centres, dtype=np.float64), np.asarray(radii, float)):
+        c0 = max(math.floor((cx - r - ox) / resolution), 0)
+        c1 = min(math.floor((cx + r - ox) / resolution) + 1, w)
+        r0 = max(math.floor((cy - r - oy) / resolution), 0)
+        r1 = min(math.floor((cy + r - oy) / resolution) + 1, h)
+        if c1 <= c0 or r1 <= r0:
+            continue
+        block = out[r0:r1, c0:c1]
+        px = ox + (np.arange(c0, c1) + 0.5) * resolution - cx
+        py = oy + (np.arange(r0, r1) + 0.5) * resolution - cy
+        hit = (block == LETHAL_OBSTACLE) & (py[:, None] ** 2 + px[None, :] ** 2 <= r * r)
+        if hit.any():
+            if out is costs:
+                out = costs.copy()
+            out[r0:r1, c0:c1][hit] = FREE_SPACE
+    return out
 
 
 def tracking_command(

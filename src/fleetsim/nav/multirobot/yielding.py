@@ -308,14 +308,15 @@ class Retreat:
 
     def velocity(
         self,
-        costmap,
+        grid: tuple[np.ndarray, tuple[float, float], float],
         xy: np.ndarray,
         own_radius: float,
         other_radius: float,
         max_speed: float,
         deceleration: float,
     ) -> np.ndarray:
-        """(2,) m/s to the refuge (found the first time, kept once it is the wide place)."""
+        """(2,) m/s to the refuge (found the first time, kept once it is the wide place) on
+        ``grid``, the local costmap as (costs (H, W) uint8, origin (2,) m, resolution m)."""
         self.retreated = True
         if not self.refuge_final:
             # the trail only: its last point is within TRAIL_STEP of the robot, and a shorter
@@ -324,9 +325,7 @@ class Retreat:
             self.refuge, self.refuge_final = refuge(
                 way,
                 way.shape[0] - 1,
-                costmap.costs,
-                (costmap.origin_x, costmap.origin_y),
-                costmap.resolution,
+                *grid,
                 own_radius,
                 other_radius,
                 setback=REFUGE_SETBACK,

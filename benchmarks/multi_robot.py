@@ -12,8 +12,9 @@ the lesson's 3 lizis in the Willow Garage map sent through each other's paths), 
   once per robot; the run goes on, so a robot that was only slow - one backing out of a passage
   too narrow for two - still arrives and counts in ``reached``);
 - makespan: from the goals going out to the last robot's arrival (move_base's SUCCEEDED, ground
-  truth within tolerance), and its ratio to the slowest robot's time alone (``solo:=lizik``, each
-  robot alone in the same world with the same planner's settings);
+  truth within tolerance), and its ratio to the slowest robot's time alone (``solo:=lizik``, or
+  ``pioneerk`` with ``model=pioneer3at``: each robot alone in the same world with the same
+  planner's settings);
 - extra path: the robots' summed path over the summed paths alone (1.0: no detour).
 
 Then the plugin's cycle: ``compute_velocity_commands`` with 16 neighbours on /position_share and a
@@ -27,7 +28,8 @@ The simulation is deterministic for a seed; the seed moves every start by up to 
 Seeds: the collvoid planner was tuned on seeds 0-4 (seed 0: the exact, symmetric starts) and is
 reported on 5-9 as well (held out): ``--first-seed 0 --seeds 5`` and ``--first-seed 5 --seeds 5``.
 A scenario may carry launch args: ``swap_corridor:2:width=1.0`` (the corridor too narrow for
-two).
+two), ``circle:8:model=pioneer3at`` (pioneer3ats, whose lasers see each other) or
+``swap_corridor:4:model=mixed`` (lizis and pioneer3ats together).
 
 Usage: python benchmarks/multi_robot.py [--seeds 10] [--first-seed 0]
                                         [--scenarios swap_corridor:2,circle:8]
@@ -97,6 +99,21 @@ def jittered_plan(path: Path, args: dict[str, str], seed: int, jitter: float):
                 out.append(f"{v:.4f}")
         spec.args[:] = out
     return plan
+
+
+def robot_name(model: str, k: int) -> str:
+    """Robot k's name in a scenario run with ``model`` (make_multi_robot_launch's rule)."""
+    import importlib.util
+
+    import fleetsim
+
+    script = Path(fleetsim.__file__).parent / "assets/launch/make_multi_robot_launch.py"
+    spec = importlib.util.spec_from_file_location("make_multi_robot_launch", script)
+    gen = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(gen)
+    if model == "mixed":
+        model = gen.MIXED[k % 2]
+    return f"{gen.NAME_PREFIXES[model]}{k}"
 
 
 def scenario_item(item: str) -> tuple[str, int, dict[str, str]]:
@@ -290,8 +307,9 @@ def main() -> None:
     print(header)
     for name, n, launch_args in items:
         for planner in a.planners.split(","):
-            alone = [run_once(name, n, planner, 0, a.limit, 0.0, f"lizi{k}", launch_args) for k in
-                     range(1, n + 1)]  # fmt: skip
+            model = launch_args.get("model", "lizi")
+            alone = [run_once(name, n, planner, 0, a.limit, 0.0, robot_name(model, k), launch_args)
+                     for k in range(1, n + 1)]  # fmt: skip
             alone_time = max(r.makespan for r in alone)
             alone_path = {m: p for r in alone for m, p in r.paths.items()}
             runs = [run_once(name, n, planner, s, a.limit, a.jitter, "", launch_args)

@@ -9,6 +9,7 @@ no contact between robots or with a wall (`RunMonitor`), MuJoCo silent.
 import logging
 import math
 import re
+from pathlib import Path
 
 import pytest
 from nav_harness import WILLOW, lesson_starts
@@ -144,6 +145,41 @@ def test_swap_through_a_corridor_too_narrow_for_two(monkeypatch, tmp_path):
         assert max(longest.values()) < 20.0, longest
 
 
+def test_a_lizi_and_a_pioneer3at_swap_the_corridor(monkeypatch, tmp_path):
+    """model:=mixed: robots of two sizes and speeds share /position_share with their own
+    footprints (each me_publisher takes its local costmap's) and pass without contact."""
+    monkeypatch.chdir(tmp_path)
+    with session("swap_corridor", robots="2", model="mixed", gui="false") as s:
+        s.run(duration=45.0, until_goals=True)
+        assert_clean_success(s, tmp_path)
+        assert {r.namespace for r in s.monitor.results()} == {"/lizi1", "/pioneer2"}
+        table = s.nodes["/lizi1/move_base"].controller.share.table
+        radii = {k: r.body_radius for k, r in table.robots.items()}
+        assert radii["pioneer2"] == pytest.approx(math.hypot(0.27, 0.25), abs=1e-3)
+
+
+def test_pioneers_that_see_each_other_cross_the_circle(monkeypatch, tmp_path):
+    """model:=pioneer3at: a pioneer's laser sweeps the other pioneers' bodies, so each one is
+    in the others' local costmaps. The planner clears those images where /position_share puts
+    the robots (the robot half-planes cover them); taken for walls they had held the pioneers
+    face to face for 40-55 s (circle of 8, benchmarks/multi_robot.py, seeds 0-4)."""
+    monkeypatch.chdir(tmp_path)
+    cleared = []
+    with session("circle", robots="8", model="pioneer3at", gui="false") as s:
+        planners = [s.nodes[f"/pioneer{k}/move_base"].controller for k in range(1, 9)]
+
+        def seen():
+            cleared.append(sum(p.grid is not None and p.grid[0] is not p.costmap.costs
+                               for p in planners))  # fmt: skip
+
+        s.runtime.create_timer(0.5, seen, priority=-50)
+        s.run(duration=60.0, until_goals=True)
+        assert_clean_success(s, tmp_path)
+        assert len(s.monitor.results()) == 8
+        assert s.runtime.now() < 2.0 + 30.0  # makespans 12.4-17.8 s (44-62 s before)
+    assert max(cleared) > 0  # the others were in the costmaps, and cleared
+
+
 def test_plain_trajectory_planner_runs_into_the_other_robot(monkeypatch, tmp_path):
     """The failure this issue fixes: lizis cannot see each other (their lasers sweep above the
     other bodies), so with TrajectoryPlannerROS the corridor swap ends in a collision."""
@@ -187,6 +223,7 @@ def test_lesson_lizis_swap_starts_in_willow(monkeypatch, tmp_path):
         ("willow_swap", {"planner": "foo"}, "'planner' is 'foo'; allowed values: collvoid, traj"),
         ("swap_corridor", {"localization": "gps"}, "'localization' is 'gps'; allowed values: fak"),
         ("circle", {"localization": "gps"}, "'localization' is 'gps'; allowed values: fake, amcl"),
+        ("circle", {"model": "burger"}, "'model' is 'burger'; allowed values: lizi, pioneer3at, "),
     ],
 )
 def test_the_scenarios_refuse_args_they_do_not_know(name, args, words):
@@ -196,6 +233,17 @@ def test_the_scenarios_refuse_args_they_do_not_know(name, args, words):
 
     with pytest.raises(LaunchError, match=re.escape(words)):
         load_plan(resolve_launch_file(name), args)
+
+
+def test_the_shipped_scenarios_are_what_their_generator_writes(tmp_path):
+    import runpy
+
+    import fleetsim
+
+    launch = Path(fleetsim.__file__).parent / "assets" / "launch"
+    gen = runpy.run_path(str(launch / "make_multi_robot_launch.py"))
+    for p in gen["write"](tmp_path):
+        assert p.read_text() == (launch / p.name).read_text(), p.name
 
 
 def test_the_scenarios_are_shipped():

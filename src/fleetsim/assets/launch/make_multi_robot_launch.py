@@ -13,7 +13,10 @@
   fleetsim_maps): the lesson's three lizis (``robots`` 3) sent through each other's paths,
   lizi1 to lizi3's start, lizi2 to lizi1's, lizi3 to lizi2's.
 
-All take ``solo`` (run only the named robot: the reference for makespan and path length),
+All take ``model`` (``lizi``, the default; ``pioneer3at``, whose robots are named pioneer1,
+pioneer2, ...; ``mixed``: odd robots lizis, even ones pioneer3ats, sharing /position_share with
+their own footprints and limits), ``solo`` (run only the named robot: the reference for
+makespan and path length),
 ``planner`` (``collvoid``, default: collvoid_local_planner/CollvoidLocalPlanner with
 position sharing and a robots layer; ``trajectory``: plain TrajectoryPlannerROS, the robots
 unaware of each other), ``localization`` (fake | amcl) and ``start_delay``. Pass criterion
@@ -74,9 +77,10 @@ def willow_swap_robots() -> list[tuple[float, float, float, float, float, float]
 def _group(k: int, robot: tuple, minimum: int) -> str:
     x, y, yaw, gx, gy, gyaw = (round(v, 4) for v in robot)
     return f"""
-  <group ns="lizi{k}" if="$(eval int(robots) >= {minimum} and solo in ('', 'lizi{k}'))">
+  <group ns="$(arg name{k})" if="$(eval int(robots) >= {minimum} and solo in ('', name{k}))">
     <include file="$(find fleetsim_launch)/include/mr_robot.launch">
-      <arg name="robot_name" value="lizi{k}"/>
+      <arg name="robot_name" value="$(arg name{k})"/>
+      <arg name="model" value="$(arg model{k})"/>
       <arg name="x" value="{x}"/> <arg name="y" value="{y}"/> <arg name="yaw" value="{yaw}"/>
       <arg name="goal_x" value="{gx}"/> <arg name="goal_y" value="{gy}"/>
       <arg name="goal_yaw" value="{gyaw}"/>
@@ -85,6 +89,26 @@ def _group(k: int, robot: tuple, minimum: int) -> str:
       <arg name="start_delay" value="$(arg start_delay)"/>
     </include>
   </group>"""
+
+
+#: robot model -> the prefix of its robots' names (lizi1, pioneer2, ...)
+NAME_PREFIXES = {"lizi": "lizi", "pioneer3at": "pioneer"}
+#: what ``model:=mixed`` gives robot k: lizis odd, pioneer3ats even
+MIXED = ("pioneer3at", "lizi")
+
+
+def _robot_args(n: int) -> str:
+    """Per robot k, ``model{k}`` (the scenario's ``model``; with ``mixed``, by k's parity) and
+    ``name{k}`` (its model's name prefix and k)."""
+    names = repr(NAME_PREFIXES)
+    out = []
+    for k in range(1, n + 1):
+        model = f"$(eval '{MIXED[k % 2]}' if model == 'mixed' else model)"
+        out.append(
+            f"""  <arg name="model{k}" value="{model}"/>
+  <arg name="name{k}" value="$(eval {names}[model{k}] + '{k}')"/>"""
+        )
+    return "\n".join(out)
 
 
 def _choices(values) -> str:
@@ -133,6 +157,11 @@ def scenario(name: str, doc: str, world: str | dict, counts: tuple[int, ...], ro
   </arg>
   <arg name="start_delay" default="2.0" doc="sim seconds before the goals go out"/>
   <arg name="solo" default="" doc="run only this robot (e.g. lizi3): its time and path alone"/>
+  <arg name="model" default="lizi"
+       doc="lizi | pioneer3at | mixed (odd robots lizis, even ones pioneer3ats)">
+    {_choices((*NAME_PREFIXES, "mixed"))}
+  </arg>
+{_robot_args(len(robots))}
 {_world_arg(world)}
   <arg name="gui" default="true" doc="open the live view when run with --viz"/>
 

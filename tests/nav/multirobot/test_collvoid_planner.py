@@ -140,6 +140,29 @@ def test_head_on_swap_with_or_without_the_others_in_the_costmap(fleet):
     assert f.run(20.0) and f.min_gap > 0.0
 
 
+def test_a_standing_robot_in_view_is_an_obstacle_of_its_shared_shape():
+    """A robot that stands still where our sensors see it (a few lethal cells of its near face
+    in our costmap) leaves ORCA and is drawn into the walls with the footprint it shares, wheels
+    and all (a pioneer3at passing one parked in a corridor scraped the wheels its laser had not
+    seen); one we do not see stays an ORCA disc."""
+    for seen in (True, False):
+        f = Fleet([(-1.0, 0, 0), (0.0, 0.0, math.pi)], [(3.0, 0, 0), (0.0, 0.0, math.pi)])
+        pl = f.planners[0]
+        pl.costmap = empty_map()
+        if seen:
+            pl.costmap.costs[199:201, 195:197] = LETHAL_OBSTACLE  # its west face, (-0.2, 0.0)
+        f.share()
+        f.rt.run(duration=0.1)
+        pl.compute_velocity_commands(tuple(f.state[0]), (0.0, 0.0, 0.0))
+        costs, n_obst = pl.grid[0], pl.lines[2]
+        rows, cols = polygon_cells(pl.costmap, footprint_at(LIZI, 0.0, 0.0, math.pi))
+        robots = pl.lines[0].shape[0] - n_obst  # the robot half-planes
+        if seen:
+            assert np.all(costs[rows, cols] == LETHAL_OBSTACLE) and robots == 0 and n_obst > 0
+        else:
+            assert costs is pl.costmap.costs and robots == 1 and n_obst == 0
+
+
 def test_without_robots_clears_lethal_cells_in_the_discs_only():
     cm = empty_map([(1.0, -5, 1.05, 5)])  # a wall at x = 1
     cm.costs[200:204, 180:184] = LETHAL_OBSTACLE  # a robot's image around (-0.9, 0.05)

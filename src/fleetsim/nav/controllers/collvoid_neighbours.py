@@ -94,6 +94,7 @@ class CollvoidNeighbours:
         try:
             tx, ty, tyaw = self._map_to_local()
         except TransformError:
+            self.near_footprints = []
             return xy, ids, pos, nvel, radii, resp, controlled, yaws, radii
         map_xy = rotated(xy - [tx, ty], -tyaw)
         near = self.share.table.near(
@@ -107,4 +108,5 @@ class CollvoidNeighbours:
         resp = np.where(~near.controlled | still, 1.0, 0.5)
         yaws = np.array([r.yaw for r in near.robots]) + tyaw
         radii, wide = self.neighbour_radii(own_r, map_xy, near, rotated(vel, -tyaw))
+        self.near_footprints = [r.footprint for r in near.robots]  # robot frames, as shared
         return map_xy, near.ids, pos, nvel, radii, resp, near.controlled, yaws, wide

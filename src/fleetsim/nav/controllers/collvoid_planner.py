@@ -68,9 +68,17 @@ from fleetsim.nav.controllers.collvoid_params import CollvoidParams
 from fleetsim.nav.controllers.collvoid_preference import (
     DECELERATION,
     KEEP_RIGHT_UNTIL,
+    STILL_SPEED,
     CollvoidPreference,
 )
-from fleetsim.nav.costmap.footprint import footprint_radii, outline_points
+from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
+from fleetsim.nav.costmap.footprint import (
+    footprint_at,
+    footprint_radii,
+    outline_points,
+    padded_footprint,
+    polygon_cells,
+)
 from fleetsim.nav.multirobot.crossing import GiveWay
 from fleetsim.nav.multirobot.deadlock import DeadlockRule
 from fleetsim.nav.multirobot.holonomic import (
@@ -101,6 +109,8 @@ SAME_GOAL_SHIFT = 0.5
 #: s; how old another robot's image in the local costmap can be against its shared pose (a
 #: 5 Hz costmap update and a 10 Hz /position_share message), and the most it moves meanwhile, m
 SEEN_LAG, SEEN_LAG_MAX = 0.3, 0.2
+#: lethal cells inside a standing robot's body that make it seen by this robot's own sensors
+SEEN_CELLS = 3
 
 
 class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive, LocalPlanner):
@@ -239,7 +249,17 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         map_xy, ids, pos, nvel, radii, resp, controlled, yaws, wide = self._neighbours(
             xy, own_r, vel
         )
-        self.grid = self._walls(pos, nvel, wide)
+        parked = self._parked_in_view(pos, nvel, yaws)
+        bodies = [  # obstacles of their true shape, as the walls (see _parked_in_view)
+            footprint_at(self.near_footprints[k], *pos[k], yaws[k]) for k in np.flatnonzero(parked)
+        ]
+        if parked.any():
+            keep = ~parked
+            ids = [i for i, k in zip(ids, keep.tolist()) if k]
+            pos, nvel, radii, resp, controlled, yaws, wide = (
+                a[keep] for a in (pos, nvel, radii, resp, controlled, yaws, wide)
+            )
+        self.grid = self._walls(pos, nvel, wide, bodies)
         dist = np.hypot(pos[:, 0] - xy[0], pos[:, 1] - xy[1])
         pair = self.pair_radii(own_r, radii, dist)
         active = {k: d for k, d, c in zip(ids, dist.tolist(), controlled) if c}
@@ -280,18 +300,44 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
             )
         return self._orca(xy, vel, pref, pos - xy, nvel, pair, resp)
 
-    def _walls(self, pos, nvel, wide) -> tuple[np.ndarray, tuple[float, float], float]:
+    def _parked_in_view(self, pos, nvel, yaws) -> np.ndarray:
+        """(N,) bool: the neighbours that stand still where this robot's own sensors see them
+        (``SEEN_CELLS`` lethal cells or more under the footprint they share, grown by a cell,
+        at ``pos`` (N, 2) m and ``yaws`` (N,) rad). They are left out of ORCA and stay in the
+        local costmap: the wall half-planes and the footprint check then take them with their
+        true shape, as collvoid puts standing robots into the costmap (its
+        ``stationary_robots``). A disc of the circumscribed radius is too wide beside them: a
+        pioneer3at (0.54 x 0.50 m, a 0.37 m disc) could not pass another one parked in the
+        middle of a 2 m corridor, with 0.75 m free on either side. A robot no sensor of ours
+        sees (a lizi's laser sweeps above the others) stays in ORCA."""
+        out = np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED
+        cm = self.costmap
+        for k in np.flatnonzero(out):
+            body = padded_footprint(self.near_footprints[k], cm.resolution)
+            rows, cols = polygon_cells(cm, footprint_at(body, *pos[k], yaws[k]))
+            out[k] = np.count_nonzero(cm.costs[rows, cols] == LETHAL_OBSTACLE) >= SEEN_CELLS
+        return out
+
+    def _walls(self, pos, nvel, wide, bodies=()) -> tuple[np.ndarray, tuple[float, float], float]:
         """The local costmap as (costs, origin, resolution) without the other robots' images
         (`without_robots`): each neighbour at ``pos`` (N, 2) m moving at ``nvel`` (N, 2) m/s,
         its body ``wide`` (N,) m grown by how far it moves in ``SEEN_LAG`` (at most
-        ``SEEN_LAG_MAX``) and two cells. What this cycle's wall half-planes, footprint check,
+        ``SEEN_LAG_MAX``) and two cells; with the standing robots' shared footprints
+        ``bodies`` (polygons, costmap frame) drawn in as LETHAL (a laser sees a robot's body
+        and not always its wheels). What this cycle's wall half-planes, footprint check,
         passage widths and refuge read."""
         cm = self.costmap
         origin, res = (cm.origin_x, cm.origin_y), cm.resolution
-        if not pos.shape[0]:
-            return cm.costs, origin, res
-        lag = np.minimum(SEEN_LAG * np.hypot(nvel[:, 0], nvel[:, 1]), SEEN_LAG_MAX)
-        return without_robots(cm.costs, origin, res, pos, wide + lag + 2.0 * res), origin, res
+        costs = cm.costs
+        if pos.shape[0]:
+            lag = np.minimum(SEEN_LAG * np.hypot(nvel[:, 0], nvel[:, 1]), SEEN_LAG_MAX)
+            costs = without_robots(costs, origin, res, pos, wide + lag + 2.0 * res)
+        for body in bodies:
+            if costs is cm.costs:
+                costs = costs.copy()
+            rows, cols = polygon_cells(cm, body)
+            costs[rows, cols] = LETHAL_OBSTACLE
+        return costs, origin, res
 
     def _orca(self, xy, vel, pref, rel, nvel, radii, resp) -> np.ndarray:
         """The velocity nearest ``pref`` (2,) m/s that the half-planes of the local costmap's

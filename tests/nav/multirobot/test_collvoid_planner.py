@@ -141,19 +141,22 @@ def test_head_on_swap_with_or_without_the_others_in_the_costmap(fleet):
 
 
 def test_a_standing_robot_in_view_is_an_obstacle_of_its_shared_shape():
-    """A robot that stands still where our sensors see it (a few lethal cells of its near face
-    in our costmap) leaves ORCA and is drawn into the walls with the footprint it shares, wheels
-    and all (a pioneer3at passing one parked in a corridor scraped the wheels its laser had not
-    seen); one we do not see stays an ORCA disc."""
+    """A robot that has stood still for a second where our sensors see it (a few lethal cells
+    of its near face in our costmap) leaves ORCA and is drawn into the walls with the footprint
+    it shares, wheels and all (a pioneer3at passing one parked in a corridor scraped the wheels
+    its laser had not seen); one we do not see stays an ORCA disc."""
     for seen in (True, False):
         f = Fleet([(-1.0, 0, 0), (0.0, 0.0, math.pi)], [(3.0, 0, 0), (0.0, 0.0, math.pi)])
         pl = f.planners[0]
         pl.costmap = empty_map()
         if seen:
             pl.costmap.costs[199:201, 195:197] = LETHAL_OBSTACLE  # its west face, (-0.2, 0.0)
-        f.share()
-        f.rt.run(duration=0.1)
-        pl.compute_velocity_commands(tuple(f.state[0]), (0.0, 0.0, 0.0))
+        for _ in range(12):  # it counts as parked once it has stood still for 1 s
+            f.share()
+            f.rt.run(duration=0.1)
+            pl.compute_velocity_commands(tuple(f.state[0]), (0.0, 0.0, 0.0))
+            if _ == 8:
+                assert pl.lines[0].shape[0] - pl.lines[2] == 1  # still in ORCA after 0.9 s
         costs, n_obst = pl.grid[0], pl.lines[2]
         rows, cols = polygon_cells(pl.costmap, footprint_at(LIZI, 0.0, 0.0, math.pi))
         robots = pl.lines[0].shape[0] - n_obst  # the robot half-planes

@@ -111,6 +111,9 @@ SAME_GOAL_SHIFT = 0.5
 SEEN_LAG, SEEN_LAG_MAX = 0.3, 0.2
 #: lethal cells inside a standing robot's body that make it seen by this robot's own sensors
 SEEN_CELLS = 3
+#: s a robot has stood still before it counts as parked (a robot stopping for a moment in a
+#: crowd, or turning on the spot, stays in ORCA)
+PARKED_TIME = 1.0
 
 
 class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive, LocalPlanner):
@@ -182,6 +185,7 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         self.retreat = Retreat()  # the way back and the refuge of a yield
         self.lines = (np.zeros((0, 2)), np.zeros((0, 2)), 0)  # this cycle's half-planes
         self.grid = None  # this cycle's local costmap without the other robots (`_walls`)
+        self.still_since: dict[str, float] = {}  # neighbour -> since when it stands still
         self.feasible = True
         #: robot id -> the side (0 right, 1 left) a robot standing in the way is gone round on
         self.detour_sides: dict[str, int] = {}
@@ -249,7 +253,7 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         map_xy, ids, pos, nvel, radii, resp, controlled, yaws, wide = self._neighbours(
             xy, own_r, vel
         )
-        parked = self._parked_in_view(pos, nvel, yaws)
+        parked = self._parked_in_view(ids, pos, nvel, yaws)
         bodies = [  # obstacles of their true shape, as the walls (see _parked_in_view)
             footprint_at(self.near_footprints[k], *pos[k], yaws[k]) for k in np.flatnonzero(parked)
         ]
@@ -300,17 +304,28 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
             )
         return self._orca(xy, vel, pref, pos - xy, nvel, pair, resp)
 
-    def _parked_in_view(self, pos, nvel, yaws) -> np.ndarray:
-        """(N,) bool: the neighbours that stand still where this robot's own sensors see them
-        (``SEEN_CELLS`` lethal cells or more under the footprint they share, grown by a cell,
-        at ``pos`` (N, 2) m and ``yaws`` (N,) rad). They are left out of ORCA and stay in the
+    def _parked_in_view(self, ids, pos, nvel, yaws) -> np.ndarray:
+        """(N,) bool: the neighbours ``ids`` that have stood still for ``PARKED_TIME`` where
+        this robot's own sensors see them (``SEEN_CELLS`` lethal cells or more under the
+        footprint they share, grown by a cell, at ``pos`` (N, 2) m and ``yaws`` (N,) rad).
+        They are left out of ORCA and stay in the
         local costmap: the wall half-planes and the footprint check then take them with their
         true shape, as collvoid puts standing robots into the costmap (its
         ``stationary_robots``). A disc of the circumscribed radius is too wide beside them: a
         pioneer3at (0.54 x 0.50 m, a 0.37 m disc) could not pass another one parked in the
         middle of a 2 m corridor, with 0.75 m free on either side. A robot no sensor of ours
         sees (a lizi's laser sweeps above the others) stays in ORCA."""
-        out = np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED
+        still = np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED
+        now, since = self.node.now(), self.still_since
+        for k in [k for k in since if k not in ids]:
+            del since[k]
+        for k, s in zip(ids, still.tolist()):
+            if not s:
+                since.pop(k, None)
+            else:
+                since.setdefault(k, now)
+        out = np.array([s and now - since[k] >= PARKED_TIME for k, s in zip(ids, still.tolist())])
+        out = out.astype(bool).reshape(len(ids))
         cm = self.costmap
         for k in np.flatnonzero(out):
             body = padded_footprint(self.near_footprints[k], cm.resolution)

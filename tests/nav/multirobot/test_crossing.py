@@ -20,6 +20,7 @@ from fleetsim.nav.multirobot.crossing import (
     GiveWay,
     across_way,
     carried_by,
+    collision_course,
     room_to_turn,
 )
 from fleetsim.nav.multirobot.holonomic import rays_blocked
@@ -185,3 +186,41 @@ def test_room_to_turn_is_no_other_robot_within_the_combined_radius_and_clearance
     assert room_to_turn(rel, r, 0)  # the one given way to does not count
     assert not room_to_turn(rel, r + TURN_CLEARANCE * 0.5, 0)  # 0.70 < 0.52 + 0.075 + 0.15
     assert room_to_turn(rel[[0, 2]], r[:2], 0)
+
+
+def test_collision_course_is_the_pair_meeting_within_the_horizon():
+    """`collision_course` against the pair's motion sampled finely: the robot at the origin at
+    ``velocity``, each neighbour at its own, meeting when their distance drops under the
+    combined radius within the horizon (or they overlap and close in)."""
+    rng = np.random.default_rng(5)
+    horizon, steps = 3.0, np.linspace(0.0, 3.0, 3001)
+    for _ in range(300):
+        n = int(rng.integers(1, 6))
+        rel = rng.uniform(-2.0, 2.0, (n, 2))
+        nvel = rng.uniform(-0.5, 0.5, (n, 2))
+        radii = rng.uniform(0.3, 0.7, n)
+        vel = rng.uniform(-0.5, 0.5, 2)
+        got = collision_course(vel, rel, nvel, radii, horizon)
+        for k in range(n):
+            w = vel - nvel[k]
+            gap = np.hypot(*(rel[k][None, :] - steps[:, None] * w[None, :]).T) - radii[k]
+            inside_now = gap[0] < 0.0
+            closing = float(w @ rel[k]) > 0.0
+            meets = bool((gap[1:] < -1e-3).any()) if not inside_now else closing
+            if inside_now or abs(gap.min()) > 1e-3:  # off the grazing cases
+                assert got[k] == meets, (rel[k], w, radii[k])
+
+
+def test_a_robot_crossing_out_of_our_way_is_no_longer_in_it():
+    """Circle of 16, seed 10, lizi10 giving way to lizi2 (its frame, 1.5 s into the give-way):
+    lizi2's disc still lies on the ray of lizi10's way within `REACH`, but it moves off it
+    faster than lizi10 would reach it: driving along its way lizi10 passes behind it, so the
+    give-way ends here (it stood and turned another 0.9 s while lizi2's disc cleared the ray)."""
+    wanted = 0.5 * np.array([math.cos(math.radians(-56)), math.sin(math.radians(-56))])
+    b = math.radians(-70)
+    rel = np.array([[0.65 * math.cos(b), 0.65 * math.sin(b)]])
+    its = 0.5 * np.array([[math.cos(math.radians(-125)), math.sin(math.radians(-125))]])
+    assert across_way(rel, R, wanted, 1.0).tolist() == [True]
+    assert collision_course(wanted, rel, its, R, 3.0).tolist() == [False]
+    # standing, it still comes our way: in our way
+    assert collision_course(wanted, rel, np.zeros((1, 2)), R, 3.0).tolist() == [True]

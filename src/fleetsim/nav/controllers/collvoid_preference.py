@@ -17,6 +17,7 @@ from fleetsim.nav.multirobot.crossing import (
     REACH,
     across_way,
     carried_by,
+    collision_course,
     room_to_turn,
 )
 from fleetsim.nav.multirobot.holonomic import detour_velocity, gaps_closed
@@ -93,7 +94,11 @@ class CollvoidPreference:
         carrying = carried_by(rel, nvel, radii, vel, wanted, REACH) & moving
         if (meeting & ~carrying).any():
             carrying[:] = False
-        in_the_way = across_way(rel, radii, wanted, REACH)
+        # in our way: across it, and met going our way within ORCA's horizon (a robot
+        # crossing it is out of our way before its disc has left the ray)
+        in_the_way = across_way(rel, radii, wanted, REACH) & collision_course(
+            wanted, rel, nvel, radii, self.params.time_horizon
+        )
         to = self.give_way.update(self.node.now(), list(ids), carrying, in_the_way, controlled)
         self.giving_way_to = to
         if to is None:

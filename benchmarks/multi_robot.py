@@ -40,6 +40,7 @@ Usage: python benchmarks/multi_robot.py [--seeds 10] [--first-seed 0]
 from __future__ import annotations
 
 import argparse
+import functools
 import itertools
 import logging
 import math
@@ -103,6 +104,15 @@ def jittered_plan(path: Path, args: dict[str, str], seed: int, jitter: float):
 
 def robot_name(model: str, k: int) -> str:
     """Robot k's name in a scenario run with ``model`` (make_multi_robot_launch's rule)."""
+    gen = _generator()
+    if model == "mixed":
+        model = gen.MIXED[k % 2]
+    return f"{gen.NAME_PREFIXES[model]}{k}"
+
+
+@functools.cache
+def _generator():
+    """The scenarios' generator script, shipped with the launch files (loaded once)."""
     import importlib.util
 
     import fleetsim
@@ -111,9 +121,7 @@ def robot_name(model: str, k: int) -> str:
     spec = importlib.util.spec_from_file_location("make_multi_robot_launch", script)
     gen = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(gen)
-    if model == "mixed":
-        model = gen.MIXED[k % 2]
-    return f"{gen.NAME_PREFIXES[model]}{k}"
+    return gen
 
 
 def scenario_item(item: str) -> tuple[str, int, dict[str, str]]:

@@ -104,7 +104,8 @@ class CollvoidDrive:
 
     def _footprint_clear(self, cmd, pose, velocity) -> tuple[float, float, float]:
         """``cmd``, or the command nearest it whose footprint rollout over ``time_horizon_obst``
-        is clear of the local costmap's obstacles (`footprint_safe_command`), at speeds the
+        is clear of the local costmap's obstacles (`footprint_safe_command` on this cycle's
+        ``grid``, set by `holonomic_velocity`), at speeds the
         robots' half-planes admit along the heading (any, when they admit none there).
 
         When the clear command nearest the holonomic velocity is to stand still while that
@@ -119,7 +120,6 @@ class CollvoidDrive:
         for sign, top in ((1.0, p.max_vel_x), (-1.0, back_top)):
             lo, hi = speed_interval(points[n_obst:], dirs[n_obst:], sign * u, top)
             caps.append(hi if lo <= hi else top)  # none admitted: as speed_along_heading
-        cm = self.costmap
         horizon = self.horizon_obst if self.horizon_obst < UNTRUNCATED else p.time_horizon_obst
 
         def clear(wanted, holo):
@@ -128,7 +128,7 @@ class CollvoidDrive:
                 holo,
                 tuple(float(a) for a in pose),
                 (float(velocity[0]), float(velocity[2])),
-                self.grid or (cm.costs, (cm.origin_x, cm.origin_y), cm.resolution),
+                self.grid,  # this cycle's local costmap, the other robots' images cleared
                 self.outline,
                 (-caps[1], caps[0], p.min_vel_theta, p.max_vel_theta, p.acc_lim_x, p.acc_lim_theta),
                 horizon,

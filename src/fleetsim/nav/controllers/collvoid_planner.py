@@ -253,11 +253,8 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         map_xy, ids, pos, nvel, radii, resp, controlled, yaws, wide = self._neighbours(
             xy, own_r, vel
         )
-        parked = self._parked_in_view(ids, pos, nvel, yaws)
-        bodies = [  # obstacles of their true shape, as the walls (see _parked_in_view)
-            footprint_at(self.near_footprints[k], *pos[k], yaws[k]) for k in np.flatnonzero(parked)
-        ]
-        if parked.any():
+        parked, bodies = self._parked_in_view(ids, pos, nvel, yaws)
+        if parked.any():  # obstacles of their true shape, as the walls (see _parked_in_view)
             keep = ~parked
             ids = [i for i, k in zip(ids, keep.tolist()) if k]
             pos, nvel, radii, resp, controlled, yaws, wide = (
@@ -304,8 +301,9 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
             )
         return self._orca(xy, vel, pref, pos - xy, nvel, pair, resp)
 
-    def _parked_in_view(self, ids, pos, nvel, yaws) -> np.ndarray:
-        """(N,) bool: the neighbours ``ids`` that have stood still for ``PARKED_TIME`` where
+    def _parked_in_view(self, ids, pos, nvel, yaws) -> tuple[np.ndarray, list[np.ndarray]]:
+        """(N,) bool, and their shared footprints at their poses (polygons, costmap frame):
+        the neighbours ``ids`` that have stood still for ``PARKED_TIME`` where
         this robot's own sensors see them (``SEEN_CELLS`` lethal cells or more under the
         footprint they share, grown by a cell, at ``pos`` (N, 2) m and ``yaws`` (N,) rad).
         They are left out of ORCA and stay in the
@@ -326,12 +324,15 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
                 since.setdefault(k, now)
         out = np.array([s and now - since[k] >= PARKED_TIME for k, s in zip(ids, still.tolist())])
         out = out.astype(bool).reshape(len(ids))
-        cm = self.costmap
+        cm, bodies = self.costmap, []
         for k in np.flatnonzero(out):
-            body = padded_footprint(self.near_footprints[k], cm.resolution)
-            rows, cols = polygon_cells(cm, footprint_at(body, *pos[k], yaws[k]))
+            fp = self.near_footprints[k]
+            grown = padded_footprint(fp, cm.resolution)
+            rows, cols = polygon_cells(cm, footprint_at(grown, *pos[k], yaws[k]))
             out[k] = np.count_nonzero(cm.costs[rows, cols] == LETHAL_OBSTACLE) >= SEEN_CELLS
-        return out
+            if out[k]:
+                bodies.append(footprint_at(fp, *pos[k], yaws[k]))
+        return out, bodies
 
     def _walls(self, pos, nvel, wide, bodies=()) -> tuple[np.ndarray, tuple[float, float], float]:
         """The local costmap as (costs, origin, resolution) without the other robots' images

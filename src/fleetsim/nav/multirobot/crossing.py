@@ -80,10 +80,16 @@ def across_way(rel_pos: np.ndarray, radii: np.ndarray, direction: np.ndarray, re
         return np.zeros(rel_pos.shape[0], dtype=bool)
     u = np.asarray(direction, dtype=np.float64) / n
     along = rel_pos @ u
-    side = u[0] * rel_pos[:, 1] - u[1] * rel_pos[:, 0]
-    inside = radii**2 - side**2
-    entry = along - np.sqrt(np.maximum(inside, 0.0))
+    inside, entry = _ray_entry(along, u[0] * rel_pos[:, 1] - u[1] * rel_pos[:, 0], radii)
     return (along > 1e-9) & (inside > 0.0) & (entry < reach)
+
+
+def _ray_entry(along: np.ndarray, side: np.ndarray, radii: np.ndarray) -> tuple:
+    """For rays meeting discs of ``radii`` (N,) m whose centres lie ``along`` (N,) m along and
+    ``side`` (N,) m across them: (radius^2 - side^2, > 0 where the ray's line crosses the
+    disc; m along the ray where it enters the disc)."""
+    inside = radii**2 - side**2
+    return inside, along - np.sqrt(np.maximum(inside, 0.0))
 
 
 def collision_course(
@@ -101,9 +107,7 @@ def collision_course(
     speed = np.hypot(w[:, 0], w[:, 1])
     u = w / np.maximum(speed, 1e-9)[:, None]
     along = np.einsum("ij,ij->i", u, rel_pos)
-    side = u[:, 0] * rel_pos[:, 1] - u[:, 1] * rel_pos[:, 0]
-    inside = radii**2 - side**2
-    entry = along - np.sqrt(np.maximum(inside, 0.0))
+    inside, entry = _ray_entry(along, u[:, 0] * rel_pos[:, 1] - u[:, 1] * rel_pos[:, 0], radii)
     inside_now = np.hypot(rel_pos[:, 0], rel_pos[:, 1]) < radii
     hit = (speed > 1e-9) & (along > 0.0) & (inside > 0.0) & (entry < speed * horizon)
     return hit | (inside_now & (along > 0.0))

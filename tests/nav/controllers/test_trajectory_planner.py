@@ -180,7 +180,7 @@ def test_the_default_limits_are_not_warned_about(caplog):
 
 
 def test_an_escape_that_cannot_turn_yet_backs_on_past_escape_reset_dist():
-    from fleetsim.nav.controllers.selection import ESCAPE_ROOM, _end_escape_when_clear
+    from fleetsim.nav.controllers.escape import ESCAPE_ROOM, _end_escape_when_clear
 
     tp = make(corridor())
     reset = tp.params.escape_reset_dist
@@ -255,7 +255,8 @@ def test_an_in_place_rotation_turns_the_short_way_to_a_near_goal(th0, bearing):
 
 
 def test_the_escape_backs_on_a_curve_that_faces_the_robot_along_its_way():
-    from fleetsim.nav.controllers.selection import _escape_choice, velocity_samples
+    from fleetsim.nav.controllers.escape import _escape_choice
+    from fleetsim.nav.controllers.selection import velocity_samples
 
     tp = make(corridor(), dwa=True, acc_lim_theta=3.0, sim_time=1.5, escape_vel=-0.1)
     tp.set_plan(np.array([[x, 1.0, 0.0] for x in np.arange(1.0, 5.0, 0.05)]))
@@ -316,7 +317,8 @@ def test_alignment_cost_kernel_on_off_and_beside_the_path():
 
 @pytest.mark.parametrize("aligning", [False, True])
 def test_escaping_with_alignment_backs_on_rather_than_turn_away_from_the_path(aligning):
-    from fleetsim.nav.controllers.selection import choose_trajectory, path_heading
+    from fleetsim.nav.controllers.lookahead import path_heading
+    from fleetsim.nav.controllers.selection import choose_trajectory
 
     tp, pose, vel = _off_axis_in_corridor(alignment_scale=0.6 if aligning else 0.0)
     assert path_heading(tp, pose) == pytest.approx(0.0, abs=1e-9)  # along the axis

@@ -256,5 +256,5 @@ def test_a_peers_observed_point_keeps_the_time_it_was_first_heard_of():
     rt.run(duration=3.0)
     peer.announce([(1.0, 1.0), (2.0, 0.5)])
     rt.run(duration=0.5)
-    (heard,) = ex.peer_stood_at.values()
+    (heard,) = ex.link.stood_at.values()
     assert heard == [(1.0, 1.0, 0.0), (2.0, 0.5, pytest.approx(3.0))]

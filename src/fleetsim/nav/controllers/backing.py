@@ -13,9 +13,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from fleetsim.nav.controllers.selection import (
+from fleetsim.nav.controllers.escape import _escape_key
+from fleetsim.nav.controllers.lookahead import (
     _ahead_goal_dist_turning,
-    _escape_key,
     _least_heading_error,
     _refused,
     _wrap,

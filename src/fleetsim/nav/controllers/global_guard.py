@@ -108,7 +108,7 @@ class GlobalCostmapGuard:
     def body_clear(self, poses: np.ndarray) -> bool:
         """Whether the rollout through ``poses`` ((T, 3), local frame) keeps the body off the
         local costmap's lethal cells it does not touch at the first pose, and the guard does
-        not refuse it: a move the padding alone makes illegal (`selection._padding_way_out`)."""
+        not refuse it: a move the padding alone makes illegal (`escape._padding_way_out`)."""
         if poses.shape[0] < 2:
             return True
         local = self.local_costmap.costmap

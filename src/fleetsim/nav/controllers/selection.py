@@ -10,7 +10,8 @@ obstacle is judged by how near it comes to that direction, and an escaping robot
 toward it, else backs on (`_escape_can_turn`); with ``back_along_plan`` too (another fleetsim
 addition, off by default) a robot facing away from its plan turns toward it where it can turn
 all the way, else backs along it (`fleetsim.nav.controllers.backing`). With 0 every choice is
-base_local_planner's.
+base_local_planner's. What a rollout says beyond its cost is read in
+`fleetsim.nav.controllers.lookahead`; the escape, taken last, is `fleetsim.nav.controllers.escape`.
 """
 
 from __future__ import annotations
@@ -20,6 +21,23 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 from numba import njit
+
+from fleetsim.nav.controllers import backing
+from fleetsim.nav.controllers.escape import (
+    _end_escape_when_clear,
+    _escape,
+    _escape_choice,
+    _padding_way_out,
+)
+from fleetsim.nav.controllers.lookahead import (
+    _ahead_goal_dist,
+    _ahead_goal_dist_turning,
+    _aligning,
+    _least_heading_error,
+    _refused,
+    _turns_toward,
+    path_heading,
+)
 
 if TYPE_CHECKING:
     from fleetsim.nav.controllers.trajectory_planner import TrajectoryPlanner
@@ -139,134 +157,6 @@ def _in_place_window(p, vth: float) -> tuple[float, float]:
     return lo, d
 
 
-def _ahead_goal_dist(tp: TrajectoryPlanner, index: int) -> float | None:
-    """Goal distance at the end of a rollout pushed ``heading_lookahead`` ahead, or None."""
-    n = int(tp._steps[index])
-    xr, yr, thr = tp._poses[index, n - 1]
-    xr += tp.params.heading_lookahead * math.cos(thr)
-    yr += tp.params.heading_lookahead * math.sin(thr)
-    cell = tp.costmap.world_to_map(xr, yr)
-    return None if cell is None else float(tp.goal_dist[cell[1], cell[0]])
-
-
-def _ahead_goal_dist_turning(tp: TrajectoryPlanner, index: int) -> tuple[float, int] | None:
-    """For an in-place rotation: the least goal distance ``heading_lookahead`` ahead of any
-    pose of its rollout, and the first step that reaches it; None if none is on the map.
-
-    Departure from base_local_planner, which looks ahead of the rollout's end only. With
-    in-place rates sampled over sim_time's window a rollout can turn past a half turn, and its
-    end then points anywhere: a burger 0.2 m from its goal with the goal 90 degrees to its
-    left chose the rotation whose end, after 315 degrees to the right, pointed at the goal,
-    and spun the long way round. Judged by the best heading it passes and how soon, the
-    rotation toward the goal wins.
-    """
-    m = tp.costmap
-    dist, step = _turning_lookahead(
-        tp._poses[index],
-        int(tp._steps[index]),
-        tp.params.heading_lookahead,
-        m.origin_x,
-        m.origin_y,
-        m.resolution,
-        tp.goal_dist,
-    )
-    return None if step < 0 else (dist, step)
-
-
-@njit(cache=True)
-def _turning_lookahead(poses, n, look, ox, oy, res, goal_dist):
-    """`_ahead_goal_dist_turning` over one rollout's first ``n`` poses, compiled (up to ~80
-    poses x 40 rotations a control cycle): the least goal distance ``look`` m ahead of a pose
-    on the map and the first step reaching it; step -1 when none is on the map. Cells as
-    `Costmap2D.cells_of` (floor of the offset over the resolution)."""
-    h, w = goal_dist.shape
-    best, step = np.inf, -1
-    for i in range(n):
-        x = poses[i, 0] + look * math.cos(poses[i, 2])
-        y = poses[i, 1] + look * math.sin(poses[i, 2])
-        cx = math.floor((x - ox) / res)
-        cy = math.floor((y - oy) / res)
-        if cx < 0 or cy < 0 or cx >= w or cy >= h:
-            continue
-        d = goal_dist[cy, cx]
-        if step < 0 or d < best:
-            best, step = d, i
-    return best, step
-
-
-#: how many escape_reset_dist a robot that cannot turn in place backs up at most
-ESCAPE_ROOM = 5.0
-#: m: how far along its plan the point lies whose direction is "the path's direction"
-PATH_HEADING_DIST = 0.75
-#: rad: a robot this close to the path's direction counts as lined up with it
-ALIGNED = 0.2
-
-
-def _wrap(a):
-    return (a + math.pi) % (2 * math.pi) - math.pi
-
-
-def path_heading(tp: TrajectoryPlanner, pose) -> float | None:
-    """The direction (rad) from the robot to its plan ``PATH_HEADING_DIST`` ahead: from the
-    plan point nearest the robot on, the first at least that far from it (else the last).
-    None without a plan."""
-    plan = tp.plan
-    if plan.shape[0] == 0:
-        return None
-    d = np.hypot(plan[:, 0] - pose[0], plan[:, 1] - pose[1])
-    i = int(np.argmin(d))
-    far = np.flatnonzero(d[i:] >= PATH_HEADING_DIST)
-    j = i + int(far[0]) if far.shape[0] else plan.shape[0] - 1
-    if d[j] < 1e-9:
-        return None
-    return math.atan2(plan[j, 1] - pose[1], plan[j, 0] - pose[0])
-
-
-def _aligning(tp: TrajectoryPlanner) -> bool:
-    """Whether rotations and escapes are judged by the path's direction (``alignment_scale``
-    > 0, a fleetsim addition; see `choose_trajectory`)."""
-    return tp.params.alignment_scale > 0.0
-
-
-def _least_heading_error(tp: TrajectoryPlanner, index: int, direction: float) -> float:
-    """The least |heading - direction| (rad) over rollout ``index``'s poses."""
-    n = max(int(tp._steps[index]), 1)
-    return float(np.abs(_wrap(tp._poses[index, :n, 2] - direction)).min())
-
-
-def _turns_toward(tp: TrajectoryPlanner, index: int, th: float, direction: float | None) -> bool:
-    """Whether rollout ``index`` brings the robot nearer the path's direction (or it is
-    lined up already)."""
-    if direction is None:
-        return True
-    err = abs(_wrap(th - direction))
-    return err <= ALIGNED or _least_heading_error(tp, index, direction) < err - 0.5 * ALIGNED
-
-
-def _end_escape_when_clear(
-    tp: TrajectoryPlanner, x: float, y: float, th: float, can_turn: bool = True
-) -> None:
-    """Stop escaping once the robot is escape_reset_dist or escape_reset_theta away from
-    where the escape began.
-
-    Departure from base_local_planner: the distance ends an escape only where an in-place
-    rotation is legal (or after ``ESCAPE_ROOM`` times escape_reset_dist). In a gap barely
-    wider than the robot, ROS backs up 0.1 m, drives the same 0.1 m forward into the spot where
-    nothing is legal, and backs up again, for ever (the BARN timeouts); backing on, while the
-    backward rollout is legal, until the robot can turn lets the in-place rotation that follows
-    take it out of the gap."""
-    ex, ey, eth = tp.escape_pose
-    dth = abs((eth - th + math.pi) % (2 * math.pi) - math.pi)
-    dist = math.hypot(x - ex, y - ey)
-    reset = tp.params.escape_reset_dist
-    if (
-        (dist > reset and can_turn)
-        or dist > ESCAPE_ROOM * reset
-        or dth > tp.params.escape_reset_theta
-    ):
-        tp.escaping = False
-
-
 def _bookkeep(tp: TrajectoryPlanner, sample, pose) -> None:
     """Oscillation flags and escape reset after a legal choice."""
     vx, vy, vth = sample
@@ -294,104 +184,6 @@ def _bookkeep(tp: TrajectoryPlanner, sample, pose) -> None:
     _end_escape_when_clear(tp, x, y, th)
 
 
-def _escape_choice(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: float) -> int:
-    """The escape sample: ROS's straight back-up, or a legal back-up that turns the robot
-    to face the way to the goal better (chosen by in-place rotation's rule: the least goal
-    distance a heading_lookahead ahead of the rollout's end).
-
-    Departure from base_local_planner, which only backs straight: a robot that entered a gap
-    barely wider than itself at a slant (BARN world 105, the jackal 0.6 rad off the gap's
-    axis) backs out straight, drives in again at the same slant and is wedged again; backing
-    on a curve straightens it out of the gap as a driver's three-point turn does. With
-    alignment, a look-ahead on an obstacle ties and the end heading against the path's
-    direction decides.
-
-    Rollouts the global costmap guard refuses (`global_guard`) are passed over; -1 when it
-    refuses every one."""
-    direction = path_heading(tp, tp._poses[g["escape"].start, 0]) if _aligning(tp) else None
-    best = g["escape"].start
-    best_key = _escape_key(tp, best, direction) if costs[best] >= 0 else None
-    if _refused(tp, best):
-        best, best_key = -1, None
-    raw = tp._in_place_raw
-    for k, i in enumerate(range(g["escape_turn"].start, g["escape_turn"].stop)):
-        if costs[i] < 0 or -dvth <= raw[k] <= dvth:
-            continue
-        ki = _escape_key(tp, i, direction)
-        if ki is not None and (best_key is None or ki < best_key) and not _refused(tp, i):
-            best, best_key = i, ki
-    return best
-
-
-def _escape_key(tp: TrajectoryPlanner, i: int, direction: float | None):
-    """How `_escape_choice` ranks back-up ``i`` (least first); None when its look-ahead is
-    off the map."""
-    ahead = _ahead_goal_dist(tp, i)
-    if ahead is None:
-        return None
-    if direction is None:
-        return (ahead,)
-    # with alignment: a look-ahead onto an obstacle tells the headings nothing apart, the
-    # heading at the end against the path's direction does
-    n = max(int(tp._steps[i]), 1)
-    size = float(tp.goal_dist.size)
-    return (min(ahead, size), abs(_wrap(tp._poses[i, n - 1, 2] - direction)))
-
-
-def _refused(tp: TrajectoryPlanner, index: int) -> bool:
-    """Whether the global costmap guard (``global_costmap_check``, `global_guard`) refuses
-    rollout ``index`` (as far as `GlobalCostmapGuard.checked_poses` looks)."""
-    guard = tp.global_guard
-    return guard is not None and guard.refuses(guard.checked_poses(tp, index))
-
-
-def _padding_way_out(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, dvth: float) -> int:
-    """With every escape refused by the global costmap guard: the in-place rotation or forward
-    move illegal only because of the padding (its rollout, as far as the guard looks, keeps
-    the body itself off the lethal cells of both costmaps) that looks best by in-place
-    rotation's rule (least goal distance ``heading_lookahead`` ahead); -1 if none.
-
-    A fleetsim addition, part of ``global_costmap_check``: a robot wedged within its padding
-    of obstacles in front, with the one behind known only to the global costmap, stood
-    pinned where ROS would have backed into it (office seed 6: a hunter by a desk for 126 s
-    until explore gave up), as navfn's way out frees a robot whose centre is inscribed."""
-    guard = tp.global_guard
-    if guard is None:
-        return -1
-    best, best_key = -1, None
-    raw = tp._in_place_raw
-    candidates = [
-        (i, True) for k, i in enumerate(range(g["in_place"].start, g["in_place"].stop))
-        if not -dvth <= raw[k] <= dvth
-    ] + [(i, False) for i in range(g["forward"].start, g["forward"].stop)]  # fmt: skip
-    for i, turning in candidates:
-        if costs[i] != -1.0:  # legal ones were refused already; -2: no way to the goal
-            continue
-        if turning:
-            ahead = _ahead_goal_dist_turning(tp, i)
-        else:
-            d = _ahead_goal_dist(tp, i)
-            ahead = None if d is None else (d, 0)
-        if ahead is None or (best_key is not None and ahead >= best_key):
-            continue
-        if guard.body_clear(guard.checked_poses(tp, i)):
-            best, best_key = i, ahead
-    return best
-
-
-def _escape_can_turn(tp: TrajectoryPlanner, costs: np.ndarray, g: dict, pose) -> bool:
-    """Whether a legal in-place rotation lets the escape end: any one (base_local_planner's
-    escape ends after escape_reset_dist), or with alignment only one that turns the robot
-    toward the path's direction. A jackal wedged in a gap entered 0.6 rad off its axis could
-    turn only further off it (BARN world 45); ending the escape there, it turned away, drove in
-    at a slant again and backed out again for 90 s."""
-    legal = [i for i in range(g["in_place"].start, g["in_place"].stop) if costs[i] >= 0]
-    if not _aligning(tp):
-        return bool(legal)
-    direction = path_heading(tp, pose)
-    return any(_turns_toward(tp, i, pose[2], direction) for i in legal)
-
-
 def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
     """The chosen sample, its cost and its batch index (cost < 0: nothing legal)."""
     samples, g, dvth = velocity_samples(tp, pose, vel)
@@ -399,14 +191,11 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
     best, best_cost = -1, -1.0
     direction = path_heading(tp, pose) if _aligning(tp) else None
     backs = direction is not None and tp.params.back_along_plan
-    if backs:
-        from fleetsim.nav.controllers import backing  # it uses this module's rules
-
-        if tp.backing_from is not None:
-            i = backing.backing_on(tp, costs, g, dvth, pose, direction)
-            if i >= 0:
-                _bookkeep(tp, samples[i], pose)
-                return tuple(samples[i]), float(costs[i]), i
+    if backs and tp.backing_from is not None:
+        i = backing.backing_on(tp, costs, g, dvth, pose, direction)
+        if i >= 0:
+            _bookkeep(tp, samples[i], pose)
+            return tuple(samples[i]), float(costs[i]), i
 
     if not tp.escaping:  # the first sample of least legal cost among forward and strafe
         first = costs[g["forward"].start : g["strafe"].stop]
@@ -468,22 +257,3 @@ def choose_trajectory(tp: TrajectoryPlanner, pose, vel):
         _bookkeep(tp, samples[j], pose)
         return tuple(samples[j]), 1.0, j
     return _escape(tp, costs, g, dvth, samples, pose, i)
-
-
-def _escape(tp: TrajectoryPlanner, costs, g: dict, dvth: float, samples, pose, i: int):
-    """Take escape sample ``i`` (`_escape_choice`): enter or keep escape mode, end it when
-    clear; returns the sample, its cost (1.0 for a blind one) and ``i``."""
-    cost = float(costs[i])
-    x, y, th = pose
-    if math.hypot(x - tp.prev[0], y - tp.prev[1]) > tp.params.oscillation_reset_dist:
-        tp._reset_oscillation_flags()
-    if not tp.escaping and cost > -2.0:
-        tp.escape_pose = (x, y, th)
-        tp.escaping = True
-    # backing on is for a robot wedged where it cannot turn, and only while the map says the
-    # backward rollout is free (the escape itself is taken blind)
-    can_turn = _escape_can_turn(tp, costs, g, pose) or cost < 0.0
-    _end_escape_when_clear(tp, x, y, th, can_turn)
-    if cost == -1.0:
-        cost = 1.0
-    return tuple(samples[i]), cost, i

@@ -56,7 +56,7 @@ from typing import Any
 import numpy as np
 
 from fleetsim.errors import FleetsimError
-from fleetsim.msgs import geometry_msgs, move_base_msgs, nav_msgs, std_msgs, visualization_msgs
+from fleetsim.msgs import move_base_msgs, nav_msgs, std_msgs, visualization_msgs
 from fleetsim.nav.move_base_support import pose_stamped
 from fleetsim.runtime import Node
 from fleetsim.tf.names import resolve_frame_once
@@ -65,14 +65,7 @@ from .frontier_search import Frontier, frontiers_from_grid, known_window
 from .markers import frontier_markers
 from .params import ExploreParams
 from .path_costs import by_path, path_distance_field
-from .peers import (
-    first_heard,
-    frontier_for_robot,
-    peer_goal,
-    points,
-    stamped_points,
-    tracked_frontier,
-)
+from .peers import PeerLink, frontier_for_robot, tracked_frontier
 from .view_points import cell_value, view_point
 
 BLACKLIST_RADIUS_CELLS = 5  # explore_lite's goalOnBlacklist tolerance
@@ -119,21 +112,7 @@ class Explore(Node):
         self._last_distance = math.inf
         self._last_progress = 0.0
         self.frontiers: list[Frontier] = []
-        self.goal_pub = self.create_publisher(geometry_msgs.PointStamped, "~goal", 1, latch=True)
-        self.blacklist_pub = self.create_publisher(
-            geometry_msgs.PoseArray, "~blacklist", 1, latch=True
-        )
-        self.observed_pub = self.create_publisher(
-            geometry_msgs.PoseArray, "~observed", 1, latch=True
-        )
-        # what the peers tell it, by topic: their goals, blacklists and view points stood at
-        self.peers = self._listen(geometry_msgs.PointStamped, p.peer_goals, peer_goal, None)
-        self.peer_blacklists = self._listen(geometry_msgs.PoseArray, p.peer_blacklists, points)
-        # the peers' observed points, each kept at the time it was first heard of: a peer
-        # republishes its whole list, stamped anew, whenever the list grows
-        self.peer_stood_at = self._listen(
-            geometry_msgs.PoseArray, p.peer_observed, stamped_points, [], merge=first_heard
-        )
+        self.link = PeerLink(self, p)  # what it tells its peers, and what they tell it
         _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now
         self.create_subscription(nav_msgs.OccupancyGrid, p.costmap_topic, self.on_costmap, 1)
         self.move_base = self.create_action_client(move_base_msgs.MoveBase, "move_base")
@@ -157,39 +136,18 @@ class Explore(Node):
         self.grid = msg
         self._grid_time = self.now()
 
-    def _listen(self, kind, topics, read, empty: Any = (), merge=None) -> dict[str, Any]:
-        """Subscribe to each of ``topics``; the dict returned holds each one's latest message
-        as ``read`` gives it (``empty`` until one arrives), or ``merge(held, read(msg))``."""
-        latest = {str(t): empty for t in topics}
-
-        def on(topic: str, msg: Any) -> None:
-            new = read(msg)
-            latest[topic] = new if merge is None else merge(latest[topic], new)
-
-        for topic in latest:
-            self.create_subscription(kind, topic, lambda m, t=topic: on(t, m), 1)
-        return latest
-
     def _publish_observed(self) -> None:
         stood = [(x, y) for x, y, _ in self.stood_at]
-        self._publish_points(self.observed_pub, [*stood, *self.closed_at])
+        self._publish_points(self.link.observed_pub, [*stood, *self.closed_at])
 
     def _blacklist(self, goal: tuple[float, float]) -> None:
         """Blacklist a goal and tell the peers (~blacklist)."""
         self.blacklist.append(goal)
-        self._publish_points(self.blacklist_pub, self.blacklist)
+        self._publish_points(self.link.blacklist_pub, self.blacklist)
 
     def _publish_points(self, pub, points: list[tuple[float, float]]) -> None:
         frame = self.grid.header.frame_id if self.grid is not None else ""
-        pub.publish(
-            geometry_msgs.PoseArray(
-                header=std_msgs.Header(stamp=self.now_msg(), frame_id=frame),
-                poses=[
-                    geometry_msgs.Pose(position=geometry_msgs.Point(x=float(x), y=float(y)))
-                    for x, y in points
-                ],
-            )
-        )
+        self.link.publish_points(pub, points, frame)
 
     def _withdraw_goal(self) -> None:
         """Cancel the active goal, if any, as no longer wanted: listed in ``withdrawn_goals``
@@ -198,16 +156,6 @@ class Explore(Node):
             self.withdrawn_goals.add(self._handle.id)
             self.move_base.cancel_all_goals()
             self._handle = None
-
-    def _announce(self, goal: tuple[float, float] | None, frame: str = "") -> None:
-        """Publish the goal on ~goal for peer explorers (NaN: none)."""
-        x, y = goal if goal is not None else (math.nan, math.nan)
-        self.goal_pub.publish(
-            geometry_msgs.PointStamped(
-                header=std_msgs.Header(stamp=self.now_msg(), frame_id=frame),
-                point=geometry_msgs.Point(x=float(x), y=float(y), z=0.0),
-            )
-        )
 
     def _robot_position(self, frame: str) -> tuple[float, float] | None:
         """The robot's newest x, y in ``frame``; None (warned) when tf does not know it, or when
@@ -276,7 +224,7 @@ class Explore(Node):
             self._publish_markers(frame)
         if (
             self.goal is not None
-            and self.peers
+            and self.link.goals
             and self.goal not in self.closed_at
             and tracked_frontier(self.frontiers, self.goal) is None
         ):
@@ -297,12 +245,12 @@ class Explore(Node):
                 for f in self.frontiers
             ]  # fmt: skip
         tolerance = BLACKLIST_RADIUS_CELLS * info.resolution
-        blacklist = [*self.blacklist, *itertools.chain(*self.peer_blacklists.values())]
+        blacklist = [*self.blacklist, *itertools.chain(*self.link.blacklists.values())]
         # view points stood at long enough ago for this map to show what was seen from there
         settled = self._grid_time - p.observe_delay
         stood = [
             (x, y)
-            for x, y, t in itertools.chain(self.stood_at, *self.peer_stood_at.values())
+            for x, y, t in itertools.chain(self.stood_at, *self.link.stood_at.values())
             if t <= settled
         ]
         observed = [
@@ -317,7 +265,7 @@ class Explore(Node):
             and not any(f is o for o in observed)
         ]
         if not candidates:
-            if any(g is not None for g in self.peers.values()):
+            if any(g is not None for g in self.link.goals.values()):
                 # a peer still explores: the merged map it makes may open a way or move a view
                 # point (a frontier "observed" from inside a room whose door the map had not yet
                 # opened; office, two hunters with the hunter's outline as footprint: hunter2
@@ -334,8 +282,8 @@ class Explore(Node):
                 self.retries += 1
                 self.get_logger().info(f"trying the {given_up} blacklisted frontiers again")
                 self.blacklist.clear()
-                self._publish_points(self.blacklist_pub, self.blacklist)
-                self.peer_blacklists.update(dict.fromkeys(self.peer_blacklists, ()))
+                self._publish_points(self.link.blacklist_pub, self.blacklist)
+                self.link.blacklists.update(dict.fromkeys(self.link.blacklists, ()))
                 self.make_plan()
                 return
             self.stop("all frontiers traversed/tried out, stopping", len(observed))
@@ -350,7 +298,7 @@ class Explore(Node):
             candidates,
             robot,
             self.goal,
-            [g for g in self.peers.values() if g is not None],
+            [g for g in self.link.goals.values() if g is not None],
             positions,
             p.peer_radius,
             p.potential_scale * info.resolution * p.switch_distance,
@@ -408,14 +356,14 @@ class Explore(Node):
         self._withdraw_goal()
         if self.goal is not None:
             self.goal = None
-            self._announce(None)
+            self.link.announce(None)
 
     def _send(self, target: tuple[float, float], frame: str, yaw: float = 0.0) -> None:
         if not self.move_base.wait_for_server():
             self._warn_once("move_base", f"waiting for move_base at {self.move_base.name}")
             return
         self.goal = target
-        self._announce(target, frame)
+        self.link.announce(target, frame)
         pose = pose_stamped(target[0], target[1], yaw, frame, self.now_msg())
         self.goals_sent += 1
         self._handle = self.move_base.send_goal(
@@ -441,7 +389,7 @@ class Explore(Node):
             self.stood_at.append((*goal, self.now()))  # what it sees from here is observed
             self._publish_observed()
         self.goal = None
-        self._announce(None)
+        self.link.announce(None)
         self.runtime.call_later(0.0, self.make_plan)  # explore_lite replans on reaching a goal
 
     def stop(self, why: str, observed: int = 0) -> None:
@@ -457,7 +405,7 @@ class Explore(Node):
             why += f" (gave up: {given_up} frontiers left, blacklisted)"
         self._withdraw_goal()
         self.timer.cancel()
-        self._announce(None)
+        self.link.announce(None)
         self.get_logger().info(why)
 
     def _publish_markers(self, frame: str) -> None:

@@ -36,10 +36,11 @@ from __future__ import annotations
 
 import math
 from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
-from fleetsim.msgs import geometry_msgs
+from fleetsim.msgs import geometry_msgs, std_msgs
 
 from .frontier_search import Frontier
 
@@ -145,3 +146,62 @@ def peer_goal(msg: geometry_msgs.PointStamped) -> tuple[float, float] | None:
     """A peer's announced goal; None (NaN announced): it has none."""
     x, y = msg.point.x, msg.point.y
     return (x, y) if math.isfinite(x) and math.isfinite(y) else None
+
+
+class PeerLink:
+    """An explorer's traffic with its peers: what it tells them, on its latched ``~goal``
+    (NaN: none), ``~blacklist`` and ``~observed`` (view points stood at and frontiers closed on
+    the way), and what they tell it, by topic (``peer_goals``, ``peer_blacklists``,
+    ``peer_observed``): their latest goals and blacklists, and their view points, each kept
+    at the time it was first heard of (a peer republishes its whole list, stamped anew,
+    whenever the list grows)."""
+
+    def __init__(self, node: Any, params: Any) -> None:
+        self.node = node
+        self.goal_pub = node.create_publisher(geometry_msgs.PointStamped, "~goal", 1, latch=True)
+        self.blacklist_pub = node.create_publisher(
+            geometry_msgs.PoseArray, "~blacklist", 1, latch=True
+        )
+        self.observed_pub = node.create_publisher(
+            geometry_msgs.PoseArray, "~observed", 1, latch=True
+        )
+        self.goals = self._listen(geometry_msgs.PointStamped, params.peer_goals, peer_goal, None)
+        self.blacklists = self._listen(geometry_msgs.PoseArray, params.peer_blacklists, points)
+        self.stood_at = self._listen(
+            geometry_msgs.PoseArray, params.peer_observed, stamped_points, [], merge=first_heard
+        )
+
+    def _listen(self, kind, topics, read, empty: Any = (), merge=None) -> dict[str, Any]:
+        """Subscribe to each of ``topics``; the dict returned holds each one's latest message
+        as ``read`` gives it (``empty`` until one arrives), or ``merge(held, read(msg))``."""
+        latest = {str(t): empty for t in topics}
+
+        def on(topic: str, msg: Any) -> None:
+            new = read(msg)
+            latest[topic] = new if merge is None else merge(latest[topic], new)
+
+        for topic in latest:
+            self.node.create_subscription(kind, topic, lambda m, t=topic: on(t, m), 1)
+        return latest
+
+    def publish_points(self, pub: Any, points: list[tuple[float, float]], frame: str) -> None:
+        """``points`` (x, y) as a PoseArray in ``frame`` on ``pub``."""
+        pub.publish(
+            geometry_msgs.PoseArray(
+                header=std_msgs.Header(stamp=self.node.now_msg(), frame_id=frame),
+                poses=[
+                    geometry_msgs.Pose(position=geometry_msgs.Point(x=float(x), y=float(y)))
+                    for x, y in points
+                ],
+            )
+        )
+
+    def announce(self, goal: tuple[float, float] | None, frame: str = "") -> None:
+        """Publish the goal on ~goal (NaN: none)."""
+        x, y = goal if goal is not None else (math.nan, math.nan)
+        self.goal_pub.publish(
+            geometry_msgs.PointStamped(
+                header=std_msgs.Header(stamp=self.node.now_msg(), frame_id=frame),
+                point=geometry_msgs.Point(x=float(x), y=float(y), z=0.0),
+            )
+        )

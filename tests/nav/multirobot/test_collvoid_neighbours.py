@@ -63,6 +63,7 @@ def test_two_robots_side_by_side_a_few_cm_apart_are_not_shoved_apart():
         pub.publish(m)
         rt.run(duration=0.1)
         pl.compute_velocity_commands((0.0, 0.0, 0.0), (0.5, 0.0, 0.0))
-    assert len(pl.lines[0]) == 1  # lizi2's half-plane, no walls
+    # lizi2's half-plane and, the discs touching, its contact line (contact_halfplanes); no walls
+    assert len(pl.lines[0]) == 2 and pl.lines[2] == 0
     assert abs(pl.last_holo[1]) < 0.01
     assert pl.last_holo[0] == pytest.approx(0.5, abs=0.01)

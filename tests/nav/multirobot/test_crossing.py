@@ -14,6 +14,7 @@ from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.nav.controllers.collvoid_planner import CollvoidLocalPlanner
 from fleetsim.nav.costmap.costmap_2d import Costmap2D
 from fleetsim.nav.multirobot.crossing import (
+    AGAINST_TIME,
     CROSSING_TIME,
     GIVE_WAY_TIME,
     TURN_CLEARANCE,
@@ -89,6 +90,26 @@ def test_the_lower_priority_robot_gives_way_after_crossing_time_until_the_other_
     low.update(0.0, ["lizi2"], yes, yes, yes)
     low.update(CROSSING_TIME, ["lizi2"], yes, yes, yes)
     assert low.update(CROSSING_TIME + GIVE_WAY_TIME + 0.1, ["lizi2"], no, yes, yes) is None
+
+
+def test_a_give_way_ends_when_the_robot_given_way_to_stays_against_us():
+    """Standing against us (discs touching) for AGAINST_TIME, it is not getting past (we may
+    stand on its goal): the give-way ends, and is not taken up again with it for GIVE_WAY_TIME;
+    touching for less does not end it."""
+    yes, no = np.array([True]), np.array([False])
+    low = GiveWay("lizi10")
+    low.update(0.0, ["lizi2"], yes, yes, yes)
+    t = CROSSING_TIME
+    assert low.update(t, ["lizi2"], yes, yes, yes, yes) == "lizi2"
+    assert low.update(t + AGAINST_TIME - 0.1, ["lizi2"], yes, yes, yes, yes) == "lizi2"
+    assert low.update(t + AGAINST_TIME - 0.05, ["lizi2"], yes, yes, yes, no) == "lizi2"
+    t2 = t + AGAINST_TIME
+    assert low.update(t2, ["lizi2"], yes, yes, yes, yes) == "lizi2"  # touching afresh
+    assert low.update(t2 + AGAINST_TIME, ["lizi2"], yes, yes, yes, yes) is None
+    for dt in np.arange(0.1, GIVE_WAY_TIME, 0.1):
+        assert low.update(t2 + AGAINST_TIME + dt, ["lizi2"], yes, yes, yes, no) is None
+    end = t2 + AGAINST_TIME + GIVE_WAY_TIME + CROSSING_TIME + 0.1
+    assert low.update(end, ["lizi2"], yes, yes, yes, no) == "lizi2"
 
 
 def _beside(

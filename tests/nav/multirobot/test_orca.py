@@ -5,10 +5,11 @@ behaviours (head-on, crossing, a static neighbour) in a small holonomic simulati
 import math
 
 import numpy as np
+import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from fleetsim.nav.multirobot.orca import orca_halfplanes, orca_velocity
+from fleetsim.nav.multirobot.orca import contact_halfplanes, orca_halfplanes, orca_velocity
 
 
 def closest_approach(p: np.ndarray, v: np.ndarray, horizon: float) -> float:
@@ -154,3 +155,59 @@ def test_lines_differing_by_rounding_alone_stay_feasible():
     pts, dirs = orca_halfplanes(rel, rel_vel, np.full(2, 0.5), v, 2.0, 0.1, 0.5)
     got, feasible = orca_velocity(pts, dirs, 1.5, np.array([2.0, 2.0]))
     assert feasible and inside(pts, dirs, got, 1e-6)
+
+
+def approach(rel, v):
+    """m/s the robot at the origin moving at ``v`` closes in on a standing neighbour at ``rel``."""
+    return float(v @ rel / np.linalg.norm(rel))
+
+
+def test_overlap_parted_slowly_still_admits_a_pass_through_the_other_robot():
+    """The flaw `contact_halfplanes` closes (circle of 16, seed 50: lizi2 drove into lizi3 at
+    0.25 m/s): two discs overlapping (0.5 m apart, combined radius 0.52), the other robot
+    standing, ORCA's overlap half-plane over 1 s admits a velocity that closes in on it at
+    0.3 m/s, to be past it by the end of the second."""
+    rel = np.array([0.5, 0.0])
+    v = np.array([0.3, 0.6])
+    pts, dirs = orca_halfplanes(rel[None], v[None], [0.52], v, 3.0, 1.0, [1.0])
+    assert inside(pts, dirs, v)
+    assert approach(rel, v) == 0.3
+
+
+@given(
+    ang=st.floats(-math.pi, math.pi),
+    d=st.floats(0.3, 0.6),
+    vx=speed,
+    vy=speed,
+    resp=st.sampled_from([0.5, 1.0]),
+)
+@settings(max_examples=200, deadline=None)
+def test_contact_halfplane_caps_the_approach_along_the_line_of_centres(ang, d, vx, vy, resp):
+    """Every velocity the half-plane admits closes in on a standing neighbour no faster than
+    resp x (its gap to the bodies' discs / the closing time) beyond what the current velocity
+    does; inside the bodies' radius that is a parting speed. Sideways motion is free."""
+    hard, closing = 0.5, 1.0
+    rel = d * np.array([math.cos(ang), math.sin(ang)])
+    v = np.array([vx, vy])
+    pts, dirs = contact_halfplanes(rel[None], v[None], [hard], v, closing, [resp])
+    n = rel / d
+    limit = approach(rel, v) + resp * ((d - hard) / closing - approach(rel, v))
+    side = np.array([-n[1], n[0]])
+    boundary = limit * n
+    assert inside(pts, dirs, boundary + 0.7 * side) and inside(pts, dirs, boundary - 0.7 * side)
+    assert not inside(pts, dirs, boundary + 0.01 * n)
+    assert inside(pts, dirs, boundary - 0.01 * n)
+    if resp == 1.0:
+        assert math.isclose(limit, (d - hard) / closing, abs_tol=1e-12)
+
+
+def test_with_the_contact_halfplane_the_pass_through_is_refused():
+    rel = np.array([0.5, 0.0])
+    v = np.array([0.3, 0.6])
+    lines = [orca_halfplanes(rel[None], v[None], [0.52], v, 3.0, 1.0, [1.0])]
+    lines.append(contact_halfplanes(rel[None], v[None], [0.5], v, 1.0, [1.0]))
+    pts, dirs = (np.concatenate(x) for x in zip(*lines))
+    got, feasible = orca_velocity(pts, dirs, 0.8, v)
+    assert feasible
+    assert approach(rel, got) <= 1e-9  # at the bodies' radius: no closer
+    assert got[1] == pytest.approx(0.6)  # going by sideways as before

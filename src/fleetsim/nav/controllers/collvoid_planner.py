@@ -24,7 +24,9 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    within ``neighbor_dist`` (at most ``max_neighbors``, horizon ``time_horizon``, half the
    responsibility, all of it for a robot that is not ``controlled``, stands still or is yielded
    to; two discs that already overlap are parted within ``overlap_time``, a fleetsim addition:
-   RVO2 and collvoid part them within one control period, see `CollvoidParams`), and one per
+   RVO2 and collvoid part them within one control period, see `CollvoidParams`; then a second
+   half-plane along the line of centres keeps them from closing in on their bodies' discs
+   faster than in that time, `contact_halfplanes`), and one per
    static obstacle point of the local costmap (the nearest lethal cell per bearing sector,
    horizon ``time_horizon_obst``, full responsibility, kept hard when the program is
    infeasible; the robot's circumscribed disc, or its inscribed one where the walls leave that
@@ -88,7 +90,7 @@ from fleetsim.nav.multirobot.holonomic import (
     rotated,
     without_robots,
 )
-from fleetsim.nav.multirobot.orca import orca_halfplanes, orca_velocity
+from fleetsim.nav.multirobot.orca import contact_halfplanes, orca_halfplanes, orca_velocity
 from fleetsim.nav.multirobot.position_share import PositionShare
 from fleetsim.nav.multirobot.uncertainty import cloud_covariance
 from fleetsim.nav.multirobot.yielding import Retreat, narrow_meetings
@@ -299,7 +301,8 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
             pref = self._give_way(
                 pref, wanted, vel, pos - xy, nvel, pair, resp, controlled, ids, meeting
             )
-        return self._orca(xy, vel, pref, pos - xy, nvel, pair, resp)
+        hard = self.body_radius + p.safety_margin + radii  # the bodies' discs, no allowance
+        return self._orca(xy, vel, pref, pos - xy, nvel, pair, resp, hard)
 
     def _parked_in_view(self, ids, pos, nvel, yaws) -> tuple[np.ndarray, list[np.ndarray]]:
         """(N,) bool, and their shared footprints at their poses (polygons, costmap frame):
@@ -355,10 +358,12 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
             costs[rows, cols] = LETHAL_OBSTACLE
         return costs, origin, res
 
-    def _orca(self, xy, vel, pref, rel, nvel, radii, resp) -> np.ndarray:
+    def _orca(self, xy, vel, pref, rel, nvel, radii, resp, hard) -> np.ndarray:
         """The velocity nearest ``pref`` (2,) m/s that the half-planes of the local costmap's
         walls and of the robots (``rel`` (N, 2) m, ``nvel`` (N, 2) m/s, combined ``radii`` (N,)
-        m, responsibilities ``resp`` (N,)) admit; the half-planes are kept in ``lines``."""
+        m, responsibilities ``resp`` (N,); ``hard`` (N,) m the combined radii of the bodies'
+        discs, which robots whose ``radii`` overlap close in on no faster than in
+        ``overlap_time``) admit; the half-planes are kept in ``lines``."""
         p = self.params
         lines_p, lines_d = [], []
         obst = obstacle_points(
@@ -377,6 +382,13 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
             )
             lines_p.append(lp)
             lines_d.append(ld)
+            touch = np.einsum("ij,ij->i", rel, rel) <= radii * radii
+            if touch.any():  # parted over overlap_t, never into each other (contact_halfplanes)
+                lp, ld = contact_halfplanes(
+                    rel[touch], (vel - nvel)[touch], hard[touch], vel, self.overlap_t, resp[touch]
+                )
+                lines_p.append(lp)
+                lines_d.append(ld)
         self.lines = (
             np.concatenate(lines_p) if lines_p else np.zeros((0, 2)),
             np.concatenate(lines_d) if lines_d else np.zeros((0, 2)),

@@ -99,7 +99,10 @@ class CollvoidPreference:
         in_the_way = across_way(rel, radii, wanted, REACH) & collision_course(
             wanted, rel, nvel, radii, self.params.time_horizon
         )
-        to = self.give_way.update(self.node.now(), list(ids), carrying, in_the_way, controlled)
+        against = np.einsum("ij,ij->i", rel, rel) <= radii * radii
+        to = self.give_way.update(
+            self.node.now(), list(ids), carrying, in_the_way, controlled, against
+        )
         self.giving_way_to = to
         if to is None:
             return pref

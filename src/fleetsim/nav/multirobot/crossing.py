@@ -69,6 +69,12 @@ CARRIED_OFF = 0.5
 #: m along the preferred way within which a neighbour is across it: as far as a robot standing
 #: in the way is gone round (`fleetsim.nav.controllers.collvoid_preference.DETOUR_REACH`)
 REACH = 1.0
+#: s the robot given way to may stand against us (their discs touching) before the give-way
+#: ends: it is not getting past, and standing there we hold it up. On the circle of 16 (seed 12)
+#: lizi14 gave way standing on lizi7's goal, and lizi7, which must not close in on a body
+#: (`fleetsim.nav.multirobot.orca.contact_halfplanes`), waited beside it for the whole
+#: `GIVE_WAY_TIME`
+AGAINST_TIME = 1.0
 
 
 def across_way(rel_pos: np.ndarray, radii: np.ndarray, direction: np.ndarray, reach: float):
@@ -153,6 +159,8 @@ class GiveWay:
         self.to: str | None = None  # the robot given way to
         self.until = -np.inf
         self.since: dict[str, float] = {}  # neighbour -> since when it carries us
+        self.against_since: float | None = None  # since when the robot given way to touches us
+        self.not_before: dict[str, float] = {}  # neighbour -> no give-way to it before then
 
     def update(
         self,
@@ -161,6 +169,7 @@ class GiveWay:
         carrying: np.ndarray,
         in_the_way: np.ndarray,
         navigating: np.ndarray,
+        against: np.ndarray | None = None,
     ) -> str | None:
         """The robot to give way to this cycle, or None.
 
@@ -170,19 +179,33 @@ class GiveWay:
         horizon, `collision_course`); navigating : (N,) bool, each one still on its way
         (``controlled``: a robot that slows down or stops for a moment beside a robot giving
         way is still to be let by; ending there, both robots stood and then drove on side by
-        side again).
+        side again); against : (N,) bool, each one's disc touching ours (`AGAINST_TIME`: the
+        give-way ends, and the robot is not given way to again within `GIVE_WAY_TIME`).
         """
         if self.to is not None:
             k = ids.index(self.to) if self.to in ids else -1
-            if k >= 0 and now < self.until and in_the_way[k] and navigating[k]:
+            if k >= 0 and against is not None and against[k]:
+                if self.against_since is None:
+                    self.against_since = now
+            else:
+                self.against_since = None
+            held = self.against_since is not None and now - self.against_since >= AGAINST_TIME
+            if k >= 0 and now < self.until and in_the_way[k] and navigating[k] and not held:
                 return self.to
+            if held:
+                self.not_before[self.to] = now + GIVE_WAY_TIME
             self.to = None
+            self.against_since = None
             self.since.clear()
         now_carrying = {ids[k] for k in np.flatnonzero(carrying)}
         self.since = {i: self.since.get(i, now) for i in now_carrying}
         mine = priority_key(self.robot_id)
         due = [
-            i for i, t in self.since.items() if now - t >= CROSSING_TIME and priority_key(i) < mine
+            i
+            for i, t in self.since.items()
+            if now - t >= CROSSING_TIME
+            and priority_key(i) < mine
+            and now >= self.not_before.get(i, -np.inf)
         ]
         if not due:
             return None

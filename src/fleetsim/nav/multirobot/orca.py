@@ -91,6 +91,38 @@ def orca_halfplanes(
     return points, directions
 
 
+def contact_halfplanes(
+    rel_pos: np.ndarray,
+    rel_vel: np.ndarray,
+    hard: np.ndarray,
+    velocity: np.ndarray,
+    closing_time: float,
+    responsibility: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Half-planes that close the gap between two bodies' discs no faster than in
+    ``closing_time``, along the line of centres: the approach speed of the pair stays at most
+    ``(distance - hard) / closing_time`` (negative inside ``hard``: they part at that speed).
+
+    What ORCA's velocity obstacle becomes as the gap to the combined radius goes to zero (the
+    cone opens to the half-plane of approaching velocities). RVO2's overlap half-plane is
+    tangent to the cut-off disc of one time step, which for a horizon of a control period is
+    this line; parted over a longer time it tilts with the relative velocity and admits a pass
+    straight through the other robot within that time (two lizis whose discs touched drove into
+    each other at 0.25 m/s on the circle of 16). Arguments as `orca_halfplanes`; ``hard`` (N,) m
+    the radii the bodies must not come inside (their circumscribed discs, without the tracking
+    allowance). Returns (points (N, 2), directions (N, 2)).
+    """
+    rel_pos = np.asarray(rel_pos, dtype=np.float64).reshape(-1, 2)
+    rel_vel = np.asarray(rel_vel, dtype=np.float64).reshape(-1, 2)
+    dist = np.sqrt(np.einsum("ij,ij->i", rel_pos, rel_pos))
+    n = rel_pos / np.maximum(dist, 1e-9)[:, None]
+    allowed = (dist - np.asarray(hard, dtype=np.float64).reshape(-1)) / closing_time
+    u = (allowed - np.einsum("ij,ij->i", rel_vel, n))[:, None] * n
+    resp = np.broadcast_to(np.asarray(responsibility, dtype=np.float64), dist.shape)
+    points = np.asarray(velocity, dtype=np.float64)[None, :] + resp[:, None] * u
+    return points, np.stack([-n[:, 1], n[:, 0]], axis=1)
+
+
 @numba.njit(cache=True)
 def _det(ax, ay, bx, by):
     return ax * by - ay * bx

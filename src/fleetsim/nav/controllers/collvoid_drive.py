@@ -27,6 +27,7 @@ import numpy as np
 from fleetsim.nav.controllers.base import VelocityCommand
 from fleetsim.nav.multirobot.footprint_check import footprint_safe_command
 from fleetsim.nav.multirobot.holonomic import (
+    least_violation_speed,
     rotated,
     speed_along_heading,
     speed_interval,
@@ -87,7 +88,7 @@ class CollvoidDrive:
             top = min(p.max_vel_x, p.max_vel_x_backwards) if back else p.max_vel_x
             heading = yaw + math.pi if back else yaw
             v, w = tracking_command(holo, heading, p.time_to_holo, top, p.max_vel_theta)
-            v = speed_along_heading(*self.lines, heading, v, top)
+            v = speed_along_heading(*self.lines, heading, v, top, self.contact_lines)
             cmd = (-v if back else v, 0.0, _clamp(w, p.min_vel_theta, p.max_vel_theta))
         self.replaced = False
         if not p.holonomic_robot:
@@ -119,7 +120,11 @@ class CollvoidDrive:
         caps = []
         for sign, top in ((1.0, p.max_vel_x), (-1.0, back_top)):
             lo, hi = speed_interval(points[n_obst:], dirs[n_obst:], sign * u, top)
-            caps.append(hi if lo <= hi else top)  # none admitted: as speed_along_heading
+            if lo > hi:  # none admitted: the bodies' lines alone, as speed_along_heading
+                lo, hi = speed_interval(*self.contact_lines, sign * u, top)
+                if lo > hi:
+                    hi = least_violation_speed(*self.contact_lines, sign * u, 0.0, top, top)
+            caps.append(hi)
         horizon = self.horizon_obst if self.horizon_obst < UNTRUNCATED else p.time_horizon_obst
 
         def clear(wanted, holo):

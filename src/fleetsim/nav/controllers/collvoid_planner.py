@@ -186,6 +186,10 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         self.plan_index = 0
         self.retreat = Retreat()  # the way back and the refuge of a yield
         self.lines = (np.zeros((0, 2)), np.zeros((0, 2)), 0)  # this cycle's half-planes
+        #: this cycle's `contact_halfplanes` of the robots whose bodies' discs overlap ours
+        #: (also in ``lines``): what a differential drive's speed along its heading keeps to
+        #: when the robots' half-planes admit none there
+        self.contact_lines = (np.zeros((0, 2)), np.zeros((0, 2)))
         self.grid = None  # this cycle's local costmap without the other robots (`_walls`)
         self.still_since: dict[str, float] = {}  # neighbour -> since when it stands still
         self.feasible = True
@@ -366,6 +370,7 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         ``overlap_time``) admit; the half-planes are kept in ``lines``."""
         p = self.params
         lines_p, lines_d = [], []
+        self.contact_lines = (np.zeros((0, 2)), np.zeros((0, 2)))
         obst = obstacle_points(
             *self.grid,
             xy,
@@ -389,6 +394,9 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
                 )
                 lines_p.append(lp)
                 lines_d.append(ld)
+                # the drive's last resort: the bodies' discs already overlapping
+                deep = np.einsum("ij,ij->i", rel[touch], rel[touch]) < hard[touch] ** 2
+                self.contact_lines = (lp[deep], ld[deep])
         self.lines = (
             np.concatenate(lines_p) if lines_p else np.zeros((0, 2)),
             np.concatenate(lines_d) if lines_d else np.zeros((0, 2)),

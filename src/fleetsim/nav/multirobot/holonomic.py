@@ -306,6 +306,33 @@ def speed_interval(
     return lo, hi
 
 
+def least_violation_speed(
+    points: np.ndarray,
+    directions: np.ndarray,
+    heading: np.ndarray,
+    lo: float,
+    hi: float,
+    wanted: float,
+) -> float:
+    """The speed v in [lo, hi] whose motion v * ``heading`` (2,) violates the half-planes
+    (``points``, ``directions`` (L, 2)) least: the smallest largest distance beyond a line
+    (RVO2's linearProgram3 along one line of velocities); of equal ones, the nearest
+    ``wanted``. The largest violation is convex and piecewise linear in v, so its minimum is
+    at an end of the interval or where two lines' violations cross."""
+    if points.shape[0] == 0:
+        return min(max(wanted, lo), hi)
+    a = directions[:, 0] * heading[1] - directions[:, 1] * heading[0]
+    b = directions[:, 0] * points[:, 1] - directions[:, 1] * points[:, 0]
+    da, db = a[:, None] - a[None, :], b[:, None] - b[None, :]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        cross = np.where(np.abs(da) > 1e-12, db / da, np.nan).ravel()
+    v = np.concatenate([[lo, hi, min(max(wanted, lo), hi)], cross])
+    v = v[np.isfinite(v) & (v >= lo) & (v <= hi)]
+    worst = np.max(b[None, :] - v[:, None] * a[None, :], axis=1)
+    best = v[worst <= worst.min() + 1e-9]
+    return float(best[np.argmin(np.abs(best - wanted))])
+
+
 def speed_along_heading(
     points: np.ndarray,
     directions: np.ndarray,
@@ -313,16 +340,31 @@ def speed_along_heading(
     yaw: float,
     wanted: float,
     max_speed: float,
+    hard: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> float:
     """The forward speed (m/s) nearest ``wanted`` whose motion along ``yaw`` all half-planes
     admit; if none does, the one the static-obstacle half-planes (the first
-    ``num_obstacle_lines``) admit; if none does either, 0."""
+    ``num_obstacle_lines``) and the ``hard`` ones (points, directions: robots' bodies,
+    `fleetsim.nav.multirobot.orca.contact_halfplanes`) admit; if those admit none, of the speeds
+    the static-obstacle ones admit, the one that violates the hard ones least
+    (`least_violation_speed`); if none does either, 0. Dropping the robots' half-planes
+    altogether, a pioneer3at inside another's body disc, heading into it, drove on at the speed
+    it wanted and touched it (circle of 8, seed 7); keeping them all, lizis that ORCA sends
+    along an edge stood until their heading was on it (circle of 16, seed 0: 2.4 s)."""
     u = np.array([math.cos(yaw), math.sin(yaw)])
-    for count in (points.shape[0], num_obstacle_lines):
-        lo, hi = speed_interval(points[:count], directions[:count], u, max_speed)
-        if lo <= hi:
-            return min(max(wanted, lo), hi)
-    return 0.0
+    lo, hi = speed_interval(points, directions, u, max_speed)
+    if lo <= hi:
+        return min(max(wanted, lo), hi)
+    n = num_obstacle_lines
+    lo, hi = speed_interval(points[:n], directions[:n], u, max_speed)
+    if lo > hi:
+        return 0.0
+    if hard is None or hard[0].shape[0] == 0:
+        return min(max(wanted, lo), hi)
+    h_lo, h_hi = speed_interval(*hard, u, max_speed)
+    if max(lo, h_lo) <= min(hi, h_hi):
+        return min(max(wanted, max(lo, h_lo)), min(hi, h_hi))
+    return least_violation_speed(*hard, u, lo, hi, wanted)
 
 
 def speed_nearest_still(

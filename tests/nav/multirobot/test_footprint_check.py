@@ -123,3 +123,23 @@ def test_a_lizi_wedged_nose_first_backs_out_and_goes_through(escape, monkeypatch
             break
     assert reached is escape
     assert (f.planners[0].escapes >= 1) is escape
+
+
+def test_a_wedged_lizi_does_not_back_out_into_a_robot_standing_behind_it():
+    """As above, with another lizi standing 3 cm behind its body's disc (the mixed circle of
+    16, seed 6: a pioneer3at wedged nose first backed into a lizi). The costmap check has the
+    other robots' images cleared, so the escape now also needs the robots' half-planes: it
+    does not back out, and the two never come closer."""
+    walls = [(0.225, -1.0, 0.5, -0.025), (0.15, 0.375, 0.6, 1.5), (-0.05, 0.3, 0.05, 1.5)]
+    behind = (-(2 * BODY + 0.03), 0.0, 0.0)
+    f = Fleet([(0.0, 0.0, 0.0), behind], [(3.0, 0.17, 0.0), behind], walls=walls)
+    corners = np.array([[0, 0, 0], [0.3, 0.12, 0], [0.6, 0.17, 0], [3, 0.17, 0]], float)
+    f.planners[0].set_plan(
+        np.concatenate([np.linspace(a, b, 20) for a, b in itertools.pairwise(corners)])
+    )
+    start = float(np.hypot(*(f.state[0, :2] - f.state[1, :2])))
+    for _ in range(25):
+        f.run(0.2)
+        gap = float(np.hypot(*(f.state[0, :2] - f.state[1, :2])))
+        assert gap >= start - 1e-3, f"backed towards the lizi behind: {gap:.3f} m"
+    assert f.planners[0].escapes == 0

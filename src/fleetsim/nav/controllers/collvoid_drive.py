@@ -107,12 +107,14 @@ class CollvoidDrive:
         """``cmd``, or the command nearest it whose footprint rollout over ``time_horizon_obst``
         is clear of the local costmap's obstacles (`footprint_safe_command` on this cycle's
         ``grid``, set by `holonomic_velocity`), at speeds the
-        robots' half-planes admit along the heading (any, when they admit none there).
+        robots' half-planes admit along the heading (when they admit none there, the contact
+        half-planes of the robots whose bodies' discs overlap ours, as `speed_along_heading`).
 
         When the clear command nearest the holonomic velocity is to stand still while that
         velocity is not (wedged nose first where no arc is clear and a turn on the spot hits a
         corner), the robot escapes as base_local_planner does: straight back at `ESCAPE_SPEED`
-        until `ESCAPE_DISTANCE` from where it stuck, while that stays clear."""
+        until `ESCAPE_DISTANCE` from where it stuck, while that stays clear and the robots'
+        half-planes admit it."""
         p, yaw = self.params, pose[2]
         points, dirs, n_obst = self.lines
         u = np.array([math.cos(yaw), math.sin(yaw)])
@@ -141,6 +143,13 @@ class CollvoidDrive:
 
         xy = np.array(pose[:2], dtype=np.float64)
         escape = min(ESCAPE_SPEED, back_top)
+        if escape > 0.0:
+            # the costmap's check has the other robots' images cleared: backing out is for
+            # walls, and only where the robots' half-planes admit it (mixed circle of 16, seed
+            # 6: a pioneer wedged nose first backed into a lizi standing behind it)
+            lo, hi = speed_interval(points[n_obst:], dirs[n_obst:], -u, escape)
+            if lo > hi or hi < escape:
+                escape = 0.0
         if self.escape_from is not None:
             if float(np.hypot(*(xy - self.escape_from))) < ESCAPE_DISTANCE and escape > 0.0:
                 _, _, blocked = clear((-escape, 0.0), -escape * u)

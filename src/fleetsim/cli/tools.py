@@ -382,9 +382,12 @@ def goal(
     with _client(connect) as c:
         gid = None
         try:
+            # feedback only with --wait: without it, feedback of the new goal that arrived
+            # before its status was printed above "goal sent" (a race the CLI test lost once)
             gid, status, text = send_goal(
-                c, ns, x, y, yaw, frame, wait=wait, on_feedback=on_feedback, timeout=timeout
-            )
+                c, ns, x, y, yaw, frame, wait=wait, timeout=timeout,
+                on_feedback=on_feedback if wait else None,
+            )  # fmt: skip
         except KeyboardInterrupt:
             if gid is not None:
                 cancel_goal(c, ns, gid)

@@ -87,7 +87,8 @@ class CollvoidParams:
         0.0,
         unit="s",
         range=(0.0, None),
-        help="time to part two robots whose discs overlap (0: one control period, as RVO2)",
+        help="time to part two robots whose discs overlap (0: one control period, as RVO2); "
+        "they close in on each other's bodies no faster than in this time",
     )
     robot_id: str = param("", help="this robot's id on /position_share (empty: tf_prefix)")
     carrot_distance: float = param(

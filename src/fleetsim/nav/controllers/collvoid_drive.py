@@ -27,8 +27,8 @@ import numpy as np
 from fleetsim.nav.controllers.base import VelocityCommand
 from fleetsim.nav.multirobot.footprint_check import footprint_safe_command
 from fleetsim.nav.multirobot.holonomic import (
-    least_violation_speed,
     rotated,
+    speed_along,
     speed_along_heading,
     speed_interval,
     speed_nearest_still,
@@ -121,12 +121,11 @@ class CollvoidDrive:
         back_top = min(p.max_vel_x, p.max_vel_x_backwards)
         caps = []
         for sign, top in ((1.0, p.max_vel_x), (-1.0, back_top)):
-            lo, hi = speed_interval(points[n_obst:], dirs[n_obst:], sign * u, top)
-            if lo > hi:  # none admitted: the bodies' lines alone, as speed_along_heading
-                lo, hi = speed_interval(*self.contact_lines, sign * u, top)
-                if lo > hi:
-                    hi = least_violation_speed(*self.contact_lines, sign * u, 0.0, top, top)
-            caps.append(hi)
+            # the robots' half-planes' top speed (none admitted: as speed_along_heading)
+            caps.append(
+                speed_along(points[n_obst:], dirs[n_obst:], 0, sign * u, top, top,
+                            self.contact_lines)
+            )  # fmt: skip
         horizon = self.horizon_obst if self.horizon_obst < UNTRUNCATED else p.time_horizon_obst
 
         def clear(wanted, holo):
@@ -143,15 +142,17 @@ class CollvoidDrive:
 
         xy = np.array(pose[:2], dtype=np.float64)
         escape = min(ESCAPE_SPEED, back_top)
-        if escape > 0.0:
-            # the costmap's check has the other robots' images cleared: backing out is for
-            # walls, and only where the robots' half-planes admit it (mixed circle of 16, seed
-            # 6: a pioneer wedged nose first backed into a lizi standing behind it)
+
+        def may_back_out() -> bool:
+            """The costmap's check has the other robots' images cleared: backing out is for
+            walls, and only where the robots' half-planes admit it (mixed circle of 16, seed
+            6: a pioneer wedged nose first backed into a lizi standing behind it)."""
             lo, hi = speed_interval(points[n_obst:], dirs[n_obst:], -u, escape)
-            if lo > hi or hi < escape:
-                escape = 0.0
+            return lo <= hi and hi >= escape
+
         if self.escape_from is not None:
-            if float(np.hypot(*(xy - self.escape_from))) < ESCAPE_DISTANCE and escape > 0.0:
+            near = float(np.hypot(*(xy - self.escape_from))) < ESCAPE_DISTANCE
+            if near and escape > 0.0 and may_back_out():
                 _, _, blocked = clear((-escape, 0.0), -escape * u)
                 if not blocked:
                     self.replaced = True
@@ -161,6 +162,8 @@ class CollvoidDrive:
         still = abs(v) < 1e-3 and abs(w) < 1e-3
         wants = float(np.hypot(*self.last_holo)) > STILL_HOLO
         if self.replaced and still and wants and not self.waiting and escape > 0.0:
+            if not may_back_out():
+                return v, 0.0, w
             _, _, blocked = clear((-escape, 0.0), -escape * u)
             if not blocked:
                 self.escape_from = xy

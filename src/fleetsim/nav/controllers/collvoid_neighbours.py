@@ -51,7 +51,15 @@ class CollvoidNeighbours:
         is held to the same half-planes (`speed_along_heading`) whatever the allowance."""
         base = self.body_radius + self.params.safety_margin
         gap = dist - base - radii
-        return base + radii + np.minimum(own_r - base, np.maximum(self.params.min_error_holo, gap))
+        return self.bodies_radii(radii) + np.minimum(
+            own_r - base, np.maximum(self.params.min_error_holo, gap)
+        )
+
+    def bodies_radii(self, radii: np.ndarray) -> np.ndarray:
+        """The combined radii (N,) m of this robot's body and margin and each neighbour's
+        (``radii`` (N,) m): `pair_radii` without the tracking allowance, what two robots'
+        bodies must not come inside (`fleetsim.nav.multirobot.orca.contact_halfplanes`)."""
+        return self.body_radius + self.params.safety_margin + radii
 
     def neighbour_radii(
         self, own_r: float, map_xy: np.ndarray, near: Any, map_vel: Any = (0.0, 0.0)

@@ -305,8 +305,7 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
             pref = self._give_way(
                 pref, wanted, vel, pos - xy, nvel, pair, resp, controlled, ids, meeting
             )
-        hard = self.body_radius + p.safety_margin + radii  # the bodies' discs, no allowance
-        return self._orca(xy, vel, pref, pos - xy, nvel, pair, resp, hard)
+        return self._orca(xy, vel, pref, pos - xy, nvel, pair, resp, self.bodies_radii(radii))
 
     def _parked_in_view(self, ids, pos, nvel, yaws) -> tuple[np.ndarray, list[np.ndarray]]:
         """(N,) bool, and their shared footprints at their poses (polygons, costmap frame):

@@ -352,6 +352,11 @@ def speed_along_heading(
     it wanted and touched it (circle of 8, seed 7); keeping them all, lizis that ORCA sends
     along an edge stood until their heading was on it (circle of 16, seed 0: 2.4 s)."""
     u = np.array([math.cos(yaw), math.sin(yaw)])
+    return speed_along(points, directions, num_obstacle_lines, u, wanted, max_speed, hard)
+
+
+def speed_along(points, directions, num_obstacle_lines, u, wanted, max_speed, hard=None):
+    """`speed_along_heading` along the unit vector ``u`` (2,) instead of a yaw."""
     lo, hi = speed_interval(points, directions, u, max_speed)
     if lo <= hi:
         return min(max(wanted, lo), hi)

@@ -324,7 +324,7 @@ def least_violation_speed(
     a = directions[:, 0] * heading[1] - directions[:, 1] * heading[0]
     b = directions[:, 0] * points[:, 1] - directions[:, 1] * points[:, 0]
     da, db = a[:, None] - a[None, :], b[:, None] - b[None, :]
-    with np.errstate(divide="ignore", invalid="ignore"):
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):  # inf: filtered below
         cross = np.where(np.abs(da) > 1e-12, db / da, np.nan).ravel()
     v = np.concatenate([[lo, hi, min(max(wanted, lo), hi)], cross])
     v = v[np.isfinite(v) & (v >= lo) & (v <= hi)]

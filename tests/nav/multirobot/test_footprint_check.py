@@ -143,3 +143,30 @@ def test_a_wedged_lizi_does_not_back_out_into_a_robot_standing_behind_it():
         gap = float(np.hypot(*(f.state[0, :2] - f.state[1, :2])))
         assert gap >= start - 1e-3, f"backed towards the lizi behind: {gap:.3f} m"
     assert f.planners[0].escapes == 0
+
+
+@pytest.mark.parametrize("escape", [True, False])
+def test_a_lizi_wedged_tail_first_escapes_ahead(escape, monkeypatch):
+    """The mixed circle of 16, seed 3: pioneer16 stood 0.4 m from its goal for the rest of the
+    run, the goal behind its right side, a parked robot at its left rear corner (every turn
+    towards the goal swept that corner into it) and no room to back out. Here a wall 3 cm
+    behind the lizi and a block at its left rear corner, the goal behind it on the right:
+    straight ahead is clear, and escaping that way (base_local_planner's escape, the other way
+    round) leaves room to turn. Without the escape it stands for good."""
+    if not escape:
+        monkeypatch.setattr("fleetsim.nav.controllers.collvoid_drive.ESCAPE_SPEED", 0.0)
+    walls = [(-0.30, 0.21, -0.05, 0.6), (-0.40, -0.6, -0.22, 0.6)]
+    f = Fleet([(0.0, 0.0, 0.0)], [(-1.0, -1.0, -1.57)], walls=walls)
+    cm = f.cm
+    reached = False
+    for _ in range(75):
+        reached = f.run(0.2)
+        cost = footprint_costs(
+            cm.costs, cm.origin_x, cm.origin_y, cm.resolution, OUTLINE, f.state.copy()
+        )
+        assert cost[0] >= 0.0, f"footprint on a wall at {f.state[0]}"
+        if reached:
+            break
+    assert reached is escape
+    assert (f.planners[0].escapes >= 1) is escape
+    assert f.backed[0] == 0.0

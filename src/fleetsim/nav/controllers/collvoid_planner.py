@@ -150,6 +150,7 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         self.replaced = False  # this cycle's command was replaced by a footprint-clear one
         self.walls_blocked = False  # this cycle the walls left the circumscribed disc no way
         self.escape_from: np.ndarray | None = None  # where a wedged robot began backing out
+        self.escape_sign = -1.0  # backing out (-1) or ahead (+1)
         self.escapes = 0  # how often it did
         self.share = PositionShare(node, eps=p.eps)
         self.deadlock = DeadlockRule(

@@ -42,6 +42,11 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    footprint, base_local_planner-style, and keeps its velocity obstacles for the robots);
 6. within ``xy_goal_tolerance`` the robot stops and turns in place to the goal yaw, as
    base_local_planner does (at ``max_vel_theta``, slowed only to stop on the yaw);
+7. the plan goes back to move_base (`NoValidTrajectory`: it plans again from where the robot
+   stands) when none of it lies within the local costmap's reach, as collvoid's planner fails
+   when base_local_planner's ``transformGlobalPlan`` leaves it no plan, and when it runs
+   through a robot parked in view while the robot has made no progress for `BLOCKED_TIME` s
+   (the global costmap's ``robots_layer`` holds that robot, so the new plan goes round it);
 
 The rules that shape the preferred velocity around other robots (keeping right, going round
 robots standing in the way on the side the robot heads for and keeping that side, yielding)
@@ -63,7 +68,12 @@ import numpy as np
 
 from fleetsim.errors import ParameterError
 from fleetsim.msgs import geometry_msgs
-from fleetsim.nav.controllers.base import EmptyPlan, LocalPlanner, VelocityCommand
+from fleetsim.nav.controllers.base import (
+    EmptyPlan,
+    LocalPlanner,
+    NoValidTrajectory,
+    VelocityCommand,
+)
 from fleetsim.nav.controllers.collvoid_drive import UNTRUNCATED, CollvoidDrive
 from fleetsim.nav.controllers.collvoid_neighbours import MAP_FRAME, CollvoidNeighbours
 from fleetsim.nav.controllers.collvoid_params import CollvoidParams
@@ -77,6 +87,7 @@ from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
 from fleetsim.nav.costmap.footprint import (
     footprint_at,
     footprint_radii,
+    inside_polygon,
     outline_points,
     padded_footprint,
     polygon_cells,
@@ -116,6 +127,13 @@ SEEN_CELLS = 3
 #: s a robot has stood still before it counts as parked (a robot stopping for a moment in a
 #: crowd, or turning on the spot, stays in ORCA)
 PARKED_TIME = 1.0
+#: s before a plan through the same parked robot asks for a new plan again (a new plan that
+#: still runs through it, where no other way is known, is driven as far as it goes)
+REPLAN_AGAIN = 5.0
+#: s without ``deadlock_progress`` towards the goal before a plan through a parked robot is
+#: planned again (a robot that gets round it on its own keeps its plan: in the pioneers'
+#: corridor of 4, seed 0, a new plan round pioneer3 led pioneer1 into the corridor's corner)
+BLOCKED_TIME = 3.0
 
 
 class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive, LocalPlanner):
@@ -134,6 +152,7 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         if p.type_vo != 0:
             _log.warning("%s: type_vo %d has no effect with orca: true", where, p.type_vo)
         self.node = node
+        self.where = where
         self.costmap_ros = costmap_ros
         self.costmap = costmap_ros.costmap
         self.frame = costmap_ros.global_frame
@@ -184,6 +203,10 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         #: (2,) the way a robot giving way turns to on the spot this cycle, or None
         self.turning_to: np.ndarray | None = None
         self.waiting = False  # yielding, in the refuge: stands still while ORCA lets it
+        #: robot id -> until when a plan through it asks for no new plan again
+        self.replanned_for: dict[str, float] = {}
+        #: (least m to the goal so far, when it was last cut by ``deadlock_progress``)
+        self.progress = (math.inf, 0.0)
         self.plan_index = 0
         self.retreat = Retreat()  # the way back and the refuge of a yield
         self.lines = (np.zeros((0, 2)), np.zeros((0, 2)), 0)  # this cycle's half-planes
@@ -225,6 +248,8 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
             self.retreat.reset()
             self.give_way.reset()
             self.escape_from = None
+            self.replanned_for.clear()
+            self.progress = (math.inf, self.node.now())
 
     def is_goal_reached(self) -> bool:
         return self.reached_goal
@@ -242,6 +267,7 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
             return self._at_goal(yaw, gyaw)
         self.rotating_to_goal = False
         carrot, self.plan_index, remaining = plan_carrot(self.plan[:, :2], xy, p.carrot_distance)
+        self._plan_in_reach(xy)
         if self.yielding_to is None:
             self.retreat.extend(xy)
         vel_body = np.array([float(velocity[0]), float(velocity[1])])
@@ -261,7 +287,11 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
             xy, own_r, vel
         )
         parked, bodies = self._parked_in_view(ids, pos, nvel, yaws)
+        if remaining < self.progress[0] - p.deadlock_progress or now < self.progress[1]:
+            self.progress = (remaining, now)
         if parked.any():  # obstacles of their true shape, as the walls (see _parked_in_view)
+            if now - self.progress[1] >= BLOCKED_TIME:
+                self._plan_through_parked(now, ids, pos, yaws, parked)
             keep = ~parked
             ids = [i for i, k in zip(ids, keep.tolist()) if k]
             pos, nvel, radii, resp, controlled, yaws, wide = (
@@ -340,6 +370,56 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
             if out[k]:
                 bodies.append(footprint_at(fp, *pos[k], yaws[k]))
         return out, bodies
+
+    def _plan_in_reach(self, xy: np.ndarray) -> None:
+        """Raise `NoValidTrajectory` (move_base plans again, from where the robot stands) when
+        no point of the global plan lies within the local costmap's reach of ``xy`` (half its
+        larger side): collvoid's planner then fails as base_local_planner's
+        ``transformGlobalPlan`` leaves it no plan (mixed circle of 16, seed 7: pioneer16, pushed
+        out of the circle 2.8 m from its plan, went to and fro outside the ring of parked robots
+        from 25 s to the end, steering at the nearest point of a plan it could not reach)."""
+        cm = self.costmap
+        reach = max(cm.size_x, cm.size_y) * cm.resolution / 2.0
+        off = float(np.hypot(*(self.plan[self.plan_index, :2] - xy)))
+        if off > reach:
+            raise NoValidTrajectory(
+                f"{self.where}: the global plan lies {off:.2f} m away, beyond the local "
+                f"costmap's {reach:.2f} m; planning again"
+            )
+
+    def _plan_through_parked(self, now, ids, pos, yaws, parked) -> None:
+        """Raise `NoValidTrajectory` (move_base then plans again, as when
+        TrajectoryPlannerROS finds no valid trajectory) when the global plan, within
+        ``carrot_distance`` ahead, runs through a robot ``parked`` (N,) in view: its shared
+        footprint at ``pos`` (N, 2) m, ``yaws`` (N,) rad, grown by our inscribed radius. A plan
+        made before that robot parked there leads into it for good (the caller asks only after
+        `BLOCKED_TIME` s without progress): the footprint check holds
+        us off it, ORCA no longer counts it, and move_base's default ``planner_frequency`` 0
+        plans only when the local planner fails (mixed circle of 16, seed 3: pioneer10, pushed
+        back to its start, where pioneer14 had parked on its goal, stood there from 60 s to
+        the end, 120 s). The global costmap's ``robots_layer`` marks robots that stand still,
+        so the new plan goes round it. Not for a robot standing on our goal (no plan gets
+        past it), nor again for the same robot within `REPLAN_AGAIN` s."""
+        pts = self.plan[self.plan_index :, :2]
+        along = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
+        ahead = pts[along <= self.params.carrot_distance]
+        goal = self.plan[-1:, :2]
+        for k in np.flatnonzero(parked):
+            rid = ids[k]
+            if now < self.replanned_for.get(rid, -math.inf):
+                continue
+            fp = padded_footprint(self.near_footprints[k], self.wall_radius)
+            body = footprint_at(fp, *pos[k], yaws[k])
+            if inside_polygon(goal, body)[0]:
+                continue
+            hit = inside_polygon(ahead, body)
+            if hit.any():
+                self.replanned_for[rid] = now + REPLAN_AGAIN
+                x, y = ahead[int(np.argmax(hit))]
+                raise NoValidTrajectory(
+                    f"{self.where}: the global plan runs through {rid}, standing at "
+                    f"({x:.2f}, {y:.2f}); planning again"
+                )
 
     def _walls(self, pos, nvel, wide, bodies=()) -> tuple[np.ndarray, tuple[float, float], float]:
         """The local costmap as (costs, origin, resolution) without the other robots' images

@@ -1,0 +1,107 @@
+"""When the collvoid planner hands the plan back to move_base (`NoValidTrajectory`, so that
+move_base plans again from where the robot stands): a global plan out of the local costmap's
+reach (base_local_planner's ``transformGlobalPlan`` leaves nothing of it), and a plan that runs
+through a robot parked in view while the robot makes no progress. The mixed circle of 16
+(seeds 3 and 7) had a pioneer3at stand or wander for the rest of the run in each case."""
+
+import math
+from types import SimpleNamespace
+
+import numpy as np
+import pytest
+from test_collvoid_planner import LIMITS, LIZI, SeeingFleet
+
+from fleetsim.nav.controllers.base import NoValidTrajectory
+from fleetsim.nav.controllers.collvoid_planner import (
+    BLOCKED_TIME,
+    REPLAN_AGAIN,
+    CollvoidLocalPlanner,
+)
+from fleetsim.nav.costmap.costmap_2d import Costmap2D
+from fleetsim.nav.costmap.footprint import inside_polygon
+from fleetsim.runtime import Node, Runtime
+
+
+def planner_with_local_costmap(size_m: float):
+    """A planner whose local costmap is a ``size_m`` square about the origin."""
+    rt = Runtime()
+    n = round(size_m / 0.05)
+    cm = Costmap2D(n, n, 0.05, -size_m / 2, -size_m / 2)
+    node = Node(rt, "move_base", "/robot1")
+    costmap_ros = SimpleNamespace(costmap=cm, footprint=LIZI, global_frame="map")
+    return CollvoidLocalPlanner.from_namespace(node, costmap_ros, dict(LIMITS), "robot1")
+
+
+@pytest.mark.parametrize("off", [1.5, 1.9, 2.1, 3.0])
+def test_a_plan_beyond_the_local_costmaps_reach_is_handed_back(off):
+    """A 4 x 4 m local costmap reaches 2 m: a plan whose nearest point lies farther than that
+    raises, with the distance in the message; a nearer one is followed."""
+    pl = planner_with_local_costmap(4.0)
+    line = np.linspace([off, -1.0], [off, 1.0], 41)
+    pl.set_plan(np.c_[line, np.zeros(41)])
+    if off > 2.0:
+        with pytest.raises(NoValidTrajectory, match=f"{off:.2f} m away.*2.00 m"):
+            pl.compute_velocity_commands((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    else:
+        cmd = pl.compute_velocity_commands((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+        assert cmd.vx >= 0.0
+
+
+def corridor(goal_of_2):
+    """robot1 at (0, 0) bound for (3, 0) along a 0.7 m corridor (too narrow to pass another
+    lizi); robot2 standing at ``goal_of_2``, its own goal, where both see each other."""
+    walls = [(-1.0, 0.35, 4.0, 1.0), (-1.0, -1.0, 4.0, -0.35)]
+    return Corridor([(0.0, 0.0, 0.0), goal_of_2], [(3.0, 0.0, 0.0), goal_of_2], walls=walls)
+
+
+class Corridor(SeeingFleet):
+    """Keeps ``nearest``: the least distance between the two robots' centres (both head along
+    the corridor, so their bodies, 0.38 m long, touch below 0.38 m)."""
+
+    nearest = math.inf
+
+    def see(self):
+        super().see()
+        self.nearest = min(self.nearest, math.dist(self.state[0, :2], self.state[1, :2]))
+
+
+def test_a_plan_through_a_parked_robot_is_handed_back_once_the_robot_stops_progressing():
+    """robot2 stands in the corridor on robot1's plan: robot1 comes up behind it and stops; after
+    `BLOCKED_TIME` s without progress its planner raises, naming robot2, and not again for the
+    same robot within `REPLAN_AGAIN` s."""
+    f = corridor((1.4, 0.0, 0.0))
+    t, raised = 0.0, []
+    while t < 12.0:
+        try:
+            f.run(0.1)
+        except NoValidTrajectory as err:
+            raised.append((t, str(err)))
+            f.vel[0] = 0.0
+        t += 0.1
+    assert raised, "robot1 never handed the blocked plan back"
+    first, text = raised[0]
+    assert "robot2" in text and "planning again" in text
+    assert first >= BLOCKED_TIME
+    gaps = np.diff([r[0] for r in raised])
+    assert (gaps >= REPLAN_AGAIN - 0.11).all()
+    assert f.nearest > 0.38, "robot1's body reached robot2's"
+
+
+def test_a_robot_parked_on_the_goal_is_not_a_reason_to_plan_again():
+    """robot2 stands on robot1's goal: no plan gets past it, so robot1 waits short of it and
+    never hands the plan back."""
+    f = corridor((3.0, 0.0, 0.0))
+    f.run(12.0)
+    assert f.nearest > 0.38, "robot1's body reached robot2's"
+    assert math.dist(f.state[0, :2], (3.0, 0.0)) > 0.3
+
+
+def test_inside_polygon_agrees_with_a_dense_grid_for_a_concave_shape():
+    """The even-odd rule on an L shape, against its two rectangles."""
+    shape = np.array([[0, 0], [2, 0], [2, 1], [1, 1], [1, 2], [0, 2]], float)
+    xs, ys = np.meshgrid(np.linspace(-0.5, 2.5, 61) + 1e-3, np.linspace(-0.5, 2.5, 61) + 1e-3)
+    pts = np.c_[xs.ravel(), ys.ravel()]
+    x, y = pts.T
+    truth = ((x > 0) & (x < 2) & (y > 0) & (y < 1)) | ((x > 0) & (x < 1) & (y > 0) & (y < 2))
+    assert (inside_polygon(pts, shape) == truth).all()
+    assert (inside_polygon(pts, shape[::-1]) == truth).all()

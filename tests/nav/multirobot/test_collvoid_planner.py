@@ -238,11 +238,14 @@ def test_robots_parked_in_the_way_are_gone_round(detour, monkeypatch):
     """robot2 stands on robot1's straight path, robot3 beside it on the right, too close for
     robot1 to pass between (their goals are where they stand): ORCA alone leads robot1 into the
     gap and stops it there; the preferred velocity turned onto the nearest clear tangent takes
-    it round on the left."""
+    it round on the left. (Without the detour, the stuck robot's later remedies, parked robots
+    by their bodies and a new plan, `test_collvoid_replan`, are put out of reach.)"""
+    extra = {}
     if not detour:
         monkeypatch.setattr("fleetsim.nav.controllers.collvoid_preference.DETOUR_REACH", 0.0)
+        extra = {"deadlock_time": 1e3}
     parked = [(0.0, 0.0, math.pi / 2), (0.0, -0.62, math.pi / 2)]
-    f = Fleet([(-3, 0, 0), *parked], [(3, 0, 0), *parked])
+    f = Fleet([(-3, 0, 0), *parked], [(3, 0, 0), *parked], **extra)
     assert f.run(30.0) is detour
     assert f.min_gap > 0.0
     if detour:

@@ -20,6 +20,21 @@ from fleetsim.nav.multirobot.footprint_check import (
 OUTLINE = outline_points(LIZI, 0.05)
 
 
+def drive_off_the_walls(f, seconds: float) -> bool:
+    """Run robot 1 of ``f`` for up to ``seconds`` (0.2 s at a time), its footprint never on a
+    wall; whether it reached its goal."""
+    cm = f.cm
+    for _ in range(round(seconds / 0.2)):
+        reached = f.run(0.2)
+        cost = footprint_costs(
+            cm.costs, cm.origin_x, cm.origin_y, cm.resolution, OUTLINE, f.state.copy()
+        )
+        assert cost[0] >= 0.0, f"footprint on a wall at {f.state[0]}"
+        if reached:
+            return True
+    return False
+
+
 def grid_of(cm):
     return cm.costs, (cm.origin_x, cm.origin_y), cm.resolution
 
@@ -111,17 +126,7 @@ def test_a_lizi_wedged_nose_first_backs_out_and_goes_through(escape, monkeypatch
     f.planners[0].set_plan(
         np.concatenate([np.linspace(a, b, 20) for a, b in itertools.pairwise(corners)])
     )
-    cm = f.cm
-    reached = False
-    for _ in range(150):
-        reached = f.run(0.2)
-        cost = footprint_costs(
-            cm.costs, cm.origin_x, cm.origin_y, cm.resolution, OUTLINE, f.state.copy()
-        )
-        assert cost[0] >= 0.0, f"footprint on a wall at {f.state[0]}"
-        if reached:
-            break
-    assert reached is escape
+    assert drive_off_the_walls(f, 30.0) is escape
     assert (f.planners[0].escapes >= 1) is escape
 
 
@@ -157,16 +162,6 @@ def test_a_lizi_wedged_tail_first_escapes_ahead(escape, monkeypatch):
         monkeypatch.setattr("fleetsim.nav.controllers.collvoid_drive.ESCAPE_SPEED", 0.0)
     walls = [(-0.30, 0.21, -0.05, 0.6), (-0.40, -0.6, -0.22, 0.6)]
     f = Fleet([(0.0, 0.0, 0.0)], [(-1.0, -1.0, -1.57)], walls=walls)
-    cm = f.cm
-    reached = False
-    for _ in range(75):
-        reached = f.run(0.2)
-        cost = footprint_costs(
-            cm.costs, cm.origin_x, cm.origin_y, cm.resolution, OUTLINE, f.state.copy()
-        )
-        assert cost[0] >= 0.0, f"footprint on a wall at {f.state[0]}"
-        if reached:
-            break
-    assert reached is escape
+    assert drive_off_the_walls(f, 15.0) is escape
     assert (f.planners[0].escapes >= 1) is escape
     assert f.backed[0] == 0.0

@@ -5,6 +5,8 @@ through a robot parked in view while the robot makes no progress. The mixed circ
 (seeds 3 and 7) had a pioneer3at stand or wander for the rest of the run in each case."""
 
 import math
+import sys
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -131,3 +133,28 @@ def test_a_stuck_robot_passes_between_parked_robots_by_their_bodies(patience):
             break
     assert reached is (patience < 100.0)
     assert nearest > 0.0, "robot1's body touched a parked one"
+
+
+def test_move_base_plans_again_from_where_a_robot_pushed_off_its_plan_stands():
+    """Through move_base: a lizi with the collvoid planner on its way along y = 1 is carried
+    (here: set down) 2.5 m off its plan, beyond its 3 x 3 m local costmap's 1.5 m reach. The
+    planner hands the plan back, move_base plans again from where the robot stands, and the
+    goal is reached on the new plan."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from nav_world import PLANNER, goal_msg, move_base_params, nav_world
+
+    from fleetsim.msgs.actionlib_msgs import GoalStatus
+
+    params = move_base_params(base_local_planner="collvoid_local_planner/CollvoidLocalPlanner")
+    params["CollvoidLocalPlanner"] = {**PLANNER, "max_vel_x": 0.5, "carrot_distance": 0.8}
+    w = nav_world(params, start=(1.0, 1.0, 0.0))
+    h = w.client.send_goal(goal_msg(3.5, 1.0))
+    w.rt.run(duration=20.0, until=lambda: w.bot.pose[0] > 1.8)
+    assert len(w.watch.plans) == 1 and not h.done
+    w.bot.pose[:] = (2.0, 3.5, 0.0)
+    w.rt.run(duration=40.0, until=lambda: h.done)
+    assert h.status == GoalStatus.SUCCEEDED
+    assert len(w.watch.plans) >= 2
+    first = w.watch.plans[-1].poses[0].pose.position
+    assert math.dist((first.x, first.y), (2.0, 3.5)) < 0.3
+    assert w.bot.min_clearance > 0.0

@@ -95,7 +95,11 @@ class CollvoidParams:
         0.8, unit="m", range=(1e-3, None), help="look-ahead along the plan for the heading"
     )
     deadlock_time: float = param(
-        10.0, unit="s", range=(0.0, None), help="no progress this long near a robot: stuck"
+        10.0,
+        unit="s",
+        range=(0.0, None),
+        help="no progress this long near a robot: stuck (the deadlock rule may yield, and the "
+        "robots parked around count by their footprints)",
     )
     narrow_deadlock_time: float = param(
         1.0,

@@ -47,6 +47,8 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    when base_local_planner's ``transformGlobalPlan`` leaves it no plan, and when it runs
    through a robot parked in view while the robot has made no progress for `BLOCKED_TIME` s
    (the global costmap's ``robots_layer`` holds that robot, so the new plan goes round it);
+   after ``deadlock_time`` s without progress, the robots parked around count by their shared
+   footprints, seen or not (`_parked_in_view`);
 
 The rules that shape the preferred velocity around other robots (keeping right, going round
 robots standing in the way on the side the robot heads for and keeping that side, yielding)
@@ -413,7 +415,8 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
     def _plan_through_parked(self, now, ids, pos, yaws, parked) -> None:
         """Raise `NoValidTrajectory` (move_base then plans again, as when
         TrajectoryPlannerROS finds no valid trajectory) when the global plan, within
-        ``carrot_distance`` ahead, runs through a robot ``parked`` (N,) in view: its shared
+        ``carrot_distance`` ahead, runs through a robot ``parked`` (N,) (`_parked_in_view`,
+        seen or counted by its body while we are stuck): its shared
         footprint at ``pos`` (N, 2) m, ``yaws`` (N,) rad, grown by our inscribed radius. A plan
         made before that robot parked there leads into it for good (the caller asks only after
         `BLOCKED_TIME` s without progress): the footprint check holds

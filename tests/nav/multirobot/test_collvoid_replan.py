@@ -14,11 +14,8 @@ import pytest
 from test_collvoid_planner import LIMITS, LIZI, Fleet, SeeingFleet
 
 from fleetsim.nav.controllers.base import NoValidTrajectory
-from fleetsim.nav.controllers.collvoid_planner import (
-    BLOCKED_TIME,
-    REPLAN_AGAIN,
-    CollvoidLocalPlanner,
-)
+from fleetsim.nav.controllers.collvoid_parked import BLOCKED_TIME, REPLAN_AGAIN
+from fleetsim.nav.controllers.collvoid_planner import CollvoidLocalPlanner
 from fleetsim.nav.costmap.costmap_2d import Costmap2D
 from fleetsim.nav.costmap.footprint import inside_polygon
 from fleetsim.runtime import Node, Runtime

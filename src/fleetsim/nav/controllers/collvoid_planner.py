@@ -48,12 +48,13 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    through a robot parked in view while the robot has made no progress for `BLOCKED_TIME` s
    (the global costmap's ``robots_layer`` holds that robot, so the new plan goes round it);
    after ``deadlock_time`` s without progress, the robots parked around count by their shared
-   footprints, seen or not (`_parked_in_view`);
+   footprints, seen or not (`collvoid_parked`);
 
 The rules that shape the preferred velocity around other robots (keeping right, going round
 robots standing in the way on the side the robot heads for and keeping that side, yielding)
 are in `collvoid_preference`; the neighbours and their radii in `collvoid_neighbours`; the
-base's command in `collvoid_drive`.
+robots parked around and handing the plan back in `collvoid_parked`; the base's command in
+`collvoid_drive`.
 
 Neighbours arrive in the ``map`` frame; the local costmap's frame (often ``odom``) is reached
 through tf. Only ORCA is available: ``clearpath: true`` or ``orca: false`` is an error, and
@@ -73,25 +74,21 @@ from fleetsim.msgs import geometry_msgs
 from fleetsim.nav.controllers.base import (
     EmptyPlan,
     LocalPlanner,
-    NoValidTrajectory,
     VelocityCommand,
 )
 from fleetsim.nav.controllers.collvoid_drive import UNTRUNCATED, CollvoidDrive
 from fleetsim.nav.controllers.collvoid_neighbours import MAP_FRAME, CollvoidNeighbours
 from fleetsim.nav.controllers.collvoid_params import CollvoidParams
+from fleetsim.nav.controllers.collvoid_parked import BLOCKED_TIME, CollvoidParked
 from fleetsim.nav.controllers.collvoid_preference import (
     DECELERATION,
     KEEP_RIGHT_UNTIL,
-    STILL_SPEED,
     CollvoidPreference,
 )
 from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
 from fleetsim.nav.costmap.footprint import (
-    footprint_at,
     footprint_radii,
-    inside_polygon,
     outline_points,
-    padded_footprint,
     polygon_cells,
 )
 from fleetsim.nav.multirobot.crossing import GiveWay
@@ -124,23 +121,11 @@ SAME_GOAL_SHIFT = 0.5
 #: s; how old another robot's image in the local costmap can be against its shared pose (a
 #: 5 Hz costmap update and a 10 Hz /position_share message), and the most it moves meanwhile, m
 SEEN_LAG, SEEN_LAG_MAX = 0.3, 0.2
-#: lethal cells inside a standing robot's body that make it seen by this robot's own sensors
-SEEN_CELLS = 3
-#: s a robot has stood still before it counts as parked (a robot stopping for a moment in a
-#: crowd, or turning on the spot, stays in ORCA)
-PARKED_TIME = 1.0
-#: s before a plan through the same parked robot asks for a new plan again (a new plan that
-#: still runs through it, where no other way is known, is driven as far as it goes)
-REPLAN_AGAIN = 5.0
-#: s without ``deadlock_progress`` towards the goal before a plan through a parked robot is
-#: planned again (a robot that gets round it on its own keeps its plan: in the pioneers'
-#: corridor of 4, seed 0, a new plan round pioneer3 led pioneer1 into the corridor's corner)
-BLOCKED_TIME = 3.0
-#: s a parked robot no sensor of ours sees counts with its footprint once we are stuck
-BODIES_TIME = 10.0
 
 
-class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive, LocalPlanner):
+class CollvoidLocalPlanner(
+    CollvoidNeighbours, CollvoidParked, CollvoidPreference, CollvoidDrive, LocalPlanner
+):
     """ORCA among the robots on /position_share, for one move_base (see the module doc)."""
 
     Params = CollvoidParams
@@ -293,9 +278,7 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
         map_xy, ids, pos, nvel, radii, resp, controlled, yaws, wide = self._neighbours(
             xy, own_r, vel
         )
-        if remaining < self.progress[0] - p.deadlock_progress or now < self.progress[1]:
-            self.progress = (remaining, now)
-        stuck = now - self.progress[1]
+        stuck = self._stuck_for(now, remaining)
         parked, bodies = self._parked_in_view(ids, pos, nvel, yaws, stuck >= p.deadlock_time)
         if parked.any():  # obstacles of their true shape, as the walls (see _parked_in_view)
             if stuck >= BLOCKED_TIME:
@@ -345,107 +328,6 @@ class CollvoidLocalPlanner(CollvoidNeighbours, CollvoidPreference, CollvoidDrive
                 pref, wanted, vel, pos - xy, nvel, pair, resp, controlled, ids, meeting
             )
         return self._orca(xy, vel, pref, pos - xy, nvel, pair, resp, self.bodies_radii(radii))
-
-    def _parked_in_view(
-        self, ids, pos, nvel, yaws, blocked=False
-    ) -> tuple[np.ndarray, list[np.ndarray]]:
-        """(N,) bool, and their shared footprints at their poses (polygons, costmap frame):
-        the neighbours ``ids`` that have stood still for ``PARKED_TIME`` where
-        this robot's own sensors see them (``SEEN_CELLS`` lethal cells or more under the
-        footprint they share, grown by a cell, at ``pos`` (N, 2) m and ``yaws`` (N,) rad).
-        They are left out of ORCA and stay in the
-        local costmap: the wall half-planes and the footprint check then take them with their
-        true shape, as collvoid puts standing robots into the costmap (its
-        ``stationary_robots``). A disc of the circumscribed radius is too wide beside them: a
-        pioneer3at (0.54 x 0.50 m, a 0.37 m disc) could not pass another one parked in the
-        middle of a 2 m corridor, with 0.75 m free on either side. A robot no sensor of ours
-        sees (a lizi's laser sweeps above the others) stays in ORCA, unless this robot is
-        ``blocked`` (no progress for ``deadlock_time`` s, the deadlock rule's patience): then
-        every robot parked within ``neighbor_dist`` counts with its shared footprint for
-        `BODIES_TIME` s (mixed circle of 16, seed 10: pioneer10 went to and fro for 80 s
-        before a gap between two parked lizis that their discs closed and their bodies left
-        0.85 m wide). Not sooner: in the lizis' corridor of 4, parked lizis taken by their
-        footprints from the start slowed every run (24.7 -> 33.2 s mean), and a lizi 3 s into
-        going round two parked lizis 0.8 m apart turned into the gap between them and stuck
-        there."""
-        still = np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED
-        now, since = self.node.now(), self.still_since
-        for k in [k for k in since if k not in ids]:
-            del since[k]
-        for k, s in zip(ids, still.tolist()):
-            if not s:
-                since.pop(k, None)
-            else:
-                since.setdefault(k, now)
-        out = np.array([s and now - since[k] >= PARKED_TIME for k, s in zip(ids, still.tolist())])
-        out = out.astype(bool).reshape(len(ids))
-        as_bodies = self.as_bodies
-        for k in [k for k in as_bodies if now >= as_bodies[k]]:
-            del as_bodies[k]
-        if blocked:
-            for k in np.flatnonzero(out):
-                as_bodies[ids[k]] = now + BODIES_TIME
-        cm, bodies = self.costmap, []
-        for k in np.flatnonzero(out):
-            fp = self.near_footprints[k]
-            grown = padded_footprint(fp, cm.resolution)
-            rows, cols = polygon_cells(cm, footprint_at(grown, *pos[k], yaws[k]))
-            seen = np.count_nonzero(cm.costs[rows, cols] == LETHAL_OBSTACLE) >= SEEN_CELLS
-            out[k] = seen or ids[k] in as_bodies
-            if out[k]:
-                bodies.append(footprint_at(fp, *pos[k], yaws[k]))
-        return out, bodies
-
-    def _plan_in_reach(self, xy: np.ndarray) -> None:
-        """Raise `NoValidTrajectory` (move_base plans again, from where the robot stands) when
-        no point of the global plan lies within the local costmap's reach of ``xy`` (half its
-        larger side): collvoid's planner then fails as base_local_planner's
-        ``transformGlobalPlan`` leaves it no plan (mixed circle of 16, seed 7: pioneer16, pushed
-        out of the circle 2.8 m from its plan, went to and fro outside the ring of parked robots
-        from 25 s to the end, steering at the nearest point of a plan it could not reach)."""
-        cm = self.costmap
-        reach = max(cm.size_x, cm.size_y) * cm.resolution / 2.0
-        off = float(np.hypot(*(self.plan[self.plan_index, :2] - xy)))
-        if off > reach:
-            raise NoValidTrajectory(
-                f"{self.where}: the global plan lies {off:.2f} m away, beyond the local "
-                f"costmap's {reach:.2f} m; planning again"
-            )
-
-    def _plan_through_parked(self, now, ids, pos, yaws, parked) -> None:
-        """Raise `NoValidTrajectory` (move_base then plans again, as when
-        TrajectoryPlannerROS finds no valid trajectory) when the global plan, within
-        ``carrot_distance`` ahead, runs through a robot ``parked`` (N,) (`_parked_in_view`,
-        seen or counted by its body while we are stuck): its shared
-        footprint at ``pos`` (N, 2) m, ``yaws`` (N,) rad, grown by our inscribed radius. A plan
-        made before that robot parked there leads into it for good (the caller asks only after
-        `BLOCKED_TIME` s without progress): the footprint check holds
-        us off it, ORCA no longer counts it, and move_base's default ``planner_frequency`` 0
-        plans only when the local planner fails (mixed circle of 16, seed 3: pioneer10, pushed
-        back to its start, where pioneer14 had parked on its goal, stood there from 60 s to
-        the end, 120 s). The global costmap's ``robots_layer`` marks robots that stand still,
-        so the new plan goes round it. Not for a robot standing on our goal (no plan gets
-        past it), nor again for the same robot within `REPLAN_AGAIN` s."""
-        pts = self.plan[self.plan_index :, :2]
-        along = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
-        ahead = pts[along <= self.params.carrot_distance]
-        goal = self.plan[-1:, :2]
-        for k in np.flatnonzero(parked):
-            rid = ids[k]
-            if now < self.replanned_for.get(rid, -math.inf):
-                continue
-            fp = padded_footprint(self.near_footprints[k], self.wall_radius)
-            body = footprint_at(fp, *pos[k], yaws[k])
-            if inside_polygon(goal, body)[0]:
-                continue
-            hit = inside_polygon(ahead, body)
-            if hit.any():
-                self.replanned_for[rid] = now + REPLAN_AGAIN
-                x, y = ahead[int(np.argmax(hit))]
-                raise NoValidTrajectory(
-                    f"{self.where}: the global plan runs through {rid}, standing at "
-                    f"({x:.2f}, {y:.2f}); planning again"
-                )
 
     def _walls(self, pos, nvel, wide, bodies=()) -> tuple[np.ndarray, tuple[float, float], float]:
         """The local costmap as (costs, origin, resolution) without the other robots' images

@@ -10,6 +10,7 @@ from __future__ import annotations
 import math
 
 import numpy as np
+import shapely
 import yaml
 from numba import njit
 
@@ -50,16 +51,10 @@ def padded_footprint(footprint: np.ndarray, padding: float) -> np.ndarray:
 
 
 def inside_polygon(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
-    """(N,) bool: which ``points`` (N, 2) lie inside ``polygon`` (M, 2) (even-odd rule, as the
-    costmap's polygon fill; any winding, convex or not)."""
+    """(N,) bool: which ``points`` (N, 2) lie inside ``polygon`` (M, 2), any winding, convex
+    or not (shapely's ``contains_xy``)."""
     pts = np.asarray(points, dtype=np.float64).reshape(-1, 2)
-    a = np.asarray(polygon, dtype=np.float64)
-    b = np.roll(a, -1, axis=0)
-    px, py = pts[:, 0:1], pts[:, 1:2]
-    straddles = (a[:, 1] > py) != (b[:, 1] > py)  # (N, M): the edge spans the point's row
-    dy = np.where(b[:, 1] == a[:, 1], 1.0, b[:, 1] - a[:, 1])
-    cross_x = a[:, 0] + (py - a[:, 1]) * (b[:, 0] - a[:, 0]) / dy
-    return (np.count_nonzero(straddles & (px < cross_x), axis=1) % 2).astype(bool)
+    return shapely.contains_xy(shapely.Polygon(polygon), pts[:, 0], pts[:, 1])
 
 
 def footprint_radii(footprint: np.ndarray) -> tuple[float, float]:

@@ -1,0 +1,157 @@
+"""Robots parked around ``CollvoidLocalPlanner``, and when its global plan goes back to
+move_base: which standing neighbours leave ORCA for the local costmap with their true shape
+(`CollvoidParked._parked_in_view`), the robot's own progress clock (`_stuck_for`), and the two
+cases in which the planner hands the plan back (`NoValidTrajectory`: move_base plans again
+from where the robot stands), a plan out of the local costmap's reach (`_plan_in_reach`) and
+one through a parked robot while the robot is stuck (`_plan_through_parked`).
+
+`CollvoidParked` is mixed into the planner, which owns the state it reads (``params``,
+``node``, ``costmap``, ``plan``, ``plan_index``, ``wall_radius``, ``near_footprints``,
+``still_since``, ``as_bodies``, ``replanned_for``, ``progress``, ``where``).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from fleetsim.nav.controllers.base import NoValidTrajectory
+from fleetsim.nav.controllers.collvoid_preference import STILL_SPEED
+from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
+from fleetsim.nav.costmap.footprint import (
+    footprint_at,
+    inside_polygon,
+    padded_footprint,
+    polygon_cells,
+)
+
+#: lethal cells inside a standing robot's body that make it seen by this robot's own sensors
+SEEN_CELLS = 3
+#: s a robot has stood still before it counts as parked (a robot stopping for a moment in a
+#: crowd, or turning on the spot, stays in ORCA)
+PARKED_TIME = 1.0
+#: s before a plan through the same parked robot asks for a new plan again (a new plan that
+#: still runs through it, where no other way is known, is driven as far as it goes)
+REPLAN_AGAIN = 5.0
+#: s without ``deadlock_progress`` towards the goal before a plan through a parked robot is
+#: planned again (a robot that gets round it on its own keeps its plan: in the pioneers'
+#: corridor of 4, seed 0, a new plan round pioneer3 led pioneer1 into the corridor's corner)
+BLOCKED_TIME = 3.0
+#: s a parked robot no sensor of ours sees counts with its footprint once we are stuck
+BODIES_TIME = 10.0
+
+
+class CollvoidParked:
+    """Parked neighbours and handing the plan back, for the collvoid planner (see the module
+    doc)."""
+
+    def _stuck_for(self, now: float, remaining: float) -> float:
+        """s since the robot last came ``deadlock_progress`` m nearer its goal (``remaining``
+        m away now). The planner's own clock: the deadlock rule's restarts whenever the robot
+        keeps the right of way, so it does not measure progress alone."""
+        best, since = self.progress
+        if remaining < best - self.params.deadlock_progress or now < since:
+            self.progress = (remaining, now)
+        return now - self.progress[1]
+
+    def _parked_in_view(
+        self, ids, pos, nvel, yaws, blocked=False
+    ) -> tuple[np.ndarray, list[np.ndarray]]:
+        """(N,) bool, and their shared footprints at their poses (polygons, costmap frame):
+        the neighbours ``ids`` that have stood still for ``PARKED_TIME`` where
+        this robot's own sensors see them (``SEEN_CELLS`` lethal cells or more under the
+        footprint they share, grown by a cell, at ``pos`` (N, 2) m and ``yaws`` (N,) rad).
+        They are left out of ORCA and stay in the
+        local costmap: the wall half-planes and the footprint check then take them with their
+        true shape, as collvoid puts standing robots into the costmap (its
+        ``stationary_robots``). A disc of the circumscribed radius is too wide beside them: a
+        pioneer3at (0.54 x 0.50 m, a 0.37 m disc) could not pass another one parked in the
+        middle of a 2 m corridor, with 0.75 m free on either side. A robot no sensor of ours
+        sees (a lizi's laser sweeps above the others) stays in ORCA, unless this robot is
+        ``blocked`` (no progress for ``deadlock_time`` s, the deadlock rule's patience): then
+        every robot parked within ``neighbor_dist`` counts with its shared footprint for
+        `BODIES_TIME` s (mixed circle of 16, seed 10: pioneer10 went to and fro for 80 s
+        before a gap between two parked lizis that their discs closed and their bodies left
+        0.85 m wide). Not sooner: in the lizis' corridor of 4, parked lizis taken by their
+        footprints from the start slowed every run (24.7 -> 33.2 s mean), and a lizi 3 s into
+        going round two parked lizis 0.8 m apart turned into the gap between them and stuck
+        there."""
+        still = np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED
+        now, since = self.node.now(), self.still_since
+        for k in [k for k in since if k not in ids]:
+            del since[k]
+        for k, s in zip(ids, still.tolist()):
+            if not s:
+                since.pop(k, None)
+            else:
+                since.setdefault(k, now)
+        out = np.array([s and now - since[k] >= PARKED_TIME for k, s in zip(ids, still.tolist())])
+        out = out.astype(bool).reshape(len(ids))
+        as_bodies = self.as_bodies
+        for k in [k for k in as_bodies if now >= as_bodies[k]]:
+            del as_bodies[k]
+        if blocked:
+            for k in np.flatnonzero(out):
+                as_bodies[ids[k]] = now + BODIES_TIME
+        cm, bodies = self.costmap, []
+        for k in np.flatnonzero(out):
+            fp = self.near_footprints[k]
+            grown = padded_footprint(fp, cm.resolution)
+            rows, cols = polygon_cells(cm, footprint_at(grown, *pos[k], yaws[k]))
+            seen = np.count_nonzero(cm.costs[rows, cols] == LETHAL_OBSTACLE) >= SEEN_CELLS
+            out[k] = seen or ids[k] in as_bodies
+            if out[k]:
+                bodies.append(footprint_at(fp, *pos[k], yaws[k]))
+        return out, bodies
+
+    def _plan_in_reach(self, xy: np.ndarray) -> None:
+        """Raise `NoValidTrajectory` (move_base plans again, from where the robot stands) when
+        no point of the global plan lies within the local costmap's reach of ``xy`` (half its
+        larger side): collvoid's planner then fails as base_local_planner's
+        ``transformGlobalPlan`` leaves it no plan (mixed circle of 16, seed 7: pioneer16, pushed
+        out of the circle 2.8 m from its plan, went to and fro outside the ring of parked robots
+        from 25 s to the end, steering at the nearest point of a plan it could not reach)."""
+        cm = self.costmap
+        reach = max(cm.size_x, cm.size_y) * cm.resolution / 2.0
+        off = float(np.hypot(*(self.plan[self.plan_index, :2] - xy)))
+        if off > reach:
+            raise NoValidTrajectory(
+                f"{self.where}: the global plan lies {off:.2f} m away, beyond the local "
+                f"costmap's {reach:.2f} m; planning again"
+            )
+
+    def _plan_through_parked(self, now, ids, pos, yaws, parked) -> None:
+        """Raise `NoValidTrajectory` (move_base then plans again, as when
+        TrajectoryPlannerROS finds no valid trajectory) when the global plan, within
+        ``carrot_distance`` ahead, runs through a robot ``parked`` (N,) (`_parked_in_view`,
+        seen or counted by its body while we are stuck): its shared
+        footprint at ``pos`` (N, 2) m, ``yaws`` (N,) rad, grown by our inscribed radius. A plan
+        made before that robot parked there leads into it for good (the caller asks only after
+        `BLOCKED_TIME` s without progress): the footprint check holds
+        us off it, ORCA no longer counts it, and move_base's default ``planner_frequency`` 0
+        plans only when the local planner fails (mixed circle of 16, seed 3: pioneer10, pushed
+        back to its start, where pioneer14 had parked on its goal, stood there from 60 s to
+        the end, 120 s). The global costmap's ``robots_layer`` marks robots that stand still,
+        so the new plan goes round it. Not for a robot standing on our goal (no plan gets
+        past it), nor again for the same robot within `REPLAN_AGAIN` s."""
+        pts = self.plan[self.plan_index :, :2]
+        along = np.concatenate([[0.0], np.cumsum(np.hypot(*np.diff(pts, axis=0).T))])
+        ahead = pts[along <= self.params.carrot_distance]
+        goal = self.plan[-1:, :2]
+        for k in np.flatnonzero(parked):
+            rid = ids[k]
+            if now < self.replanned_for.get(rid, -math.inf):
+                continue
+            fp = padded_footprint(self.near_footprints[k], self.wall_radius)
+            body = footprint_at(fp, *pos[k], yaws[k])
+            if inside_polygon(goal, body)[0]:
+                continue
+            hit = inside_polygon(ahead, body)
+            if hit.any():
+                self.replanned_for[rid] = now + REPLAN_AGAIN
+                x, y = ahead[int(np.argmax(hit))]
+                raise NoValidTrajectory(
+                    f"{self.where}: the global plan runs through {rid}, standing at "
+                    f"({x:.2f}, {y:.2f}); planning again"
+                )

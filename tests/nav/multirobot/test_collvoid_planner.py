@@ -455,30 +455,3 @@ def test_overlap_time_parts_overlapping_discs_without_stalling_the_robot(overlap
         assert along > 0.3
         # and 1 s on they are farther apart than the 0.4 m they are now
         assert math.hypot(along, away + 0.4) > 0.5
-
-
-@pytest.mark.parametrize(
-    ("keep_right_dist", "half_width", "early"),
-    [(0.0, 2.0, False), (6.0, 2.0, True), (6.0, 0.45, False)],
-)
-def test_keep_right_dist_keeps_right_for_a_robot_coming_from_beyond_neighbor_dist(
-    keep_right_dist, half_width, early
-):
-    """Two lizis head-on on the axis of a corridor, 9 m apart (the way the inner pair of the
-    pioneers' corridor of 4 meets). Keeping right starts once the other robot is a neighbour
-    (3 m); with ``keep_right_dist`` 6 m both have taken their right-hand side before that,
-    from /position_share, where the corridor leaves room for it (not in one 0.9 m wide, where
-    they meet in its middle; one of them yields there, which needs move_base round the
-    planner). In the wide corridor they pass without contact either way."""
-    walls = [(-1.0, half_width, 10.0, 3.0), (-1.0, -3.0, 10.0, -half_width)]
-    f = Fleet([(0.0, 0.0, 0.0), (9.0, 0.0, math.pi)], [(9.0, 0.0, 0.0), (0.0, 0.0, math.pi)],
-              walls=walls, neighbor_dist=3.0, keep_right_dist=keep_right_dist)  # fmt: skip
-    while float(np.hypot(*(f.state[0, :2] - f.state[1, :2]))) > 3.2:
-        f.run(0.1)
-    right = [-f.state[0, 1], f.state[1, 1]]  # each one's offset to its own right, m
-    if early:
-        assert min(right) > 0.05, right
-    else:
-        assert max(abs(r) for r in right) < 0.01, right
-    if half_width > 1.0:
-        assert f.run(30.0) and f.min_gap > 0.0

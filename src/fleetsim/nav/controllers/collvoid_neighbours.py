@@ -15,14 +15,10 @@ import numpy as np
 
 from fleetsim.errors import TransformError
 from fleetsim.nav.controllers.collvoid_preference import STILL_SPEED
-from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
 from fleetsim.nav.multirobot.holonomic import rotated
 from fleetsim.nav.multirobot.uncertainty import pair_padding, side_by_side_padding
 
 MAP_FRAME = "map"
-#: m beyond the robot's circumscribed radius that must be free on its right for it to keep
-#: right before a meeting (``keep_right_dist``)
-KEEP_RIGHT_ROOM = 0.3
 
 
 class CollvoidNeighbours:
@@ -122,47 +118,3 @@ class CollvoidNeighbours:
         radii, wide = self.neighbour_radii(own_r, map_xy, near, rotated(vel, -tyaw))
         self.near_footprints = [r.footprint for r in near.robots]  # robot frames, as shared
         return map_xy, near.ids, pos, nvel, radii, resp, near.controlled, yaws, wide
-
-    def _met_ahead(self, xy, map_xy, vel, pref, remaining) -> bool:
-        """Whether a robot beyond ``neighbor_dist`` but within ``keep_right_dist`` m (and
-        nearer than the goal, ``remaining`` m) comes against us along our way, where the
-        walls leave room to keep right (`room_on_the_right`: in a passage too narrow for two,
-        a robot kept right early stood off its middle, and its circumscribed disc pressed on
-        the wall it had moved towards; the pioneers' corridor too narrow for two, seed 5, the
-        robot yielding could not back out)."""
-        p = self.params
-        reach = min(p.keep_right_dist, remaining)
-        if reach <= p.neighbor_dist:
-            return False
-        if not room_on_the_right(self.grid, xy, pref, self.body_radius + KEEP_RIGHT_ROOM):
-            return False
-        try:
-            tx, ty, tyaw = self._map_to_local()
-        except TransformError:
-            return False
-        far = self.share.table.near(
-            self.node.now(), (map_xy[0], map_xy[1]), reach, p.max_neighbors, self.robot_id
-        )
-        if not far.ids:
-            return False
-        rel = far.positions - map_xy
-        nvel = far.velocities
-        vel_m, pref_m = rotated(vel, -tyaw), rotated(pref, -tyaw)
-        dist = np.hypot(rel[:, 0], rel[:, 1])
-        beyond = dist > p.neighbor_dist
-        return bool((self._oncoming(rel, nvel, vel_m, pref_m, dist, reach) & beyond).any())
-
-
-def room_on_the_right(grid, xy, way, reach) -> bool:
-    """Whether no lethal cell of ``grid`` (costs, origin, resolution) lies within ``reach`` m
-    of ``xy`` (2,) m to the right of ``way`` (2,) (cells off the grid count as free)."""
-    costs, origin, res = grid
-    n = float(np.hypot(*way))
-    if n < 1e-9:
-        return True
-    right = np.array([way[1], -way[0]]) / n
-    pts = xy + np.outer(np.arange(1, math.ceil(reach / res) + 1) * res, right)
-    cols = np.floor((pts[:, 0] - origin[0]) / res).astype(int)
-    rows = np.floor((pts[:, 1] - origin[1]) / res).astype(int)
-    inside = (rows >= 0) & (rows < costs.shape[0]) & (cols >= 0) & (cols < costs.shape[1])
-    return not (costs[rows[inside], cols[inside]] >= LETHAL_OBSTACLE).any()

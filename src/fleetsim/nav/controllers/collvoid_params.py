@@ -64,13 +64,6 @@ class CollvoidParams:
         unit="rad",
         help="turn of the preferred velocity while a robot is ahead (negative: keep right)",
     )
-    keep_right_dist: float = param(
-        0.0,
-        unit="m",
-        range=(0.0, None),
-        help="robots coming against us this far ahead already turn the preferred velocity by "
-        "left_pref (0: only those within neighbor_dist; a fleetsim addition)",
-    )
     time_to_holo: float = param(
         0.4, unit="s", range=(1e-3, None), help="time to reach the holonomic velocity's heading"
     )

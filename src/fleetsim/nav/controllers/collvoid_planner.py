@@ -14,10 +14,8 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    ``max_vel_x``, slowing at a quarter of ``acc_lim_x`` (not below ``min_vel_x``) to stop at
    the goal; while another robot ahead, nearer than the goal, is closing in, it is turned by
    ``left_pref`` rad (negative: keep right), which breaks the symmetry of head-on meetings that
-   plain ORCA cannot (``keep_right_dist``: also for robots coming against us from farther than
-   ``neighbor_dist``, so that lanes form before the meeting, where the walls leave room);
-   outside a meeting, a robot carried off its way by a higher-priority robot beside it that
-   moves the same way drops back behind it (`fleetsim.nav.multirobot.crossing`);
+   plain ORCA cannot; outside a meeting, a robot carried off its way by a higher-priority robot
+   beside it that moves the same way drops back behind it (`fleetsim.nav.multirobot.crossing`);
 3. the `DeadlockRule` may make the robot yield (at once when a robot faces it across a
    passage too narrow for two): it backs out along the way it came (``max_vel_x_backwards``)
    to a place wide enough, aside to the right, taking full responsibility for avoiding the
@@ -319,18 +317,16 @@ class CollvoidLocalPlanner(
                 self.waiting = not pref.any()
         self.giving_way_to = None
         self.turning_to = None
-        keep_right = self.yielding_to is None and remaining >= KEEP_RIGHT_UNTIL
         if self.yielding_to is None and ids:
             wanted = pref
+            near_goal = remaining < KEEP_RIGHT_UNTIL
             meeting = self._oncoming(pos - xy, nvel, vel, pref, dist, remaining)
-            if keep_right and (meeting.any() or self._met_ahead(xy, map_xy, vel, pref, remaining)):
+            if not near_goal and meeting.any():
                 pref = rotated(pref, p.left_pref)
             pref = self._around_still(pref, xy, vel, pos - xy, nvel, pair, controlled, ids)
             pref = self._give_way(
                 pref, wanted, vel, pos - xy, nvel, pair, resp, controlled, ids, meeting
             )
-        elif keep_right and self._met_ahead(xy, map_xy, vel, pref, remaining):
-            pref = rotated(pref, p.left_pref)
         return self._orca(xy, vel, pref, pos - xy, nvel, pair, resp, self.bodies_radii(radii))
 
     def _walls(self, pos, nvel, wide, bodies=()) -> tuple[np.ndarray, tuple[float, float], float]:

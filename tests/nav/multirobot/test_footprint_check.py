@@ -13,10 +13,8 @@ from test_collvoid_planner import BODY, LIZI, Fleet, empty_map
 from fleetsim.nav.costmap.footprint import footprint_costs, outline_points
 from fleetsim.nav.multirobot.footprint_check import (
     STEPS,
-    clearances,
     first_collisions,
     footprint_safe_command,
-    rollout_clearances,
 )
 
 OUTLINE = outline_points(LIZI, 0.05)
@@ -167,71 +165,3 @@ def test_a_lizi_wedged_tail_first_escapes_ahead(escape, monkeypatch):
     assert drive_off_the_walls(f, 15.0) is escape
     assert (f.planners[0].escapes >= 1) is escape
     assert f.backed[0] == 0.0
-
-
-PIONEER = np.array([[-0.27, -0.25], [-0.27, 0.25], [0.27, 0.25], [0.27, -0.25]])
-PIONEER_OUTLINE = outline_points(PIONEER, 0.05)
-
-
-def test_clearances_are_the_distance_to_the_nearest_lethal_cell():
-    cm = empty_map([(0.0, 0.0, 0.05, 0.05)])  # one lethal cell
-    room = clearances(cm.costs, 0.05)
-    r, c = np.argwhere(cm.costs == 254)[0]
-    assert room[r, c] == 0.0
-    assert room[r, c + 3] == pytest.approx(0.15) and room[r + 3, c + 4] == pytest.approx(0.25)
-
-
-def test_rollout_clearances_agree_with_the_footprint_pose_by_pose():
-    cm = empty_map([(0.5, -1.0, 0.7, 1.0)])
-    room = clearances(cm.costs, 0.05)
-    cmds = np.array([[0.3, 0.0], [0.3, 0.8], [-0.2, -0.5]])
-    pose, vel, acc = np.array([0.0, 0.1, 0.2]), np.array([0.2, 0.0]), np.array([2.5, 3.2])
-    got = rollout_clearances(cmds, pose, vel, acc, 1.0, STEPS, room, np.array([-10.0, -10.0]),
-                             0.05, OUTLINE)  # fmt: skip
-    dt = 1.0 / STEPS
-    for (cv, cw), least in zip(cmds, got):
-        x, y, th = pose
-        v, w = vel
-        want = np.inf
-        for _ in range(STEPS):
-            v = min(cv, v + 2.5 * dt) if cv >= v else max(cv, v - 2.5 * dt)
-            w = min(cw, w + 3.2 * dt) if cw >= w else max(cw, w - 3.2 * dt)
-            x, y, th = x + v * math.cos(th) * dt, y + v * math.sin(th) * dt, th + w * dt
-            c, s = math.cos(th), math.sin(th)
-            px = x + c * OUTLINE[:, 0] - s * OUTLINE[:, 1]
-            py = y + s * OUTLINE[:, 0] + c * OUTLINE[:, 1]
-            cells = room[((py + 10) / 0.05).astype(int), ((px + 10) / 0.05).astype(int)]
-            want = min(want, float(cells.min()))
-        assert least == pytest.approx(want)
-
-
-def test_a_command_that_would_end_flush_with_a_wall_keeps_room_instead():
-    """A pioneer3at running along a wall 10 cm off its right side, the holonomic velocity
-    leaning into the wall: the command leaning in is clear of the wall's cells, so the plain
-    check keeps it; with the clearances it is replaced by one that keeps more room and still
-    goes on. In a gap 4 cm wider than the body, the plain check decides: nothing keeps more
-    room there and still goes on."""
-    wall = (-5.0, -2.0, 5.0, -0.31)  # lethal up to y = -0.35; the right side at -0.25
-    cm = empty_map([wall])
-    grid = grid_of(cm)
-    limits = (-0.5, 0.7, -1.5, 1.5, 2.5, 3.2)
-    pose, vel = (0.0, 0.0, 0.0), (0.5, 0.0)
-    lean = np.array([0.5, -0.06])
-    wanted = (0.5, -0.12)
-    plain = footprint_safe_command(wanted, lean, pose, vel, grid, PIONEER_OUTLINE, limits, 1.0)
-    assert plain == (0.5, -0.12, False)
-    room = clearances(cm.costs, 0.05)
-    v, w, replaced = footprint_safe_command(
-        wanted, lean, pose, vel, grid, PIONEER_OUTLINE, limits, 1.0, room
-    )
-    assert replaced and v > 0.3 and w > -0.12
-    got = rollout_clearances(np.array([[v, w], wanted]), np.array(pose), np.array(vel),
-                             np.array([2.5, 3.2]), 1.0, STEPS, room, np.array(grid[1]), 0.05,
-                             PIONEER_OUTLINE)  # fmt: skip
-    assert got[0] > got[1]
-    gap = empty_map([wall, (-5.0, 0.29, 5.0, 2.0)])  # 0.6 m wide, the body 0.5 m
-    got = footprint_safe_command(
-        (0.5, 0.0), np.array([0.5, 0.0]), pose, vel, grid_of(gap), PIONEER_OUTLINE, limits, 1.0,
-        clearances(gap.costs, 0.05),
-    )  # fmt: skip
-    assert got == (0.5, 0.0, False)

@@ -8,8 +8,7 @@ holonomic ORCA velocity to the command a base can follow.
   (`speed_nearest_still`), and so does one giving way at a crossing, turning on the spot
   towards its way; then the command's rollout over ``time_horizon_obst`` is checked
   with the real footprint on the local costmap and, if it touches an obstacle, replaced by the
-  clear command that best follows the holonomic velocity (`footprint_safe_command`; one that
-  keeps more room from the obstacles where that costs little progress); a robot
+  clear command that best follows the holonomic velocity (`footprint_safe_command`); a robot
   wedged (the best clear command is to stand) backs out straight a little, or where it
   cannot, goes straight ahead a little;
 * every command within ``acc_lim_x``/``acc_lim_y``/``acc_lim_theta`` of the last;
@@ -27,7 +26,7 @@ import math
 import numpy as np
 
 from fleetsim.nav.controllers.base import VelocityCommand
-from fleetsim.nav.multirobot.footprint_check import clearances, footprint_safe_command
+from fleetsim.nav.multirobot.footprint_check import footprint_safe_command
 from fleetsim.nav.multirobot.holonomic import (
     rotated,
     speed_along,
@@ -133,9 +132,7 @@ class CollvoidDrive:
             )  # fmt: skip
         horizon = self.horizon_obst if self.horizon_obst < UNTRUNCATED else p.time_horizon_obst
 
-        room = clearances(self.grid[0], self.grid[2])
-
-        def clear(wanted, holo, room=None):
+        def clear(wanted, holo):
             return footprint_safe_command(
                 wanted,
                 holo,
@@ -145,7 +142,6 @@ class CollvoidDrive:
                 self.outline,
                 (-caps[1], caps[0], p.min_vel_theta, p.max_vel_theta, p.acc_lim_x, p.acc_lim_theta),
                 horizon,
-                room,
             )
 
         xy = np.array(pose[:2], dtype=np.float64)
@@ -168,7 +164,7 @@ class CollvoidDrive:
                 self.replaced = True
                 return sign * escape, 0.0, 0.0
             self.escape_from = None
-        v, w, self.replaced = clear((cmd[0], cmd[2]), self.last_holo, room)
+        v, w, self.replaced = clear((cmd[0], cmd[2]), self.last_holo)
         still = abs(v) < 1e-3 and abs(w) < 1e-3
         wants = float(np.hypot(*self.last_holo)) > STILL_HOLO
         if self.replaced and still and wants and not self.waiting and escape > 0.0:

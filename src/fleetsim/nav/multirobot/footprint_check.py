@@ -16,10 +16,7 @@ here the same split is made after the fact:
 * `footprint_safe_command` keeps the planner's command when its rollout is clear, else takes
   the clear one from a (v, w) grid over the robot's limits whose rollout ends nearest where
   the holonomic velocity leads (forwards or backwards: a lizi beside a wall that cannot turn
-  on the spot backs out straight);
-* given the obstacles' `clearances`, it keeps the footprint off them where that costs little
-  progress (`rollout_clearances`, up to `ROOM`): a pioneer3at squeezing past a parked robot
-  no longer ends flush with the wall beyond it, where it could not turn.
+  on the spot backs out straight).
 
 The rollout's simulation is base_local_planner's, written again here rather than imported:
 `fleetsim.nav.controllers.rollout.trajectory_costs` also scores path and goal distance maps,
@@ -32,10 +29,8 @@ import math
 
 import numpy as np
 from numba import njit
-from scipy import ndimage
 
 from fleetsim.nav.controllers.rollout import new_velocity
-from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
 from fleetsim.nav.costmap.footprint import footprint_cost_at
 
 #: m: weight of a rad/s of turn-rate difference against a m/s of speed difference when
@@ -45,12 +40,6 @@ TURN_WEIGHT = 0.3
 #: samples of the forward (or backward) speed and of the turn rate in the fallback grid
 SPEED_SAMPLES = 11
 TURN_SAMPLES = 21
-#: m: a rollout keeping the footprint this far off the obstacles is not replaced for more
-#: room (`clearances`); a command with more room must gain at least ROOM_STEP m of it, and
-#: make ROOM_SHARE of the plain choice's progress
-ROOM = 0.1
-ROOM_STEP = 0.01
-ROOM_SHARE = 0.75
 #: rollout steps over the horizon (0.05 m apart at 0.5 m/s over 1 s: below a cell's width)
 STEPS = 10
 
@@ -107,7 +96,6 @@ def footprint_safe_command(
     outline: np.ndarray,
     limits: tuple[float, float, float, float, float, float],
     horizon: float,
-    clearance: np.ndarray | None = None,
 ) -> tuple[float, float, bool]:
     """``wanted`` (v, w) if its rollout's footprint stays clear of static obstacles, else the
     clear command from a (v, w) grid whose rollout ends nearest where the ``holonomic``
@@ -122,15 +110,6 @@ def footprint_safe_command(
     When the robot's footprint already collides where it stands, nothing can be judged and
     ``wanted`` is kept; when every command collides, those that collide last compete.
     Returns (v, w, whether ``wanted`` was replaced).
-
-    ``clearance`` : (H, W) m from each cell to the nearest lethal one (`clearances`). With
-    it, a command whose rollout keeps the footprint less than `ROOM` m off the obstacles is
-    replaced by the clear moving one that keeps it farthest off them (up to `ROOM`), as long as
-    that one makes `ROOM_SHARE` of the plain choice's progress towards where the holonomic
-    velocity leads (a lizi still drives into a gap 4 cm wider than its body). A rectangle
-    squeezing past a parked robot otherwise ended flush against the wall beyond it (a
-    pioneer3at, under 1 cm from the wall's cells), where no turn of any radius is clear and
-    it could never turn to its goal beside it; centred in the gap it has room to turn off.
     """
     costs, origin, res = grid
     lo_v, hi_v, lo_w, hi_w, acc_v, acc_w = limits
@@ -141,18 +120,12 @@ def footprint_safe_command(
     x, y, th = pose
     if footprint_cost_at(costs, origin_a[0], origin_a[1], res, outline, x, y, th) < 0:
         return wanted[0], wanted[1], False
-    target = pose_a[:2] + np.asarray(holonomic, dtype=np.float64) * horizon
-    wanted_a = np.array([wanted], dtype=np.float64)
     ends = np.empty((1, 2))
     first = first_collisions(
-        wanted_a, pose_a, vel, acc, horizon, STEPS, costs, origin_a, res, outline, ends
-    )
-    room = math.inf
-    if clearance is not None and first[0] > STEPS:
-        room = rollout_clearances(
-            wanted_a, pose_a, vel, acc, horizon, STEPS, clearance, origin_a, res, outline
-        )[0]
-    if first[0] > STEPS and room >= ROOM:
+        np.array([wanted], dtype=np.float64), pose_a, vel, acc, horizon, STEPS,
+        costs, origin_a, res, outline, ends,
+    )  # fmt: skip
+    if first[0] > STEPS:
         return wanted[0], wanted[1], False
     speeds = np.concatenate(
         [
@@ -163,78 +136,13 @@ def footprint_safe_command(
     turns = np.linspace(lo_w, hi_w, TURN_SAMPLES)
     cand = np.stack(np.meshgrid(speeds, turns, indexing="ij"), axis=-1).reshape(-1, 2)
     cand = np.concatenate([cand, [[0.0, 0.0]]])
-    off = np.hypot(cand[:, 0] - wanted[0], TURN_WEIGHT * (cand[:, 1] - wanted[1]))
-    cand_ends = np.empty((cand.shape[0], 2))
+    ends = np.empty((cand.shape[0], 2))
     steps = first_collisions(
-        cand, pose_a, vel, acc, horizon, STEPS, costs, origin_a, res, outline, cand_ends
+        cand, pose_a, vel, acc, horizon, STEPS, costs, origin_a, res, outline, ends
     )
-    miss = np.hypot(cand_ends[:, 0] - target[0], cand_ends[:, 1] - target[1])
-    if first[0] > STEPS:  # wanted is clear, though near the obstacles
-        k_plain, miss_plain = -1, float(np.hypot(*(ends[0] - target)))
-        plain = (float(wanted[0]), float(wanted[1]))
-    else:
-        best = np.flatnonzero(steps == steps.max())
-        k_plain = int(best[np.lexsort((off[best], np.round(miss[best], 3)))[0]])
-        miss_plain = float(miss[k_plain]) if steps[k_plain] > STEPS else math.inf
-        plain = (float(cand[k_plain, 0]), float(cand[k_plain, 1]))
-    if clearance is not None:
-        reach = float(np.hypot(*(target - pose_a[:2])))  # how far the target is
-        gain = reach - miss
-        ok = (steps > STEPS) & (np.abs(cand).max(axis=1) > 1e-9) & (gain > 0.0)
-        ok &= gain >= ROOM_SHARE * (reach - miss_plain)
-        if ok.any():
-            idx = np.flatnonzero(ok)
-            kept = np.minimum(
-                rollout_clearances(
-                    cand[idx], pose_a, vel, acc, horizon, STEPS, clearance, origin_a, res,
-                    outline,
-                ),
-                ROOM,
-            )  # fmt: skip
-            if k_plain >= 0:
-                room = rollout_clearances(
-                    cand[k_plain : k_plain + 1], pose_a, vel, acc, horizon, STEPS, clearance,
-                    origin_a, res, outline,
-                )[0]  # fmt: skip
-            order = np.lexsort((off[idx], np.round(miss[idx], 3), -np.round(kept, 3)))[0]
-            if kept[order] > min(room, ROOM) + ROOM_STEP:
-                k = int(idx[order])
-                return float(cand[k, 0]), float(cand[k, 1]), True
-    return plain[0], plain[1], k_plain >= 0
-
-
-@njit(cache=True)
-def rollout_clearances(
-    commands, pose, velocity, acc, horizon, steps, clearance, origin, resolution, outline
-):
-    """(S,) m: the least ``clearance`` under the footprint's outline over each command's
-    rollout (`first_collisions`' integration), 0 where a pose leaves the grid."""
-    out = np.empty(commands.shape[0])
-    dt = horizon / steps
-    sy, sx = clearance.shape
-    for s in range(commands.shape[0]):
-        x, y, th = pose[0], pose[1], pose[2]
-        v, w = velocity[0], velocity[1]
-        least = np.inf
-        for _ in range(steps):
-            v = new_velocity(commands[s, 0], v, acc[0], dt)
-            w = new_velocity(commands[s, 1], w, acc[1], dt)
-            x += v * math.cos(th) * dt
-            y += v * math.sin(th) * dt
-            th += w * dt
-            c, sn = math.cos(th), math.sin(th)
-            for k in range(outline.shape[0]):
-                fx = (x + c * outline[k, 0] - sn * outline[k, 1] - origin[0]) / resolution
-                fy = (y + sn * outline[k, 0] + c * outline[k, 1] - origin[1]) / resolution
-                if fx < 0.0 or fy < 0.0 or fx >= sx or fy >= sy:
-                    least = 0.0
-                    break
-                least = min(least, clearance[int(fy), int(fx)])
-        out[s] = least
-    return out
-
-
-def clearances(costs: np.ndarray, resolution: float) -> np.ndarray:
-    """(H, W) m from each cell's centre to the nearest LETHAL cell's centre (0 on one): what
-    `footprint_safe_command` keeps the footprint off when it can."""
-    return ndimage.distance_transform_edt(costs != LETHAL_OBSTACLE) * resolution
+    target = pose_a[:2] + np.asarray(holonomic, dtype=np.float64) * horizon
+    miss = np.hypot(ends[:, 0] - target[0], ends[:, 1] - target[1])
+    off = np.hypot(cand[:, 0] - wanted[0], TURN_WEIGHT * (cand[:, 1] - wanted[1]))
+    best = np.flatnonzero(steps == steps.max())
+    k = int(best[np.lexsort((off[best], np.round(miss[best], 3)))[0]])
+    return float(cand[k, 0]), float(cand[k, 1]), True

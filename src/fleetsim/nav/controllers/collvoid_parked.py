@@ -145,9 +145,10 @@ class CollvoidParked:
                 continue
             fp = padded_footprint(self.near_footprints[k], self.wall_radius)
             body = footprint_at(fp, *pos[k], yaws[k])
-            if inside_polygon(goal, body)[0]:
+            inside = inside_polygon(np.concatenate([goal, ahead]), body)  # one polygon
+            if inside[0]:  # standing on our goal
                 continue
-            hit = inside_polygon(ahead, body)
+            hit = inside[1:]
             if hit.any():
                 self.replanned_for[rid] = now + REPLAN_AGAIN
                 x, y = ahead[int(np.argmax(hit))]

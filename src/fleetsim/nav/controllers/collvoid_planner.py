@@ -71,11 +71,7 @@ import numpy as np
 
 from fleetsim.errors import ParameterError
 from fleetsim.msgs import geometry_msgs
-from fleetsim.nav.controllers.base import (
-    EmptyPlan,
-    LocalPlanner,
-    VelocityCommand,
-)
+from fleetsim.nav.controllers.base import EmptyPlan, LocalPlanner, VelocityCommand
 from fleetsim.nav.controllers.collvoid_drive import UNTRUNCATED, CollvoidDrive
 from fleetsim.nav.controllers.collvoid_neighbours import MAP_FRAME, CollvoidNeighbours
 from fleetsim.nav.controllers.collvoid_params import CollvoidParams

@@ -173,3 +173,75 @@ def test_max_combination_in_place_matches_combined_max():
         want[y0:y1, x0:x1] = combined_max(master[y0:y1, x0:x1], layer[y0:y1, x0:x1])
         combine_max_into(master[y0:y1, x0:x1], layer[y0:y1, x0:x1], NO_INFORMATION)
         assert np.array_equal(master, want)
+
+
+#: global costmaps of a map alone: its static layer, with and without inflation
+STATIC = {
+    "plugins": [{"name": "static_layer", "type": "costmap_2d::StaticLayer"}],
+    "track_unknown_space": True,
+}
+STATIC_INFLATION = {
+    **STATIC,
+    "plugins": [
+        *STATIC["plugins"],
+        {"name": "inflation_layer", "type": "costmap_2d::InflationLayer"},
+    ],
+    "robot_radius": 0.2,
+    "inflation_layer": {"inflation_radius": 0.5},
+}
+
+
+def _office_like(rng: np.random.Generator, size: int = 120) -> np.ndarray:
+    """An int8 occupancy map: unknown, with a known room of free cells and walls."""
+    data = np.full((size, size), -1, dtype=np.int8)
+    data[20:100, 20:100] = 0
+    data[20, 20:100] = data[99, 20:100] = 100
+    data[rng.integers(25, 95, 40), rng.integers(25, 95, 40)] = 100
+    return data
+
+
+def _fresh(params: dict, data: np.ndarray) -> np.ndarray:
+    lc = LayeredCostmap.from_params(params, "g")
+    lc.set_map(OccupancyMap(data, 0.05, (-3.0, -3.0, 0.0)))
+    lc.update_map(0.0, 0.0, 0.0)
+    return lc.costmap.costs.copy()
+
+
+@pytest.mark.parametrize("params", [STATIC, STATIC_INFLATION], ids=["static", "inflated"])
+def test_a_new_map_updates_only_what_changed_and_gives_the_full_update(params):
+    """A republished map of the same geometry (a SLAM map) updates the cells it changed (grown
+    by the inflation radius), not the whole map, and the master comes out as a costmap built
+    from that map alone; two maps taken before one update count both maps' changes."""
+    rng = np.random.default_rng(4)
+    a = _office_like(rng)
+    lc = LayeredCostmap.from_params(params, "g")
+
+    def take(data: np.ndarray) -> None:
+        lc.set_map(OccupancyMap(data, 0.05, (-3.0, -3.0, 0.0)))
+
+    take(a)
+    assert lc.update_map(0.0, 0.0, 0.0) == (0, 0, 120, 120)  # the first map: all of it
+    b = a.copy()
+    b[50:54, 60:63] = 100  # an obstacle mapped
+    b[100:104, 30:40] = 0  # unknown cells seen free
+    take(b)
+    x0, y0, xn, yn = lc.update_map(0.0, 0.0, 0.0)
+    assert (x0, y0) > (0, 0) and (xn - x0) * (yn - y0) < 120 * 120 / 2, (x0, y0, xn, yn)
+    if params is STATIC:  # the changed cells and, as costmap_2d converts bounds, one beyond
+        assert (x0, y0, xn, yn) == (30, 50, 64, 105)
+    np.testing.assert_array_equal(lc.costmap.costs, _fresh(params, b))
+    assert lc.update_map(0.0, 0.0, 0.0) == (0, 0, 0, 0)  # nothing new
+    c = b.copy()
+    c[30:32, 90:92] = 100  # mapped in the first of two maps, kept in the second
+    d = c.copy()
+    d[80, 25] = 100
+    take(c)
+    take(d)
+    lc.update_map(0.0, 0.0, 0.0)
+    np.testing.assert_array_equal(lc.costmap.costs, _fresh(params, d))
+    take(d)
+    assert lc.update_map(0.0, 0.0, 0.0) == (0, 0, 0, 0)  # the same map again
+    grown = np.pad(d, ((0, 20), (0, 0)), constant_values=-1)  # gmapping grew its map
+    take(grown)
+    assert lc.update_map(0.0, 0.0, 0.0) == (0, 0, 120, 140)
+    np.testing.assert_array_equal(lc.costmap.costs, _fresh(params, grown))

@@ -67,6 +67,42 @@ def costs_from_occupancy(
     return out
 
 
+def _changed_cells(old: Costmap2D | None, new: Costmap2D) -> tuple[int, int, int, int] | None:
+    """The bounds (x0, y0, xn, yn), end exclusive, of the cells whose costs differ between two
+    maps of the same size, resolution and origin ((0, 0, 0, 0) when none does); None when there
+    is no old map or its geometry differs (every cell is new).
+
+    ROS's StaticLayer marks the whole map for update on every new map; the layers' costs outside
+    the changed cells (grown by the inflation radius) are the same either way, so the update is
+    the same. A SLAM map is republished whole every few seconds (gmapping's
+    ``map_update_interval``) but changes around the robot: inflating all of the hunter's
+    2000 x 2000 cell map took ~120 ms a map."""
+    if old is None or (old.size_x, old.size_y, old.resolution, old.origin) != (
+        new.size_x,
+        new.size_y,
+        new.resolution,
+        new.origin,
+    ):
+        return None
+    diff = old.costs != new.costs
+    rows = np.flatnonzero(diff.any(axis=1))
+    if rows.size == 0:
+        return (0, 0, 0, 0)
+    cols = np.flatnonzero(diff[rows[0] : rows[-1] + 1].any(axis=0))
+    return int(cols[0]), int(rows[0]), int(cols[-1]) + 1, int(rows[-1]) + 1
+
+
+def _union(a: tuple[int, int, int, int] | None, b: tuple[int, int, int, int]):
+    """The bounds covering both cell bounds (None, every cell, covers anything)."""
+    if a is None:
+        return None
+    if a[2] <= a[0] or a[3] <= a[1]:
+        return b
+    if b[2] <= b[0] or b[3] <= b[1]:
+        return a
+    return min(a[0], b[0]), min(a[1], b[1]), max(a[2], b[2]), max(a[3], b[3])
+
+
 class StaticLayer(CostmapLayer):
     """Holds the latest map (as costs); static maps size the master unless it rolls."""
 
@@ -78,6 +114,8 @@ class StaticLayer(CostmapLayer):
         self.enabled = self.params.enabled
         self.map_grid: Costmap2D | None = None  # the map's own grid (its resolution, origin)
         self._has_updated_data = False
+        #: the map's cells (x0, y0, xn, yn) that the last map changed, or None: all of them
+        self._changed: tuple[int, int, int, int] | None = None
 
     def set_map(self, occupancy: OccupancyMap) -> bool:
         """Take a new map (the ``map`` topic callback). Returns False if it was ignored."""
@@ -99,6 +137,10 @@ class StaticLayer(CostmapLayer):
             track_unknown_space=p.track_unknown_space,
             trinary_costmap=p.trinary_costmap,
         )
+        changed = _changed_cells(self.map_grid, grid)
+        if self._has_updated_data and changed is not None:  # the last map is not applied yet
+            changed = _union(self._changed, changed)
+        self._changed = changed
         self.map_grid = grid
         assert self.layered is not None
         lc = self.layered
@@ -127,20 +169,29 @@ class StaticLayer(CostmapLayer):
     def reset(self) -> None:
         # The static map is not sensor data: a reset re-applies it.
         self._has_updated_data = True
+        self._changed = None
 
     def update_bounds(self, robot_x: float, robot_y: float, robot_yaw: float, bounds: Bounds):
         g = self.map_grid
         if g is None:
             return
-        if not self.layered.rolling_window and not self._has_updated_data:  # type: ignore[union-attr]
+        rolling = self.layered.rolling_window  # type: ignore[union-attr]
+        if not rolling and not self._has_updated_data:
             return
-        bounds.include(
-            g.origin_x,
-            g.origin_y,
-            g.origin_x + g.size_x * g.resolution,
-            g.origin_y + g.size_y * g.resolution,
+        x0, y0, xn, yn = (
+            (0, 0, g.size_x, g.size_y) if rolling or self._changed is None else self._changed
         )
         self._has_updated_data = False
+        self._changed = None
+        if xn <= x0 or yn <= y0:  # the same map again
+            return
+        res = g.resolution
+        bounds.include(
+            g.origin_x + x0 * res,
+            g.origin_y + y0 * res,
+            g.origin_x + xn * res,
+            g.origin_y + yn * res,
+        )
 
     def update_costs(self, master: Costmap2D, x0: int, y0: int, xn: int, yn: int) -> None:
         if not self.enabled or self.map_grid is None or xn <= x0 or yn <= y0:

@@ -9,7 +9,12 @@ import pytest
 from fleetsim.nav.costmap import Costmap2D
 from fleetsim.nav.errors import GoalOccupied, GoalOutsideMap, NoPathFound, StartOutsideMap
 from fleetsim.nav.planners import NavFn, NavfnParams
-from fleetsim.nav.planners.navfn_kernels import POT_HIGH, navfn_costs, navfn_potential
+from fleetsim.nav.planners.navfn_kernels import (
+    POT_HIGH,
+    known_bounds,
+    navfn_costs,
+    navfn_potential,
+)
 
 
 def dijkstra4(costarr, nx, src):
@@ -316,3 +321,31 @@ def test_a_robot_whose_centre_is_in_inscribed_space_gets_a_way_out():
     assert out > 0 and abs(path.poses[out, 0] - 1.0) < 0.15
     # a start off the band plans as before
     assert nf.create_plan((1.0, 0.3, 0.0), goal).poses[0, :2].tolist() == [1.0, 0.3]
+
+
+def _known_bounds_reference(costs: np.ndarray) -> tuple[int, int, int, int]:
+    known = costs != 255
+    rows, cols = np.flatnonzero(known.any(axis=1)), np.flatnonzero(known.any(axis=0))
+    if rows.size == 0:
+        return 0, 0, 0, 0
+    return int(cols[0]), int(rows[0]), int(cols[-1]) + 1, int(rows[-1]) + 1
+
+
+def test_known_bounds_match_numpy_on_whole_maps_windows_and_odd_widths():
+    """The known cells' bounds, word by word on whole maps and cell by cell on windows of them
+    and on widths that are no whole number of words, agree with NumPy's."""
+    rng = np.random.default_rng(11)
+    for shape in ((64, 64), (40, 24), (33, 57), (1, 8), (9, 1)):
+        for _ in range(20):
+            costs = np.full(shape, 255, np.uint8)
+            k = int(rng.integers(0, 6))
+            costs[rng.integers(0, shape[0], k), rng.integers(0, shape[1], k)] = rng.integers(
+                0, 255, k
+            )
+            assert known_bounds(costs) == _known_bounds_reference(costs), (shape, costs.nonzero())
+            window = costs[1:, 3:]  # not C-contiguous
+            assert known_bounds(window) == _known_bounds_reference(window)
+    assert known_bounds(np.full((16, 16), 255, np.uint8)) == (0, 0, 0, 0)
+    edge = np.full((16, 16), 255, np.uint8)
+    edge[15, 15] = 0  # the last byte of the last word
+    assert known_bounds(edge) == (15, 15, 16, 16)

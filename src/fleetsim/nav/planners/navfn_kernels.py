@@ -46,21 +46,91 @@ def navfn_costs(costs, allow_unknown):
     return out
 
 
-@njit(cache=True)
-def known_bounds(costs):
+def known_bounds(costs: np.ndarray) -> tuple[int, int, int, int]:
     """(x0, y0, xn, yn): the bounds (end exclusive) of the cells of the (ny, nx) uint8 costmap
-    that are not unknown (255); (0, 0, 0, 0) when every cell is. One pass that stops at the
-    first known cell from each side: on a SLAM map mostly unknown it reads the unknown rows
-    once, not the four temporaries of numpy's ``any`` along both axes."""
+    that are not unknown (255); (0, 0, 0, 0) when every cell is.
+
+    On a SLAM map mostly unknown (the hunter's 2000 x 2000 cells, 98 % unknown early on) the
+    unknown rows are the work: a C-contiguous map whose rows are whole 8-byte words is read a
+    word at a time (2.4 -> ~0.2 ms a call); the known rows' sides stop at the first known cell."""
+    ny, nx = costs.shape
+    if costs.flags.c_contiguous and nx % 8 == 0 and nx > 0:
+        y0, yn = _known_rows_words(costs.view(np.uint64))
+    else:
+        y0, yn = _known_rows(costs)
+    if y0 >= yn:
+        return 0, 0, 0, 0
+    x0, xn = _known_columns(costs, y0, yn)
+    return x0, y0, xn, yn
+
+
+_ALL_UNKNOWN = np.uint64(0xFFFFFFFFFFFFFFFF)
+
+
+@njit(cache=True)
+def _known_rows_words(words):
+    """(y0, yn): the first row holding a known cell and one past the last, ``words`` (ny, nx/8)
+    uint64 the map's rows a word at a time; y0 == yn when there is none."""
+    ny, nw = words.shape
+    y0 = 0
+    while y0 < ny:
+        row = words[y0]
+        known = False
+        for k in range(nw):
+            if row[k] != _ALL_UNKNOWN:
+                known = True
+                break
+        if known:
+            break
+        y0 += 1
+    yn = ny
+    while yn > y0:
+        row = words[yn - 1]
+        known = False
+        for k in range(nw):
+            if row[k] != _ALL_UNKNOWN:
+                known = True
+                break
+        if known:
+            break
+        yn -= 1
+    return y0, yn
+
+
+@njit(cache=True)
+def _known_rows(costs):
+    """`_known_rows_words` a cell at a time, for any (ny, nx) uint8 map."""
     ny, nx = costs.shape
     y0 = 0
-    while y0 < ny and (costs[y0] == COST_UNKNOWN_ROS).all():
+    while y0 < ny:
+        row = costs[y0]
+        known = False
+        for x in range(nx):
+            if row[x] != COST_UNKNOWN_ROS:
+                known = True
+                break
+        if known:
+            break
         y0 += 1
-    if y0 == ny:
-        return 0, 0, 0, 0
     yn = ny
-    while (costs[yn - 1] == COST_UNKNOWN_ROS).all():
+    while yn > y0:
+        row = costs[yn - 1]
+        known = False
+        for x in range(nx):
+            if row[x] != COST_UNKNOWN_ROS:
+                known = True
+                break
+        if known:
+            break
         yn -= 1
+    return y0, yn
+
+
+@njit(cache=True)
+def _known_columns(costs, y0, yn):
+    """(x0, xn): the known cells' columns over rows y0..yn, each row read from both sides only
+    as far as the bounds so far."""
+    nx = costs.shape[1]
     x0 = nx
     xn = 0
     for y in range(y0, yn):
@@ -73,7 +143,7 @@ def known_bounds(costs):
             if row[x] != COST_UNKNOWN_ROS:
                 xn = x + 1
                 break
-    return x0, y0, xn, yn
+    return x0, xn
 
 
 @njit(cache=True, error_model="numpy")  # no zero-division checks: costs are >= 50

@@ -76,13 +76,30 @@ def merged_grid(
     x1, y1 = pts.max(0)
     width, height = math.ceil((x1 - x0) / res), math.ceil((y1 - y0) / res)
     out = np.full((height, width), -1, dtype=np.int8)
-    gx, gy = np.meshgrid(x0 + (np.arange(width) + 0.5) * res, y0 + (np.arange(height) + 0.5) * res)
+    # the merged cells' centres: x by column, y by row. Each map's cell of a merged cell is
+    # worked out from them without (H, W) meshgrids: x and y each take one term per column and
+    # one per row, added as the 2-D formula adds them (the same floats), and a map placed
+    # without rotation (its yaw exactly 0: cos 1, sin 0) takes its columns and rows apart, a
+    # block gathered in one step. Two hunters' 2000 x 2000 maps took ~0.4 s a merge in 2-D.
+    gx = x0 + (np.arange(width) + 0.5) * res
+    gy = y0 + (np.arange(height) + 0.5) * res
     for data, r, wx, wy, wyaw in placed:
         cw, sw = math.cos(wyaw), math.sin(wyaw)
         dx, dy = gx - wx, gy - wy
-        lx, ly = cw * dx + sw * dy, -sw * dx + cw * dy
+        h, w = data.shape
+        if cw == 1.0 and sw == 0.0:
+            cx, cy = np.floor(dx / r).astype(int), np.floor(dy / r).astype(int)
+            # cell indices grow with the centres, so the inside columns and rows are runs
+            cols = np.flatnonzero((cx >= 0) & (cx < w))
+            rows = np.flatnonzero((cy >= 0) & (cy < h))
+            if cols.size and rows.size:
+                block = out[rows[0] : rows[-1] + 1, cols[0] : cols[-1] + 1]
+                np.maximum(block, data[np.ix_(cy[rows], cx[cols])], out=block)
+            continue
+        lx = (cw * dx)[None, :] + (sw * dy)[:, None]
+        ly = (-sw * dx)[None, :] + (cw * dy)[:, None]
         cx, cy = np.floor(lx / r).astype(int), np.floor(ly / r).astype(int)
-        inside = (cx >= 0) & (cy >= 0) & (cx < data.shape[1]) & (cy < data.shape[0])
+        inside = (cx >= 0) & (cy >= 0) & (cx < w) & (cy < h)
         values = np.full(out.shape, -1, dtype=np.int8)
         values[inside] = data[cy[inside], cx[inside]]
         np.maximum(out, values, out=out)

@@ -245,3 +245,49 @@ def test_a_new_map_updates_only_what_changed_and_gives_the_full_update(params):
     take(grown)
     assert lc.update_map(0.0, 0.0, 0.0) == (0, 0, 120, 140)
     np.testing.assert_array_equal(lc.costmap.costs, _fresh(params, grown))
+
+
+def _interpret_value_reference(data, lethal, unknown_value, track_unknown, trinary):
+    """StaticLayer::interpretValue over an array, as costs_from_occupancy first computed it."""
+    v = np.asarray(data).astype(np.int16) & 0xFF
+    unknown = v == (unknown_value & 0xFF)
+    if trinary:
+        out = np.full(v.shape, FREE_SPACE, dtype=np.uint8)
+    else:
+        out = np.clip(v.astype(np.float64) / max(lethal, 1) * LETHAL_OBSTACLE, 0, 255)
+        out = out.astype(np.uint8)
+    out[v >= lethal] = LETHAL_OBSTACLE
+    out[unknown] = NO_INFORMATION if track_unknown else FREE_SPACE
+    return out
+
+
+@pytest.mark.parametrize(
+    "kw",
+    [
+        {},
+        {"trinary_costmap": False},
+        {"track_unknown_space": False},
+        {"lethal_cost_threshold": 65, "unknown_cost_value": 255, "trinary_costmap": False},
+    ],
+)
+def test_map_translations_by_table_match_the_per_cell_rules(kw):
+    """Both translations of a map (occupancy -> costs as StaticLayer reads it, costs ->
+    occupancy as costmap_2d publishes it) looked up by byte agree with the rules cell by cell,
+    for every byte value, in any shape (empty, one row, a non-contiguous window)."""
+    every = np.arange(-128, 128, dtype=np.int8).reshape(16, 16)
+    ref = _interpret_value_reference(
+        every,
+        kw.get("lethal_cost_threshold", 100),
+        kw.get("unknown_cost_value", -1),
+        kw.get("track_unknown_space", True),
+        kw.get("trinary_costmap", True),
+    )
+    np.testing.assert_array_equal(costs_from_occupancy(every, **kw), ref)
+    np.testing.assert_array_equal(costs_from_occupancy(every[1::2, 3:], **kw), ref[1::2, 3:])
+    np.testing.assert_array_equal(costs_from_occupancy(every.ravel(), **kw), ref.ravel())
+    assert costs_from_occupancy(np.zeros((0, 4), np.int8), **kw).shape == (0, 4)
+    costs = np.arange(256, dtype=np.uint8).reshape(2, 8, 16)
+    published = occupancy_from_costs(costs)
+    assert published.shape == costs.shape and published.dtype == np.int8
+    assert published.ravel()[[0, 1, 252, 253, 254, 255]].tolist() == [0, 1, 98, 99, 100, -1]
+    assert (np.diff(published.ravel()[1:253].astype(int)) >= 0).all()

@@ -45,6 +45,25 @@ def points_from_cells(
     )
 
 
+def lookup_bytes(data: np.ndarray, table: np.ndarray) -> np.ndarray:
+    """``table[data]``, shaped as ``data``: each value of ``data`` read as an unsigned byte (int8
+    -1 is 255; wider integers keep their low byte) replaced by its entry in the (256,) byte
+    ``table`` (uint8 or int8).
+
+    OpenCV's LUT, not NumPy's gather: the gather widens every index to 8 bytes first, and on a
+    2000 x 2000 SLAM map, translated at every map and every costmap publication, it took
+    9.7 ms against LUT's 1.2 ms."""
+    a = np.ascontiguousarray(data)
+    a = a.view(np.uint8) if a.dtype.itemsize == 1 else (a.astype(np.int64) & 0xFF).astype(np.uint8)
+    if a.size == 0:
+        return table[a]
+    import cv2  # here: OpenCV loads in ~0.1 s, paid only by processes that translate maps
+
+    return cv2.LUT(a.reshape(-1, a.shape[-1]) if a.ndim >= 2 else a.reshape(-1, 1), table).reshape(
+        a.shape
+    )
+
+
 def shifted_grid(grid: np.ndarray, cell_ox: int, cell_oy: int, fill: int) -> np.ndarray:
     """A grid moved by (cell_ox, cell_oy) cells: new[y, x] = old[y + cell_oy, x + cell_ox].
 

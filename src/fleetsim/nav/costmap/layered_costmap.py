@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from fleetsim.errors import did_you_mean
-from fleetsim.nav.costmap.costmap_2d import FREE_SPACE, NO_INFORMATION, Costmap2D
+from fleetsim.nav.costmap.costmap_2d import FREE_SPACE, NO_INFORMATION, Costmap2D, lookup_bytes
 from fleetsim.nav.costmap.footprint import (
     footprint_from_param,
     footprint_from_radius,
@@ -326,7 +326,7 @@ for _cost in range(255, -1, -1):  # from the top, so each value keeps its least 
 
 def occupancy_from_costs(costs: np.ndarray) -> np.ndarray:
     """costmap_2d's publisher translation: 0->0, 1..252->1..97, 253->99, 254->100, 255->-1."""
-    return _PUBLISHED[np.asarray(costs, dtype=np.uint8)]
+    return lookup_bytes(np.asarray(costs, dtype=np.uint8), _PUBLISHED)
 
 
 def costs_from_published(data: np.ndarray) -> np.ndarray:

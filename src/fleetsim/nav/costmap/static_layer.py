@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass
 
 import numpy as np
@@ -11,6 +12,7 @@ from fleetsim.nav.costmap.costmap_2d import (
     LETHAL_OBSTACLE,
     NO_INFORMATION,
     Costmap2D,
+    lookup_bytes,
 )
 from fleetsim.nav.costmap.layer import Bounds, CostmapLayer, combined_max
 from fleetsim.nav.map_io import OccupancyMap
@@ -53,17 +55,27 @@ def costs_from_occupancy(
     """Costmap costs of occupancy values, as StaticLayer::interpretValue.
 
     data : (H, W) int8 occupancy (-1 unknown, 0..100). Values are compared as unsigned
-    bytes, so -1 is 255. Returns (H, W) uint8 costs.
-    """
-    v = np.asarray(data).astype(np.int16) & 0xFF
-    unknown = v == (unknown_cost_value & 0xFF)
-    if trinary_costmap:
+    bytes, so -1 is 255. Returns (H, W) uint8 costs: each of the 256 byte values is
+    interpreted once and the map looked up (`lookup_bytes`)."""
+    table = _interpreted(
+        lethal_cost_threshold, unknown_cost_value, track_unknown_space, trinary_costmap
+    )
+    return lookup_bytes(np.asarray(data), table)
+
+
+@functools.lru_cache(maxsize=16)
+def _interpreted(lethal: int, unknown_value: int, track_unknown: bool, trinary: bool) -> np.ndarray:
+    """(256,) uint8: StaticLayer::interpretValue of every byte value."""
+    v = np.arange(256, dtype=np.int16)
+    unknown = v == (unknown_value & 0xFF)
+    if trinary:
         out = np.full(v.shape, FREE_SPACE, dtype=np.uint8)
     else:
-        scaled = v.astype(np.float64) / max(lethal_cost_threshold, 1) * LETHAL_OBSTACLE
+        scaled = v.astype(np.float64) / max(lethal, 1) * LETHAL_OBSTACLE
         out = np.clip(scaled, 0, 255).astype(np.uint8)
-    out[v >= lethal_cost_threshold] = LETHAL_OBSTACLE
-    out[unknown] = NO_INFORMATION if track_unknown_space else FREE_SPACE
+    out[v >= lethal] = LETHAL_OBSTACLE
+    out[unknown] = NO_INFORMATION if track_unknown else FREE_SPACE
+    out.flags.writeable = False
     return out
 
 

@@ -55,75 +55,41 @@ def known_bounds(costs: np.ndarray) -> tuple[int, int, int, int]:
     word at a time (2.4 -> ~0.2 ms a call); the known rows' sides stop at the first known cell."""
     ny, nx = costs.shape
     if costs.flags.c_contiguous and nx % 8 == 0 and nx > 0:
-        y0, yn = _known_rows_words(costs.view(np.uint64))
+        y0, yn = _known_rows(costs.view(np.uint64), _ALL_UNKNOWN)
     else:
-        y0, yn = _known_rows(costs)
+        y0, yn = _known_rows(costs, np.uint8(COST_UNKNOWN_ROS))
     if y0 >= yn:
         return 0, 0, 0, 0
     x0, xn = _known_columns(costs, y0, yn)
     return x0, y0, xn, yn
 
 
+#: eight unknown cells read as one word
 _ALL_UNKNOWN = np.uint64(0xFFFFFFFFFFFFFFFF)
 
 
 @njit(cache=True)
-def _known_rows_words(words):
-    """(y0, yn): the first row holding a known cell and one past the last, ``words`` (ny, nx/8)
-    uint64 the map's rows a word at a time; y0 == yn when there is none."""
-    ny, nw = words.shape
+def _known_rows(rows, unknown):
+    """(y0, yn): the first row holding a value other than ``unknown`` and one past the last
+    (y0 == yn when there is none); ``rows`` (ny, m) the map's cells (uint8, unknown 255) or its
+    words (uint64, eight unknown cells all ones)."""
+    ny = rows.shape[0]
     y0 = 0
-    while y0 < ny:
-        row = words[y0]
-        known = False
-        for k in range(nw):
-            if row[k] != _ALL_UNKNOWN:
-                known = True
-                break
-        if known:
-            break
+    while y0 < ny and _all_equal(rows[y0], unknown):
         y0 += 1
     yn = ny
-    while yn > y0:
-        row = words[yn - 1]
-        known = False
-        for k in range(nw):
-            if row[k] != _ALL_UNKNOWN:
-                known = True
-                break
-        if known:
-            break
+    while yn > y0 and _all_equal(rows[yn - 1], unknown):
         yn -= 1
     return y0, yn
 
 
 @njit(cache=True)
-def _known_rows(costs):
-    """`_known_rows_words` a cell at a time, for any (ny, nx) uint8 map."""
-    ny, nx = costs.shape
-    y0 = 0
-    while y0 < ny:
-        row = costs[y0]
-        known = False
-        for x in range(nx):
-            if row[x] != COST_UNKNOWN_ROS:
-                known = True
-                break
-        if known:
-            break
-        y0 += 1
-    yn = ny
-    while yn > y0:
-        row = costs[yn - 1]
-        known = False
-        for x in range(nx):
-            if row[x] != COST_UNKNOWN_ROS:
-                known = True
-                break
-        if known:
-            break
-        yn -= 1
-    return y0, yn
+def _all_equal(row, value):
+    # a loop that stops at the first other value: numba compiles no all() over a generator
+    for k in range(row.shape[0]):  # noqa: SIM110
+        if row[k] != value:
+            return False
+    return True
 
 
 @njit(cache=True)

@@ -154,6 +154,12 @@ def test_costs_from_published_inverts_the_costmap_publisher():
     published = occupancy_from_costs(costs)
     assert np.array_equal(occupancy_from_costs(costs_from_published(published)), published)
     assert costs_from_published(np.array([-1, 0, 99, 100], np.int8)).tolist() == [255, 0, 253, 254]
+    every = np.arange(-128, 128, dtype=np.int8).reshape(16, 16)  # any byte, in a grid's shape
+    back = costs_from_published(every)
+    assert back.shape == (16, 16) and back.dtype == np.uint8
+    assert (back[every < 0] == 255).all() and (back[every > 100] == 254).all()
+    valid = (every >= 0) & (every <= 100)  # each published by some cost: read back as one
+    np.testing.assert_array_equal(occupancy_from_costs(back)[valid], every[valid])
 
 
 def test_max_combination_in_place_matches_combined_max():

@@ -333,4 +333,4 @@ def costs_from_published(data: np.ndarray) -> np.ndarray:
     """(H, W) uint8 costs of a published costmap grid (H, W) int8: the inverse of
     `occupancy_from_costs`, each value read as the least cost that publishes as it (-1 -> 255
     unknown, 99 -> 253 inscribed, 100 -> 254 lethal)."""
-    return _UNPUBLISHED[np.asarray(data).astype(np.int16) & 0xFF]
+    return lookup_bytes(np.asarray(data), _UNPUBLISHED)

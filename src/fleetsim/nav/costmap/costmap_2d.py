@@ -121,6 +121,11 @@ class Costmap2D:
     def origin(self) -> tuple[float, float]:
         return (self.origin_x, self.origin_y)
 
+    @property
+    def geometry(self) -> tuple[int, int, float, tuple[float, float]]:
+        """(size_x, size_y, resolution, origin): equal for two grids whose cells coincide."""
+        return (self.size_x, self.size_y, self.resolution, self.origin)
+
     def cell_distance(self, world_dist: float) -> int:
         """Cells spanned by a world distance (costmap_2d's cellDistance: ceil, >= 0)."""
         return int(max(0.0, math.ceil(world_dist / self.resolution)))

@@ -89,12 +89,7 @@ def _changed_cells(old: Costmap2D | None, new: Costmap2D) -> tuple[int, int, int
     the same. A SLAM map is republished whole every few seconds (gmapping's
     ``map_update_interval``) but changes around the robot: inflating all of the hunter's
     2000 x 2000 cell map took ~120 ms a map."""
-    if old is None or (old.size_x, old.size_y, old.resolution, old.origin) != (
-        new.size_x,
-        new.size_y,
-        new.resolution,
-        new.origin,
-    ):
+    if old is None or old.geometry != new.geometry:
         return None
     diff = old.costs != new.costs
     rows = np.flatnonzero(diff.any(axis=1))
@@ -158,12 +153,7 @@ class StaticLayer(CostmapLayer):
         lc = self.layered
         if not lc.rolling_window:
             m = lc.costmap
-            if (m.size_x, m.size_y, m.resolution, m.origin) != (
-                grid.size_x,
-                grid.size_y,
-                grid.resolution,
-                grid.origin,
-            ):
+            if m.geometry != grid.geometry:
                 lc.resize_map(
                     grid.size_x, grid.size_y, grid.resolution, grid.origin_x, grid.origin_y
                 )

@@ -6,6 +6,7 @@ import math
 from types import SimpleNamespace
 
 import numpy as np
+import pytest
 
 from fleetsim.msgs import collvoid_msgs, geometry_msgs
 from fleetsim.msgs.builtin_interfaces import Time
@@ -137,3 +138,103 @@ def test_a_local_costmap_marks_every_robot_with_its_own_padding():
     assert cost_at(cm, 3.0, 3.0) == LETHAL_OBSTACLE
     assert cost_at(cm, 3.0 + 0.22, 3.0) == LETHAL_OBSTACLE  # 0.2 x 0.95 + 0.05
     assert cost_at(cm, 3.0 + 0.27, 3.0) == INSCRIBED_INFLATED_OBSTACLE  # inflated, not marked
+
+
+# -- clear_robots: the other robots' bodies, as a laser saw them, are erased ------------------
+
+
+def _seen_costmap(order, **robots):
+    """A 10 x 10 m costmap with an obstacle (or voxel) layer fed one observation source and a
+    robots layer, in ``order``; returns it and a /position_share publisher."""
+    rt = Runtime()
+    node = Node(rt, "move_base", "/lizi1")
+    kinds = {"obstacle_layer": "costmap_2d::ObstacleLayer", "voxel_layer": "costmap_2d::VoxelLayer"}
+    params = {
+        "global_frame": "/map",
+        "width": 10.0,
+        "height": 10.0,
+        "resolution": 0.05,
+        "footprint": SQUARE,
+        "plugins": [{"name": n, "type": kinds.get(n, "fleetsim::RobotsLayer")} for n in order],
+        "robots_layer": robots,
+    }
+    for n in set(kinds) & set(order):
+        params[n] = {
+            "observation_sources": "scan",
+            "scan": {"data_type": "LaserScan", "marking": True, "clearing": False},
+            "obstacle_range": 8.0,
+        }
+    cm = LayeredCostmap.from_params(params, "/lizi1/move_base/global_costmap")
+    cm.layer("robots_layer").connect(SimpleNamespace(node=node, global_frame="map"))
+    pub = Node(rt, "talker", "/").create_publisher(
+        collvoid_msgs.PoseTwistWithCovariance, "/position_share"
+    )
+    return rt, cm, pub
+
+
+def _hits(cm, name, points):
+    pts = np.array([[x, y, 0.1] for x, y in points])
+    cm.layer(name).add_observation("scan", [5.0, 5.0, 0.1], pts)
+
+
+# a laser's hits on the near side of lizi2's square body centred at (x, 3), and on a wall
+def _body(x):
+    return [(x - 0.2, 2.9), (x - 0.2, 3.0), (x - 0.2, 3.1), (x - 0.1, 2.8), (x, 2.8)]
+
+
+WALL = [(1.0, 1.0), (1.05, 1.0), (2.0, 2.55)]  # the last a cell beyond the padding
+
+
+@pytest.mark.parametrize(
+    "order",
+    [
+        ("obstacle_layer", "robots_layer"),
+        ("robots_layer", "obstacle_layer"),
+        ("voxel_layer", "robots_layer"),
+    ],
+)
+def test_a_moving_robot_leaves_no_image_and_no_wake(order):
+    layer = next(n for n in order if n != "robots_layer")
+    rt, cm, pub = _seen_costmap(order)
+    pub.publish(shared("lizi2", 2.0, 3.0, 0.0, vx=0.2))
+    rt.run(duration=0.05)
+    _hits(cm, layer, _body(2.0) + WALL)
+    cm.update_map(5.0, 5.0, 0.0)
+    for x, y in _body(2.0):
+        assert cost_at(cm, x, y) == 0, (x, y)
+        assert cm.layer(layer).grid.costs[int(y / 0.05), int(x / 0.05)] == 0
+        if layer == "voxel_layer":  # the column's voxels too, or a later mark counts them
+            assert cm.layer(layer).marked[int(y / 0.05), int(x / 0.05)] == 0
+    for x, y in WALL:
+        assert cost_at(cm, x, y) == LETHAL_OBSTACLE, (x, y)
+    # lizi2 drives 0.6 m east: the next scan sees it there; where it was stays free
+    pub.publish(shared("lizi2", 2.6, 3.0, 0.1, vx=0.2))
+    rt.run(duration=0.05)
+    _hits(cm, layer, _body(2.6))
+    cm.update_map(5.0, 5.0, 0.0)
+    for x, y in _body(2.0) + _body(2.6):
+        assert cost_at(cm, x, y) == 0, (x, y)
+
+
+def test_without_clear_robots_the_image_stays_as_a_wake():
+    rt, cm, pub = _seen_costmap(("obstacle_layer", "robots_layer"), clear_robots=False)
+    pub.publish(shared("lizi2", 2.0, 3.0, 0.0, vx=0.2))
+    rt.run(duration=0.05)
+    _hits(cm, "obstacle_layer", _body(2.0))
+    cm.update_map(5.0, 5.0, 0.0)
+    pub.publish(shared("lizi2", 2.6, 3.0, 0.1, vx=0.2))
+    rt.run(duration=0.05)
+    cm.update_map(5.0, 5.0, 0.0)
+    assert all(cost_at(cm, x, y) == LETHAL_OBSTACLE for x, y in _body(2.0))
+
+
+def test_the_padding_grows_with_the_robots_speed():
+    # a hit 0.14 m outside a parked robot's outline stays (0.1 m padding); the same hit
+    # beside a robot at 0.5 m/s (0.1 + 0.3 s x 0.5 m/s) is its image, erased
+    for vx, expected in ((0.0, LETHAL_OBSTACLE), (0.5, 0)):
+        rt, cm, pub = _seen_costmap(("obstacle_layer", "robots_layer"), still_speed=0.0)
+        pub.publish(shared("lizi2", 2.0, 3.0, 0.0, vx=vx))
+        rt.run(duration=0.05)
+        _hits(cm, "obstacle_layer", [(2.34, 3.0)])
+        cm.update_map(5.0, 5.0, 0.0)
+        assert cost_at(cm, 2.34, 3.0) == expected, vx

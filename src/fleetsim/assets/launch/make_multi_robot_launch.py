@@ -14,7 +14,8 @@
   lizi1 to lizi3's start, lizi2 to lizi1's, lizi3 to lizi2's.
 
 All take ``model`` (``lizi``, the default; ``pioneer3at``, whose robots are named pioneer1,
-pioneer2, ...; ``mixed``: odd robots lizis, even ones pioneer3ats, sharing /position_share with
+pioneer2, ...; ``turtlebot3_burger`` and ``turtlebot3_waffle``, burger1, waffle1, ..., with
+turtlebot3_navigation's parameters; ``mixed``: odd robots lizis, even ones pioneer3ats, sharing /position_share with
 their own footprints and limits), ``solo`` (run only the named robot: the reference for
 makespan and path length),
 ``planner`` (``collvoid``, default: collvoid_local_planner/CollvoidLocalPlanner with
@@ -92,7 +93,12 @@ def _group(k: int, robot: tuple, minimum: int) -> str:
 
 
 #: robot model -> the prefix of its robots' names (lizi1, pioneer2, ...)
-NAME_PREFIXES = {"lizi": "lizi", "pioneer3at": "pioneer"}
+NAME_PREFIXES = {
+    "lizi": "lizi",
+    "pioneer3at": "pioneer",
+    "turtlebot3_burger": "burger",
+    "turtlebot3_waffle": "waffle",
+}
 #: what ``model:=mixed`` gives robot k: lizis odd, pioneer3ats even
 MIXED = ("pioneer3at", "lizi")
 
@@ -158,7 +164,8 @@ def scenario(name: str, doc: str, world: str | dict, counts: tuple[int, ...], ro
   <arg name="start_delay" default="2.0" doc="sim seconds before the goals go out"/>
   <arg name="solo" default="" doc="run only this robot (e.g. lizi3): its time and path alone"/>
   <arg name="model" default="lizi"
-       doc="lizi | pioneer3at | mixed (odd robots lizis, even ones pioneer3ats)">
+       doc="lizi | pioneer3at | turtlebot3_burger | turtlebot3_waffle | mixed (odd robots lizis,
+            even ones pioneer3ats)">
     {_choices((*NAME_PREFIXES, "mixed"))}
   </arg>
 {_robot_args(len(robots))}

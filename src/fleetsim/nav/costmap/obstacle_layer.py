@@ -298,6 +298,14 @@ class ObstacleLayer(CostmapLayer):
             max(ox - r, lo[0]), max(oy - r, lo[1]), min(ox + r, hi[0]), min(oy + r, hi[1])
         )
 
+    def clear_cells(self, rows: np.ndarray, cols: np.ndarray) -> None:
+        """Forget the obstacles this layer has marked in these cells (another robot's body
+        as this robot's sensors saw it: `RobotsLayer`'s ``clear_robots``). Unknown cells stay
+        unknown."""
+        cells = self.grid.costs[rows, cols]
+        hit = cells == LETHAL_OBSTACLE
+        self.grid.costs[rows[hit], cols[hit]] = FREE_SPACE
+
     def update_costs(self, master, x0: int, y0: int, xn: int, yn: int) -> None:
         if not self.enabled or xn <= x0 or yn <= y0:
             return

@@ -195,6 +195,11 @@ class VoxelLayer(ObstacleLayer):
             max(ox - r, lo[0]), max(oy - r, lo[1]), min(ox + r, hi[0]), min(oy + r, hi[1])
         )
 
+    def clear_cells(self, rows: np.ndarray, cols: np.ndarray) -> None:
+        """Forget the marked voxels of these columns, and the obstacles they made."""
+        self.marked[rows, cols] = 0
+        super().clear_cells(rows, cols)
+
     def update_costs(self, master, x0: int, y0: int, xn: int, yn: int) -> None:
         if self.params.footprint_clearing_enabled and self.layered is not None:
             from fleetsim.nav.costmap.footprint import footprint_at, polygon_cells

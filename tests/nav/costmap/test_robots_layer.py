@@ -238,3 +238,20 @@ def test_the_padding_grows_with_the_robots_speed():
         _hits(cm, "obstacle_layer", [(2.34, 3.0)])
         cm.update_map(5.0, 5.0, 0.0)
         assert cost_at(cm, 2.34, 3.0) == expected, vx
+
+
+def test_a_robot_standing_still_keeps_its_image():
+    """What the laser sees of a parked robot is where it is: it stays (the collvoid planner
+    tells the parked robots its sensors see by it), and the layer marks the robot too."""
+    rt, cm, pub = _seen_costmap(("obstacle_layer", "robots_layer"))
+    pub.publish(shared("lizi2", 2.0, 3.0, 0.0))
+    rt.run(duration=0.05)
+    _hits(cm, "obstacle_layer", _body(2.0))
+    cm.update_map(5.0, 5.0, 0.0)
+    assert all(cost_at(cm, x, y) == LETHAL_OBSTACLE for x, y in _body(2.0))
+    assert cost_at(cm, 2.1, 3.0) == 252
+    # it drives off: its image goes at the next update
+    pub.publish(shared("lizi2", 2.1, 3.0, 0.1, vx=0.3))
+    rt.run(duration=0.05)
+    cm.update_map(5.0, 5.0, 0.0)
+    assert all(cost_at(cm, x, y) == 0 for x, y in _body(2.0))

@@ -15,14 +15,14 @@
 
 All take ``model`` (``lizi``, the default; ``pioneer3at``, whose robots are named pioneer1,
 pioneer2, ...; ``turtlebot3_burger`` and ``turtlebot3_waffle``, burger1, waffle1, ..., with
-turtlebot3_navigation's parameters; ``mixed``: odd robots lizis, even ones pioneer3ats, sharing /position_share with
-their own footprints and limits), ``solo`` (run only the named robot: the reference for
-makespan and path length),
-``planner`` (``collvoid``, default: collvoid_local_planner/CollvoidLocalPlanner with
-position sharing and a robots layer; ``trajectory``: plain TrajectoryPlannerROS, the robots
-unaware of each other), ``localization`` (fake | amcl) and ``start_delay``. Pass criterion
-(checked by tests/scenarios/test_multi_robot_scenarios.py and benchmarks/multi_robot.py): every
-robot reaches its goal, no contact between robots or with a wall.
+turtlebot3_navigation's parameters; ``mixed``: odd robots lizis, even ones pioneer3ats, sharing
+/position_share with their own footprints and limits), ``solo`` (run only the named robot: the
+reference for makespan and path length), ``planner`` (``collvoid``, default:
+collvoid_local_planner/CollvoidLocalPlanner with position sharing and a robots layer;
+``trajectory``: plain TrajectoryPlannerROS, the robots unaware of each other), ``localization``
+(fake | amcl) and ``start_delay``. Pass criterion (checked by
+tests/scenarios/test_multi_robot_scenarios.py and benchmarks/multi_robot.py): every robot reaches
+its goal, no contact between robots or with a wall.
 
 Run ``python make_multi_robot_launch.py [OUTDIR]`` to rewrite them (deterministic).
 """

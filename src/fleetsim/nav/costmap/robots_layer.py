@@ -28,14 +28,15 @@ cell a moving robot was seen in stays lethal until a ray of this robot's sensor 
 it again: in a crowd the cells behind the other robots are never swept, and eight turtlebot3
 burgers on the circle of 8 stood in a ring of their own wakes (32 robots 20 s without progress
 in 5 seeds). With ``clear_robots`` (a fleetsim addition, on by default) the layer erases from
-the obstacle layers of its costmap the cells under every other robot's shared footprint, padded
-by ``seen_padding`` and by how far the robot moves in ``SEEN_LAG`` (the age of a scan and of a
-shared pose), at every update: a robot's image never outlives the update it was marked in, and
-the robots are this layer's business alone. A wall under the padding is marked again by the
-next scan that sees it (the static layer's walls are not touched). Layers before this one in
+the obstacle layers of its costmap the cells under every other robot on the move (at
+``still_speed`` or faster), its shared footprint padded by ``seen_padding`` and by how far it
+moves in ``SEEN_LAG`` (the age of a scan and of a shared pose), at every update: a moving
+robot's image never outlives the update it was marked in. A robot standing still keeps its
+image, which is where it is (the local planner tells parked robots it sees from those it does
+not by it), and gets this layer's marks. A wall under the padding is marked again by the next
+scan that sees it (the static layer's walls are not touched). Layers before this one in
 ``plugins`` are cleared after their marking (``update_bounds``), layers after it before their
-costs reach the master grid (``update_costs``). In a local costmap, ``still_speed: 0`` clears
-the images and marks nothing.
+costs reach the master grid (``update_costs``).
 
 The layer keeps no grid of its own: each update it clears where robots were last marked (by
 widening the bounds, so the layers below rewrite those cells) and marks where they are now. The
@@ -79,7 +80,7 @@ class RobotsLayerParams:
     cost: int = param(252, range=(1, 254), help="cost of the cells under a marked robot")
     clear_robots: bool = param(
         True,
-        help="erase the other robots' bodies, as the sensors saw them, from this costmap's "
+        help="erase the moving robots' bodies, as the sensors saw them, from this costmap's "
         "obstacle layers (fleetsim)",
     )
     seen_padding: float = param(
@@ -136,7 +137,7 @@ class RobotsLayer(Layer):
 
     def _polygons_now(self, robot_x: float, robot_y: float) -> tuple[list, list]:
         """The footprints to mark (robots standing still, scaled and padded for planning) and
-        the bodies to clear (every other robot, `clear_robots`), in the costmap's frame."""
+        the bodies to clear (the robots on the move, `clear_robots`), in the costmap's frame."""
         if self.table is None:
             return self.polygons, []
         p = self.params
@@ -160,7 +161,7 @@ class RobotsLayer(Layer):
             speed = float(np.hypot(r.vx, r.vy))
             if speed < p.still_speed:
                 marked.append(placed(r, padded_footprint(r.footprint * p.static_scale, self._grow)))
-            if p.clear_robots:
+            elif p.clear_robots:
                 pad = p.seen_padding + SEEN_LAG * speed
                 seen.append(placed(r, padded_footprint(r.footprint, pad)))
         return marked, seen

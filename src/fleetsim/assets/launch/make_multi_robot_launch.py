@@ -15,12 +15,12 @@
 
 All take ``model`` (``lizi``, the default; ``pioneer3at``, whose robots are named pioneer1,
 pioneer2, ...; ``turtlebot3_burger`` and ``turtlebot3_waffle``, burger1, waffle1, ..., with
-turtlebot3_navigation's parameters; ``mixed``: odd robots lizis, even ones pioneer3ats, sharing
-/position_share with their own footprints and limits), ``solo`` (run only the named robot: the
-reference for makespan and path length), ``planner`` (``collvoid``, default:
-collvoid_local_planner/CollvoidLocalPlanner with position sharing and a robots layer;
-``trajectory``: plain TrajectoryPlannerROS, the robots unaware of each other), ``localization``
-(fake | amcl) and ``start_delay``. Pass criterion (checked by
+turtlebot3_navigation's parameters; ``jackal``, with the BARN jackal's limits; ``mixed``: odd
+robots lizis, even ones pioneer3ats, sharing /position_share with their own footprints and limits),
+``solo`` (run only the named robot: the reference for makespan and path length), ``planner``
+(``collvoid``, default: collvoid_local_planner/CollvoidLocalPlanner with position sharing and a
+robots layer; ``trajectory``: plain TrajectoryPlannerROS, the robots unaware of each other),
+``localization`` (fake | amcl) and ``start_delay``. Pass criterion (checked by
 tests/scenarios/test_multi_robot_scenarios.py and benchmarks/multi_robot.py): every robot reaches
 its goal, no contact between robots or with a wall.
 
@@ -98,6 +98,7 @@ NAME_PREFIXES = {
     "pioneer3at": "pioneer",
     "turtlebot3_burger": "burger",
     "turtlebot3_waffle": "waffle",
+    "jackal": "jackal",
 }
 #: what ``model:=mixed`` gives robot k: lizis odd, pioneer3ats even
 MIXED = ("pioneer3at", "lizi")
@@ -164,8 +165,8 @@ def scenario(name: str, doc: str, world: str | dict, counts: tuple[int, ...], ro
   <arg name="start_delay" default="2.0" doc="sim seconds before the goals go out"/>
   <arg name="solo" default="" doc="run only this robot (e.g. lizi3): its time and path alone"/>
   <arg name="model" default="lizi"
-       doc="lizi | pioneer3at | turtlebot3_burger | turtlebot3_waffle | mixed (odd robots lizis,
-            even ones pioneer3ats)">
+       doc="lizi | pioneer3at | turtlebot3_burger | turtlebot3_waffle | jackal | mixed (odd
+            robots lizis, even ones pioneer3ats)">
     {_choices((*NAME_PREFIXES, "mixed"))}
   </arg>
 {_robot_args(len(robots))}

@@ -111,6 +111,36 @@ def test_a_command_into_a_wall_is_replaced_by_the_nearest_clear_one():
                                   OUTLINE, limits, 1.0) == (0.5, 0.2, False)  # fmt: skip
 
 
+def test_a_rectangle_a_degree_nose_in_beside_a_wall_peels_off_it():
+    """The jackals' corridor of 4 (seed 0): jackal1 (0.62 x 0.54 m with its padding) 1 cm
+    below the wall beside a robot parked on its goal, its nose 1 degree in, its holonomic
+    velocity ahead and away from the wall. Every forward command of the fallback grid at 0.3
+    m/s or more hits the wall (straight on closes the 1 cm, the grid's next turn swings the
+    rear corner into it), so the nearest clear one was a crawl, and the crawl and the escape
+    behind it went to and fro for 40 s. A turn of a few hundredths of a rad/s keeps the body
+    off the wall and the speed up."""
+    from fleetsim.nav.multirobot.footprint_check import TURN_SAMPLES
+
+    jackal = [[-0.31, -0.27], [-0.31, 0.27], [0.31, 0.27], [0.31, -0.27]]
+    outline = outline_points(jackal, 0.05)
+    cm = empty_map([(-3.0, 0.25, 3.0, 0.6)])
+    pose, vel = (0.0, -0.03, math.radians(1.0)), (0.1, 0.0)
+    limits = (-0.5, 0.5, -1.57, 1.57, 2.0, 3.0)
+    acc = np.array([2.0, 3.0])
+    origin = np.array(grid_of(cm)[1])
+    coarse = np.array([[v, w] for v in np.linspace(0.3, 0.5, 5)
+                       for w in np.linspace(-1.57, 1.57, TURN_SAMPLES)])  # fmt: skip
+    hit = first_collisions(coarse, np.array(pose), np.array(vel), acc, 1.0, STEPS, cm.costs,
+                           origin, 0.05, outline, np.empty((len(coarse), 2)))  # fmt: skip
+    assert (hit <= STEPS).all()  # the premise: no coarse command at speed is clear
+    v, w, replaced = footprint_safe_command((0.5, -0.3), np.array([0.45, -0.15]), pose, vel,
+                                            grid_of(cm), outline, limits, 1.0)  # fmt: skip
+    assert replaced and v >= 0.3 and -0.2 < w < 0.0
+    k = first_collisions(np.array([[v, w]]), np.array(pose), np.array(vel), acc, 1.0, STEPS,
+                         cm.costs, origin, 0.05, outline, np.empty((1, 2)))  # fmt: skip
+    assert k[0] == STEPS + 1
+
+
 @pytest.mark.parametrize("escape", [True, False])
 def test_a_lizi_wedged_nose_first_backs_out_and_goes_through(escape, monkeypatch):
     """Issue 14's lizi7 at (24.84, 44.70): a block 3.5 cm ahead of the lizi's right front

@@ -40,6 +40,12 @@ TURN_WEIGHT = 0.3
 #: samples of the forward (or backward) speed and of the turn rate in the fallback grid
 SPEED_SAMPLES = 11
 TURN_SAMPLES = 21
+#: fractions of the fastest turn added to the fallback grid on either side of straight: a
+#: rectangle beside a wall with its nose a degree in (a jackal 6 cm off the corridor's wall
+#: beside a robot parked on its goal) finds every forward command but a crawl hitting the wall
+#: (straight on closes it, the grid's next turn, 0.16 rad/s, swings the rear corner into it);
+#: a turn of a few hundredths of a rad/s peels it off, as a driver does
+FINE_TURNS = (1.0 / 64.0, 1.0 / 32.0, 1.0 / 16.0)
 #: rollout steps over the horizon (0.05 m apart at 0.5 m/s over 1 s: below a cell's width)
 STEPS = 10
 
@@ -135,7 +141,13 @@ def footprint_safe_command(
     )
     turns = np.linspace(lo_w, hi_w, TURN_SAMPLES)
     cand = np.stack(np.meshgrid(speeds, turns, indexing="ij"), axis=-1).reshape(-1, 2)
-    cand = np.concatenate([cand, [[0.0, 0.0]]])
+    # the fine turns only under way: on the spot they inch a robot wedged nose first round
+    # into the corner, where standing sends it back out (`CollvoidDrive._footprint_clear`)
+    fine = np.array(FINE_TURNS)
+    moving = speeds[speeds != 0.0]
+    fine_turns = np.concatenate((fine * lo_w, fine * hi_w))
+    peel = np.stack(np.meshgrid(moving, fine_turns, indexing="ij"), axis=-1).reshape(-1, 2)
+    cand = np.concatenate([cand, peel, [[0.0, 0.0]]])
     ends = np.empty((cand.shape[0], 2))
     steps = first_collisions(
         cand, pose_a, vel, acc, horizon, STEPS, costs, origin_a, res, outline, ends

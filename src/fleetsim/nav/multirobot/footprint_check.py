@@ -41,10 +41,10 @@ TURN_WEIGHT = 0.3
 SPEED_SAMPLES = 11
 TURN_SAMPLES = 21
 #: fractions of the fastest turn added to the fallback grid on either side of straight: a
-#: rectangle beside a wall with its nose a degree in (a jackal 6 cm off the corridor's wall
-#: beside a robot parked on its goal) finds every forward command but a crawl hitting the wall
-#: (straight on closes it, the grid's next turn, 0.16 rad/s, swings the rear corner into it);
-#: a turn of a few hundredths of a rad/s peels it off, as a driver does
+#: rectangle beside a wall with its nose a degree in (a jackal's padded footprint 1 cm off the
+#: corridor's wall beside a robot parked on its goal) finds every forward command but a crawl
+#: hitting the wall (straight on closes the gap, the grid's next turn, 0.16 rad/s, swings the
+#: rear corner into it); a turn of a few hundredths of a rad/s peels it off, as a driver does
 FINE_TURNS = (1.0 / 64.0, 1.0 / 32.0, 1.0 / 16.0)
 #: rollout steps over the horizon (0.05 m apart at 0.5 m/s over 1 s: below a cell's width)
 STEPS = 10

@@ -70,7 +70,11 @@ def test_a_lizi_in_the_clutter_pocket_leaves_by_the_gap_it_can_turn_in(tmp_path)
     launch = tmp_path / "clutter.launch"
     launch.write_text(launch_text(crop_map(tmp_path)))
     with LaunchSession(load_plan(launch), seed=0) as s:
-        s.run(duration=35.0, until_goals=True)
+        # from this start the lizi turns in the pocket for 12-24 s before it leaves (a knife
+        # edge: with the footprint check's fine turns it arrives at ~37 s, before them at 25.3
+        # s; starts 2 cm or 0.03 rad off arrive in 18.4-19.2 s either way); wedged in the
+        # narrow gap it never arrives
+        s.run(duration=45.0, until_goals=True)
         engine = s.nodes["/gazebo"].engine
         assert {i: w.number for i, w in enumerate(engine.data.warning) if w.number} == {}
         (r,) = s.monitor.results()

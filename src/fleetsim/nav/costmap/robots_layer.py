@@ -54,6 +54,7 @@ import numpy as np
 from fleetsim.errors import TransformError
 from fleetsim.nav.costmap.footprint import padded_footprint, polygon_cells
 from fleetsim.nav.costmap.layer import Bounds, Layer
+from fleetsim.nav.costmap.obstacle_layer import ObstacleLayer
 from fleetsim.runtime import param
 
 MAP_FRAME = "map"
@@ -169,8 +170,6 @@ class RobotsLayer(Layer):
     def _clear_seen(self, after: bool) -> None:
         """Erase the other robots' bodies (``self.seen``) from the obstacle layers before this
         one in the costmap's plugins (``after`` False: their marking is done) or after it."""
-        from fleetsim.nav.costmap.obstacle_layer import ObstacleLayer
-
         if not self.seen or self.layered is None:
             return
         layers = self.layered.layers

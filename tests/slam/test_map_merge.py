@@ -109,26 +109,12 @@ def test_the_first_merged_map_goes_out_when_the_first_map_arrives():
 
 
 def _merged_grid_reference(grids):
-    """merged_grid as first written, every merged cell placed in 2-D (meshgrids): the reference
-    the separable form must give bit for bit."""
-    res = min(g[1] for g in grids)
-    corners, placed = [], []
-    for data, r, (ox, oy, oyaw), (ix, iy, iyaw) in grids:
-        c, s = math.cos(iyaw), math.sin(iyaw)
-        wx, wy, wyaw = ix + c * ox - s * oy, iy + s * ox + c * oy, iyaw + oyaw
-        h, w = data.shape
-        local = np.array([[0, 0], [w * r, 0], [0, h * r], [w * r, h * r]])
-        cw, sw = math.cos(wyaw), math.sin(wyaw)
-        corners.append(
-            np.c_[
-                wx + cw * local[:, 0] - sw * local[:, 1], wy + sw * local[:, 0] + cw * local[:, 1]
-            ]
-        )
-        placed.append((data, r, wx, wy, wyaw))
-    pts = np.concatenate(corners)
-    x0, y0 = np.floor(pts.min(0) / res) * res
-    x1, y1 = pts.max(0)
-    width, height = math.ceil((x1 - x0) / res), math.ceil((y1 - y0) / res)
+    """merged_grid's placement as first written, every merged cell placed in 2-D (meshgrids):
+    the reference the separable form must give bit for bit (the maps' frame is merged_grid's
+    own, `merged_frame`)."""
+    from fleetsim.slam.map_merge import merged_frame
+
+    placed, res, x0, y0, width, height = merged_frame(grids)
     out = np.full((height, width), -1, dtype=np.int8)
     gx, gy = np.meshgrid(x0 + (np.arange(width) + 0.5) * res, y0 + (np.arange(height) + 0.5) * res)
     for data, r, wx, wy, wyaw in placed:

@@ -41,20 +41,12 @@ class MapMergeParams:
     world_frame: str = param("world", help="frame of the merged map")
 
 
-def merged_grid(
+def merged_frame(
     grids: list[tuple[np.ndarray, float, tuple[float, float, float], tuple[float, float, float]]],
-) -> tuple[np.ndarray, float, tuple[float, float]]:
-    """Merge maps placed in a common frame.
-
-    Parameters
-    ----------
-    grids : per robot ``(data (H, W) int8, resolution m, origin (x, y, yaw) in the robot's map
-        frame, init pose (x, y, yaw) of that map frame in the world frame)``.
-
-    Returns
-    -------
-    ``(data (H, W) int8, resolution, (origin x, origin y))`` of the merged map (axis-aligned).
-    """
+) -> tuple[list[tuple[np.ndarray, float, float, float, float]], float, float, float, int, int]:
+    """Where the maps of `merged_grid` lie and the merged grid that covers them: (per map
+    ``(data, resolution, world x, world y, world yaw)`` of its cell (0, 0) corner, the merged
+    resolution (the finest), the merged origin x, y and its width and height in cells)."""
     res = min(g[1] for g in grids)
     corners = []
     placed = []
@@ -75,6 +67,24 @@ def merged_grid(
     x0, y0 = np.floor(pts.min(0) / res) * res
     x1, y1 = pts.max(0)
     width, height = math.ceil((x1 - x0) / res), math.ceil((y1 - y0) / res)
+    return placed, res, x0, y0, width, height
+
+
+def merged_grid(
+    grids: list[tuple[np.ndarray, float, tuple[float, float, float], tuple[float, float, float]]],
+) -> tuple[np.ndarray, float, tuple[float, float]]:
+    """Merge maps placed in a common frame.
+
+    Parameters
+    ----------
+    grids : per robot ``(data (H, W) int8, resolution m, origin (x, y, yaw) in the robot's map
+        frame, init pose (x, y, yaw) of that map frame in the world frame)``.
+
+    Returns
+    -------
+    ``(data (H, W) int8, resolution, (origin x, origin y))`` of the merged map (axis-aligned).
+    """
+    placed, res, x0, y0, width, height = merged_frame(grids)
     out = np.full((height, width), -1, dtype=np.int8)
     # the merged cells' centres: x by column, y by row. Each map's cell of a merged cell is
     # worked out from them without (H, W) meshgrids: x and y each take one term per column and

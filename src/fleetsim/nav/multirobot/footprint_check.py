@@ -46,6 +46,7 @@ TURN_SAMPLES = 21
 #: hitting the wall (straight on closes the gap, the grid's next turn, 0.16 rad/s, swings the
 #: rear corner into it); a turn of a few hundredths of a rad/s peels it off, as a driver does
 FINE_TURNS = (1.0 / 64.0, 1.0 / 32.0, 1.0 / 16.0)
+_FINE = np.array(FINE_TURNS)  # a constant of the compiled code, not built at every call
 #: rollout steps over the horizon (0.05 m apart at 0.5 m/s over 1 s: below a cell's width)
 STEPS = 10
 
@@ -143,9 +144,8 @@ def footprint_safe_command(
     cand = np.stack(np.meshgrid(speeds, turns, indexing="ij"), axis=-1).reshape(-1, 2)
     # the fine turns only under way: on the spot they inch a robot wedged nose first round
     # into the corner, where standing sends it back out (`CollvoidDrive._footprint_clear`)
-    fine = np.array(FINE_TURNS)
     moving = speeds[speeds != 0.0]
-    fine_turns = np.concatenate((fine * lo_w, fine * hi_w))
+    fine_turns = np.concatenate((_FINE * lo_w, _FINE * hi_w))
     peel = np.stack(np.meshgrid(moving, fine_turns, indexing="ij"), axis=-1).reshape(-1, 2)
     cand = np.concatenate([cand, peel, [[0.0, 0.0]]])
     ends = np.empty((cand.shape[0], 2))

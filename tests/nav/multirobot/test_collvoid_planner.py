@@ -218,6 +218,7 @@ def test_in_a_corridor_too_narrow_to_pass_the_lower_priority_robot_backs_off():
             walls=walls,
             deadlock_time=deadlock_time,
             narrow_deadlock_time=deadlock_time,
+            standoff_time=deadlock_time,
             yield_time=4.0,
         )
         f.run(10.0)  # facing each other within 3 m from ~1 s, nearly stopped by 10 s
@@ -455,3 +456,30 @@ def test_overlap_time_parts_overlapping_discs_without_stalling_the_robot(overlap
         assert along > 0.3
         # and 1 s on they are farther apart than the 0.4 m they are now
         assert math.hypot(along, away + 0.4) > 0.5
+
+
+def test_a_standoff_yields_to_the_robot_met_head_on_only():
+    """Two pairs abreast in a corridor wide enough for two by its walls meet front to front and
+    creep at a few cm/s: after standoff_time without deadlock_progress the robot met head-on
+    with priority is yielded to, not a teammate beside us, and without one nobody yields."""
+    rule = make_rule("pioneer4", deadlock_time=10.0, deadlock_progress=0.2, standoff_time=3.0)
+    around = {"pioneer3": 0.9, "pioneer2": 0.8, "pioneer1": 1.6}
+    assert rule.update(0.0, 5.0, around, facing=["pioneer3"]) is None
+    assert rule.update(2.9, 4.85, around, facing=["pioneer3"]) is None  # a creep: 0.15 m
+    # pioneer2 (beside us) is nearer and has priority too, but only the robot met counts
+    assert rule.update(3.1, 4.85, around, facing=["pioneer3"]) == "pioneer3"
+    # the same creep with nobody met head-on: the no-progress clock alone, deadlock_time
+    plain = make_rule("pioneer4", deadlock_time=10.0, deadlock_progress=0.2, standoff_time=3.0)
+    plain.update(0.0, 5.0, around)
+    assert plain.update(3.1, 4.85, around) is None
+    assert plain.update(9.9, 4.85, around) is None
+    assert plain.update(10.1, 4.85, around) == "pioneer2"
+    # progress restarts the clock; the robot met with no priority over us is not yielded to,
+    # and keeping our right of way there does not restart the no-progress clock
+    top = make_rule("pioneer3", deadlock_time=10.0, deadlock_progress=0.2, standoff_time=3.0)
+    near = {"pioneer4": 0.9, "pioneer1": 1.0}
+    top.update(0.0, 5.0, near, facing=["pioneer4"])
+    assert top.update(2.0, 4.7, near, facing=["pioneer4"]) is None
+    assert top.update(4.9, 4.6, near, facing=["pioneer4"]) is None
+    assert top.update(5.1, 4.6, near, facing=["pioneer4"]) is None
+    assert top.update(12.1, 4.6, near, facing=["pioneer4"]) == "pioneer1"

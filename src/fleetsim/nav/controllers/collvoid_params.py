@@ -107,6 +107,14 @@ class CollvoidParams:
         range=(0.0, None),
         help="a robot facing this one across a passage too narrow for two this long: stuck",
     )
+    standoff_time: float = param(
+        3.0,
+        unit="s",
+        range=(0.0, None),
+        help="a robot ahead facing this one, neither drawing away, and no deadlock_progress "
+        "this long: stuck, and it yields to that robot if it has priority (a fleetsim "
+        "addition: robots abreast fill a passage wide enough for two by its walls)",
+    )
     max_vel_x_backwards: float = param(
         0.5,
         unit="m/s",

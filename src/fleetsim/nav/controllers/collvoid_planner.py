@@ -99,7 +99,7 @@ from fleetsim.nav.multirobot.holonomic import (
 from fleetsim.nav.multirobot.orca import contact_halfplanes, orca_halfplanes, orca_velocity
 from fleetsim.nav.multirobot.position_share import PositionShare
 from fleetsim.nav.multirobot.uncertainty import cloud_covariance
-from fleetsim.nav.multirobot.yielding import Retreat, narrow_meetings
+from fleetsim.nav.multirobot.yielding import Retreat, head_on, narrow_between
 from fleetsim.runtime import load_params
 
 _log = logging.getLogger("fleetsim.nav.collvoid")
@@ -157,14 +157,7 @@ class CollvoidLocalPlanner(
         self.escape_sign = -1.0  # backing out (-1) or ahead (+1)
         self.escapes = 0  # how often it did
         self.share = PositionShare(node, eps=p.eps)
-        self.deadlock = DeadlockRule(
-            self.robot_id,
-            p.deadlock_time,
-            p.deadlock_progress,
-            p.deadlock_radius,
-            p.yield_time,
-            p.narrow_deadlock_time,
-        )
+        self.deadlock = DeadlockRule.from_params(self.robot_id, p)
         self._covariance: np.ndarray | None = None  # own localization's, map frame
         node.create_subscription(geometry_msgs.PoseArray, "particlecloud", self._on_cloud, 1)
         self.dt = 1.0 / p.controller_frequency
@@ -289,20 +282,14 @@ class CollvoidLocalPlanner(
         pair = self.pair_radii(own_r, radii, dist)
         active = {k: d for k, d, c in zip(ids, dist.tolist(), controlled) if c}
         narrow: list[str] = []
+        facing: list[str] = []
         if active and self.yielding_to is None:
-            meet = narrow_meetings(
-                self.grid,
-                xy,
-                carrot - xy,
-                pos - xy,
-                nvel,
-                yaws,
-                wide,
-                controlled,
-                own_r,
-            )
-            narrow = [ids[k] for k in meet]
-        self.yielding_to = self.deadlock.update(now, remaining, active, narrow)
+            met = head_on(carrot - xy, pos - xy, nvel, yaws, controlled)
+            facing = [ids[k] for k in met]
+            narrow = [
+                ids[k] for k in met if narrow_between(*self.grid, xy, pos[k], own_r, float(wide[k]))
+            ]
+        self.yielding_to = self.deadlock.update(now, remaining, active, narrow, facing)
         self.waiting = False
         if self.yielding_to is not None:
             k = ids.index(self.yielding_to)

@@ -10,7 +10,12 @@ measurement with RVO2: exact head-on pairs and 0.6 m corridors never finish). Ea
    ``deadlock_radius`` m, the robot is *stuck*; when a robot faces it across a passage too
    narrow for two (the planner measures it: a *narrow meeting*) after ``narrow_time`` s of
    that meeting already, progress or not: no reciprocal method resolves it (ORCA only slows
-   the pair to a creep), waiting longer only loses time;
+   the pair to a creep), waiting longer only loses time; when a robot faces it head-on (ahead,
+   facing it, not drawing away) and it has not made ``deadlock_progress`` m for
+   ``standoff_time`` s, it is in a *standoff* with that robot: the passage is wide enough by the
+   walls, but robots beside the two fill it (two pairs abreast in a corridor meet front to
+   front and creep at a few cm/s; the no-progress clock alone waits ``deadlock_time`` for
+   that), and it yields only to a robot it faces;
 2. a stuck robot looks at the robots around it that are navigating (``controlled`` on
    /position_share; a robot parked at its goal will not move, waiting for it is pointless):
    priority goes by robot id (natural order, so ``lizi2`` before ``lizi10``); every robot sees
@@ -55,6 +60,7 @@ class DeadlockRule:
     deadlock_radius: float
     yield_time: float
     narrow_time: float
+    standoff_time: float
 
     def __post_init__(self) -> None:
         self.reset(0.0)
@@ -69,6 +75,7 @@ class DeadlockRule:
             params.deadlock_radius,
             params.yield_time,
             params.narrow_deadlock_time,
+            params.standoff_time,
         )
 
     def reset(self, now: float, remaining: float = float("inf")) -> None:
@@ -93,12 +100,15 @@ class DeadlockRule:
         remaining: float,
         nearby: dict[str, float],
         narrow: Collection[str] = (),
+        facing: Collection[str] = (),
     ) -> str | None:
         """The robot to yield to this cycle, or None.
 
         remaining : m to the goal; nearby : robot id -> distance (m) of the navigating robots
         around; narrow : the robots of a narrow meeting (each faces this one across a passage
-        too narrow for two; they take part at any distance, not only within deadlock_radius).
+        too narrow for two; they take part at any distance, not only within deadlock_radius);
+        facing : the robots that face this one head-on, ahead of it and not drawing away (a
+        standoff with one of them after ``standoff_time`` s without progress).
         """
         if remaining < self.best - self.deadlock_progress:
             self.best, self.best_time = remaining, now
@@ -118,10 +128,20 @@ class DeadlockRule:
         if self.narrow_since is not None:
             waited = max(waited, now - self.narrow_since)
             patience = min(self.narrow_time, self.deadlock_time)
-        if not close or waited < patience:
+        if not close:
             return None
+        standoff = False
+        if waited < patience:
+            if waited < self.standoff_time:
+                return None
+            # a standoff: only the robots met head-on take part, and keeping the right of way
+            # there restarts no clock (the no-progress rule still runs for the others around)
+            close = {k: d for k, d in close.items() if k in facing}
+            standoff = True
         mine = priority_key(self.robot_id)
         higher = [k for k in close if priority_key(k) < mine]
+        if standoff and not higher:
+            return None
         if not higher:
             self.best, self.best_time = remaining, now  # we keep the right of way
             self.narrow_since = now if narrow else None

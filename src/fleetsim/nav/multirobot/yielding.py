@@ -11,6 +11,7 @@ robot has gone by:
 * `passage_width`: the free width across a direction at a point, from the costmap's lethal cells
   (the clear distance to each side, each capped);
 * `too_narrow`: two robots cannot pass each other here;
+* `head_on`: the robots ahead that face us and are not drawing away;
 * `narrow_meetings` / `narrow_between`: somewhere between two robots facing each other the
   passage is too narrow for both (the deadlock rule decides at once who yields, instead of
   waiting for no progress: ORCA slows a pair in such a passage to a creep that keeps making a
@@ -162,17 +163,29 @@ def narrow_meetings(
     direction of travel; rel : (N, 2) their positions relative to us, m; velocities : (N, 2)
     m/s; yaws : (N,) rad; radii : (N,) m; navigating : (N,) bool. Returns indices into rel.
     """
+    return [
+        k
+        for k in head_on(way, rel, velocities, yaws, navigating)
+        if narrow_between(*grid, xy, xy + rel[k], own_radius, float(radii[k]))
+    ]
+
+
+def head_on(
+    way: np.ndarray,
+    rel: np.ndarray,
+    velocities: np.ndarray,
+    yaws: np.ndarray,
+    navigating: np.ndarray,
+) -> list[int]:
+    """The robots we meet head-on: navigating, ahead of us (along ``way``), facing us and not
+    drawing away (the arrays as for `narrow_meetings`). Returns indices into rel."""
     if float(np.hypot(*way)) < 1e-6 or rel.shape[0] == 0:
         return []
     d = np.maximum(np.hypot(rel[:, 0], rel[:, 1]), 1e-9)
     facing = -(np.cos(yaws) * rel[:, 0] + np.sin(yaws) * rel[:, 1]) > 0.0
     receding = np.einsum("ij,ij->i", rel, velocities) / d > RECEDING_SPEED
     ahead = rel @ way > 0.0
-    return [
-        int(k)
-        for k in np.flatnonzero(navigating & ahead & facing & ~receding)
-        if narrow_between(*grid, xy, xy + rel[k], own_radius, float(radii[k]))
-    ]
+    return np.flatnonzero(navigating & ahead & facing & ~receding).tolist()
 
 
 def refuge(

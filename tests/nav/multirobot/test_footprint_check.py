@@ -195,3 +195,18 @@ def test_a_lizi_wedged_tail_first_escapes_ahead(escape, monkeypatch):
     assert drive_off_the_walls(f, 15.0) is escape
     assert (f.planners[0].escapes >= 1) is escape
     assert f.backed[0] == 0.0
+
+
+def test_walls_that_turn_the_disc_back_from_a_gap_the_body_fits_leave_it_no_way_on():
+    """A lizi at the mouth of a 0.44 m gap, two corners 0.27 m from its centre ahead on either
+    side: inside its circumscribed disc (0.25 m + a cell), outside its inscribed one. The disc's
+    program pushes it straight back out of the gap, fast (more than WALLS_BLOCK of the preferred
+    speed): that is no way on either, so the inscribed disc steers it in (a jackal flipped
+    between the two discs at such a mouth beside a parked robot for 90 s)."""
+    walls = [(0.15, 0.22, 0.6, 1.5), (0.15, -1.5, 0.6, -0.22)]
+    f = Fleet([(0.0, 0.0, 0.0)], [(2.5, 0.0, 0.0)], walls=walls)
+    pl = f.planners[0]
+    xy = np.zeros(2)
+    holo = pl.holonomic_velocity(xy, 0.0, np.zeros(2), np.array([1.2, 0.0]), 2.5)
+    assert pl.walls_blocked
+    assert holo[0] > 0.05, holo

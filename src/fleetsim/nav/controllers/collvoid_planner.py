@@ -387,12 +387,12 @@ class CollvoidLocalPlanner(
         """ORCA half-planes of the static obstacle points ``rel`` (M, 2), m from the robot.
 
         The robot is its circumscribed disc (``body_radius``) unless the walls leave that disc
-        no way on (their program infeasible, or its velocity under `WALLS_BLOCK` of the
-        preferred speed): then, for a differential drive, its inscribed disc, and the real
-        footprint's rollout (`_footprint_clear`) keeps it off the walls. A lizi's disc (0.25 m)
-        does not pass a 0.45 m gap between clutter that its body (0.32 m wide) drives through;
-        in open corridors the disc keeps its distance from walls as before, so two lizis
-        meeting in a corridor still find it too narrow to pass."""
+        no way on (their program infeasible, its velocity under `WALLS_BLOCK` of the
+        preferred speed, or turned back from it): then, for a differential drive, its inscribed
+        disc, and the real footprint's rollout (`_footprint_clear`) keeps it off the walls. A
+        lizi's disc (0.25 m) does not pass a 0.45 m gap between clutter that its body (0.32 m
+        wide) drives through; in open corridors the disc keeps its distance from walls as
+        before, so two lizis meeting in a corridor still find it too narrow to pass."""
         cell_r = self.costmap.resolution * 0.71
         n, p = rel.shape[0], self.params
         lines = orca_halfplanes(
@@ -403,7 +403,11 @@ class CollvoidLocalPlanner(
         if self.wall_radius >= self.body_radius:
             return lines
         v, ok = orca_velocity(*lines, p.max_vel_x, pref, n)
-        if ok and float(np.hypot(*v)) >= WALLS_BLOCK * float(np.hypot(*pref)):
+        # a velocity the disc's program turns back (away from a gap the body fits through) is
+        # no way on either, however fast (a jackal flipped between the two discs beside a
+        # parked one at the corridor's end, 1.5 m from its goal, for 90 s)
+        fast = float(np.hypot(*v)) >= WALLS_BLOCK * float(np.hypot(*pref))
+        if ok and fast and float(v @ pref) >= 0.0:
             return lines
         self.walls_blocked = True
         return orca_halfplanes(

@@ -64,3 +64,23 @@ def test_bodies_apart_the_fallback_is_the_walls_alone_and_the_bodies_lines_cap_t
     pts = np.concatenate([agent[0], hard[0]])
     dirs = np.concatenate([agent[1], hard[1]])
     assert math.isclose(speed_along_heading(pts, dirs, 0, yaw, 0.4, 0.5, hard), 0.02)
+
+
+def test_a_heading_a_hair_off_the_static_half_planes_still_moves():
+    """Pioneers' corridor of 4, seed 17: an obstacle point inside the disc asks for at least
+    0.02 m/s away from it (east here), a wall ahead caps the speed north at 0.355 m/s, and the
+    holonomic velocity (0.02, 0.355) has both; a heading 87 degrees, a hair off it, has
+    neither at any speed. Tracking asks no turn of a heading that close, so at speed 0 the
+    robot stood for good; within HEADING_SLACK of the half-planes it drives on, and a heading
+    well off them still stands."""
+    pts = np.array([[0.02, 0.0], [0.0, 0.355]])
+    dirs = np.array([[0.0, -1.0], [-1.0, 0.0]])  # x >= 0.02, y <= 0.355 (left of each)
+    assert violation(pts, dirs, np.array([0.02, 0.355])) == 0.0
+    yaw = math.radians(87.0)
+    u = np.array([math.cos(yaw), math.sin(yaw)])
+    assert all(violation(pts, dirs, s * u) > 0.0 for s in np.linspace(0.0, 0.7, 141))
+    v = speed_along_heading(pts, dirs, 2, yaw, 0.37, 0.7)
+    assert 0.3 < v <= 0.37
+    assert violation(pts, dirs, v * u) <= 0.01 + 1e-9
+    assert speed_along_heading(pts, dirs, 2, math.radians(80.0), 0.37, 0.7) > 0.0
+    assert speed_along_heading(pts, dirs, 2, math.radians(95.0), 0.37, 0.7) == 0.0

@@ -12,7 +12,7 @@ from fleetsim.msgs import nav_msgs
 from fleetsim.nav.map_io import OccupancyMap
 from fleetsim.nav.map_server import grid_msg_from_map, map_from_grid_msg
 from fleetsim.runtime import Node, Runtime
-from fleetsim.slam.map_merge import MapMerge
+from fleetsim.slam.map_merge import MapMerge, merged_frame
 
 RES = 0.1
 
@@ -112,8 +112,6 @@ def _merged_grid_reference(grids):
     """merged_grid's placement as first written, every merged cell placed in 2-D (meshgrids):
     the reference the separable form must give bit for bit (the maps' frame is merged_grid's
     own, `merged_frame`)."""
-    from fleetsim.slam.map_merge import merged_frame
-
     placed, res, x0, y0, width, height = merged_frame(grids)
     out = np.full((height, width), -1, dtype=np.int8)
     gx, gy = np.meshgrid(x0 + (np.arange(width) + 0.5) * res, y0 + (np.arange(height) + 0.5) * res)

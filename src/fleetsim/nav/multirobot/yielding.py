@@ -12,7 +12,7 @@ robot has gone by:
   (the clear distance to each side, each capped);
 * `too_narrow`: two robots cannot pass each other here;
 * `head_on`: the robots ahead that face us and are not drawing away;
-* `narrow_meetings` / `narrow_between`: somewhere between two robots facing each other the
+* `narrow_between`: somewhere between two robots facing each other the
   passage is too narrow for both (the deadlock rule decides at once who yields, instead of
   waiting for no progress: ORCA slows a pair in such a passage to a creep that keeps making a
   little progress, and every second of it is one more the yielder has to back out);
@@ -145,31 +145,6 @@ def narrow_between(
     return False
 
 
-def narrow_meetings(
-    grid: tuple[np.ndarray, tuple[float, float], float],
-    xy: np.ndarray,
-    way: np.ndarray,
-    rel: np.ndarray,
-    velocities: np.ndarray,
-    yaws: np.ndarray,
-    radii: np.ndarray,
-    navigating: np.ndarray,
-    own_radius: float,
-) -> list[int]:
-    """The robots we meet across a passage too narrow for two: navigating, ahead of us (along
-    ``way``), facing us and not drawing away, with `narrow_between` us.
-
-    grid : (costs (H, W) uint8, origin (2,) m, resolution m); xy : (2,) us; way : (2,) our
-    direction of travel; rel : (N, 2) their positions relative to us, m; velocities : (N, 2)
-    m/s; yaws : (N,) rad; radii : (N,) m; navigating : (N,) bool. Returns indices into rel.
-    """
-    return [
-        k
-        for k in head_on(way, rel, velocities, yaws, navigating)
-        if narrow_between(*grid, xy, xy + rel[k], own_radius, float(radii[k]))
-    ]
-
-
 def head_on(
     way: np.ndarray,
     rel: np.ndarray,
@@ -178,7 +153,11 @@ def head_on(
     navigating: np.ndarray,
 ) -> list[int]:
     """The robots we meet head-on: navigating, ahead of us (along ``way``), facing us and not
-    drawing away (the arrays as for `narrow_meetings`). Returns indices into rel."""
+    drawing away. Those with `narrow_between` us meet us across a passage too narrow for two.
+
+    way : (2,) our direction of travel; rel : (N, 2) their positions relative to us, m;
+    velocities : (N, 2) m/s; yaws : (N,) rad; navigating : (N,) bool. Returns indices into rel.
+    """
     if float(np.hypot(*way)) < 1e-6 or rel.shape[0] == 0:
         return []
     d = np.maximum(np.hypot(rel[:, 0], rel[:, 1]), 1e-9)

@@ -20,6 +20,7 @@ from fleetsim.nav.multirobot.uncertainty import (
     pair_padding,
     shared_padding,
     spread_along,
+    spread_outline,
     widest_spread,
 )
 from fleetsim.runtime import Node, Runtime
@@ -185,6 +186,66 @@ def test_a_robot_sharing_a_covariance_is_its_body_padded_in_the_direction_that_m
     body = math.hypot(0.19, 0.16)
     # ahead along the corridor: padded by 0.05 m, not the 0.32 m of its widest spread
     assert body + 0.03 < got < body + 0.08 < msg.radius - 0.3
+
+
+def test_the_outline_is_the_body_plus_the_spread_in_every_direction():
+    cov = np.array([[0.2**2, 0.01], [0.01, 0.06**2]])
+    own = np.diag([0.1**2, 0.08**2])
+    out = spread_outline(LIZI, cov, 0.5, 0.1, own, 0.5)
+    ang = np.linspace(0.0, 2.0 * math.pi, 721)
+    n = np.stack((np.cos(ang), np.sin(ang)), axis=1)
+    want = (LIZI @ n.T).max(axis=0) + np.hypot(
+        spread_along(cov, n, 0.1, 0.5), spread_along(own, n, 0.1, 0.5)
+    )
+    got = (out @ n.T).max(axis=0)
+    # it holds the true sum (never inside it) and stands off it by under a centimetre
+    assert (got >= want - 1e-9).all()
+    assert (got - want).max() < 0.01
+    # capped: a spread of 1 m along x at 0.3 m, 0.1 m along y as it is
+    capped = spread_outline(LIZI, np.diag([1.0, (0.1 / K) ** 2]), 0.3, 0.1)
+    assert capped[:, 0].max() == pytest.approx(0.19 + 0.3)
+    assert capped[:, 1].max() == pytest.approx(0.16 + 0.1)
+
+
+def test_without_a_spread_the_outline_is_the_footprint_itself():
+    assert spread_outline(LIZI, None, 0.5, 0.1) is not None
+    assert spread_outline(LIZI, None, 0.5, 0.1).tolist() == LIZI.tolist()
+    assert spread_outline(LIZI, np.zeros((2, 2)), 0.5, 0.1, np.zeros((2, 2)), 0.5) is not None
+    table = NeighbourTable()
+    table.update(message("fake"))
+    r = table.robots["fake"]
+    assert r.outline(0.1) is r.footprint  # fake_localization: the footprint as sent, exactly
+
+
+def test_a_parked_robot_uncertain_along_a_corridor_leaves_room_beside_it():
+    """A lizi parked in the middle of a 2 m corridor (along x), amcl's particles 0.2 m along
+    it and 0.06 m across: padded by its widest spread (what it shares) it closes the corridor
+    to another lizi (0.32 m wide, and a 5 cm cell either side), by the spread in each
+    direction it leaves room."""
+    cov = np.diag([0.25**2, 0.06**2])
+    pad = widest_spread(cov, 0.1, 2 * math.hypot(0.19, 0.16))
+    msg = message("amcl", cov=cov)
+    msg.footprint.polygon.points = [
+        geometry_msgs.Point32(x=a, y=b) for a, b in padded_footprint(LIZI, pad)
+    ]
+    table = NeighbourTable()
+    table.update(msg)
+    r = table.robots["amcl"]
+    assert r.body_footprint == pytest.approx(LIZI)
+    room_shared = 1.0 - r.footprint[:, 1].max()  # to the wall on either side
+    mine = np.diag([0.1**2, 0.07**2])  # the passing lizi's own spread
+    room = 1.0 - r.outline(0.1, mine, 2 * math.hypot(0.19, 0.16))[:, 1].max()
+    assert room_shared < 0.32 + 2 * 0.05 < room
+    # turned with the robot: parked across the corridor, it is uncertain along its own y
+    half = math.pi / 4
+    msg.pose.pose.orientation = geometry_msgs.Quaternion(z=math.sin(half), w=math.cos(half))
+    table.update(msg)
+    r = table.robots["amcl"]
+    body = r.outline(0.1)
+    c, s = math.cos(r.yaw), math.sin(r.yaw)
+    in_map = body @ np.array([[c, s], [-s, c]])
+    assert in_map[:, 1].max() == pytest.approx(0.19 + K * 0.06, abs=0.005)
+    assert in_map[:, 0].max() == pytest.approx(0.16 + 2 * math.hypot(0.19, 0.16), abs=0.005)
 
 
 @pytest.mark.parametrize(

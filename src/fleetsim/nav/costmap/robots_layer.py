@@ -161,7 +161,10 @@ class RobotsLayer(Layer):
                 continue
             speed = float(np.hypot(r.vx, r.vy))
             if speed < p.still_speed:
-                marked.append(placed(r, padded_footprint(r.footprint * p.static_scale, self._grow)))
+                # its body and spread by direction (its shared footprint is padded by its
+                # widest spread all round: a lizi parked with amcl closed a 2 m corridor)
+                body = r.outline(self.table.eps) * p.static_scale
+                marked.append(placed(r, padded_footprint(body, self._grow)))
             elif p.clear_robots:
                 pad = p.seen_padding + SEEN_LAG * speed
                 seen.append(placed(r, padded_footprint(r.footprint, pad)))

@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 
 from fleetsim.msgs import collvoid_msgs
-from fleetsim.nav.multirobot.uncertainty import shared_padding, widest_spread
+from fleetsim.nav.multirobot.uncertainty import shared_padding, spread_outline, widest_spread
 from fleetsim.tf.names import normalize_frame
 from fleetsim.tf.quaternions import yaw_from_quaternion
 
@@ -91,6 +91,30 @@ class Neighbour:
     body_radius: float = 0.0
     #: why a covariance it sent was ignored (warned about once), else None
     covariance_fault: Rejection | None = None
+    #: (K, 2) the footprint without the localization padding (``footprint`` without a
+    #: covariance)
+    body_footprint: np.ndarray | None = None
+
+    def outline(
+        self, eps: float, own_cov: np.ndarray | None = None, own_cap: float = 0.0
+    ) -> np.ndarray:
+        """The body grown by where it probably is against a robot whose own covariance is
+        ``own_cov`` ((2, 2) m^2, map frame; its spread capped at ``own_cap`` m): (K, 2) robot
+        frame, m (`uncertainty.spread_outline`; each robot's spread capped at twice its body
+        radius, as the pair's padding caps them). The footprint as sent when neither robot
+        shares a covariance."""
+        body = self.footprint if self.body_footprint is None else self.body_footprint
+        if self.covariance is None and own_cov is None:
+            return body
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        to_robot = np.array([[c, s], [-s, c]])
+
+        def turned(cov):
+            return None if cov is None else to_robot @ cov @ to_robot.T
+
+        return spread_outline(
+            body, turned(self.covariance), 2.0 * self.body_radius, eps, turned(own_cov), own_cap
+        )
 
     def polygon(self) -> np.ndarray:
         """The footprint at the robot's pose: (K, 2) map frame, m."""
@@ -167,7 +191,7 @@ def neighbour_from_msg(
     radius = float(msg.radius)
     cov = shared_covariance(msg, rid)
     fault = cov if isinstance(cov, Rejection) else None
-    body = radius
+    body, unpadded = radius, fp
     if isinstance(cov, np.ndarray):
         pad = shared_padding(fp, widest_spread(cov, eps, math.inf))
         unpadded = fp - np.sign(fp) * pad
@@ -175,8 +199,9 @@ def neighbour_from_msg(
     else:
         cov = None
     return Neighbour(
-        rid, *pose, yaw, v.x, v.y, radius, fp, bool(msg.controlled), stamp, cov, body, fault
-    )
+        rid, *pose, yaw, v.x, v.y, radius, fp, bool(msg.controlled), stamp, cov, body, fault,
+        unpadded,
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)

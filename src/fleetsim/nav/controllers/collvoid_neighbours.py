@@ -116,8 +116,7 @@ class CollvoidNeighbours:
         resp = np.where(~near.controlled | still, 1.0, 0.5)
         yaws = np.array([r.yaw for r in near.robots]) + tyaw
         radii, wide = self.neighbour_radii(own_r, map_xy, near, rotated(vel, -tyaw))
-        # robot frames: the bodies grown by the two robots' spreads by direction (as shared,
-        # with the widest spread all round, a lizi parked in a 2 m corridor with amcl closed it)
-        own_cap = 2.0 * self.body_radius
-        self.near_footprints = [r.outline(p.eps, self._covariance, own_cap) for r in near.robots]
+        # robot frames: the bodies grown by their spreads by direction (as shared, with the
+        # widest spread all round, a lizi parked with amcl closed a 2 m corridor)
+        self.near_footprints = [r.outline(p.eps) for r in near.robots]
         return map_xy, near.ids, pos, nvel, radii, resp, near.controlled, yaws, wide

@@ -95,26 +95,17 @@ class Neighbour:
     #: covariance)
     body_footprint: np.ndarray | None = None
 
-    def outline(
-        self, eps: float, own_cov: np.ndarray | None = None, own_cap: float = 0.0
-    ) -> np.ndarray:
-        """The body grown by where it probably is against a robot whose own covariance is
-        ``own_cov`` ((2, 2) m^2, map frame; its spread capped at ``own_cap`` m): (K, 2) robot
-        frame, m (`uncertainty.spread_outline`; each robot's spread capped at twice its body
-        radius, as the pair's padding caps them). The footprint as sent when neither robot
-        shares a covariance."""
+    def outline(self, eps: float) -> np.ndarray:
+        """The body grown by where it probably is, by direction: (K, 2) robot frame, m
+        (`uncertainty.spread_outline`, capped at twice its body radius as the pair padding caps
+        it). The footprint as sent when it shares no covariance."""
         body = self.footprint if self.body_footprint is None else self.body_footprint
-        if self.covariance is None and own_cov is None:
+        if self.covariance is None:
             return body
         c, s = math.cos(self.yaw), math.sin(self.yaw)
         to_robot = np.array([[c, s], [-s, c]])
-
-        def turned(cov):
-            return None if cov is None else to_robot @ cov @ to_robot.T
-
-        return spread_outline(
-            body, turned(self.covariance), 2.0 * self.body_radius, eps, turned(own_cov), own_cap
-        )
+        cov = to_robot @ self.covariance @ to_robot.T
+        return spread_outline(body, cov, 2.0 * self.body_radius, eps)
 
     def polygon(self) -> np.ndarray:
         """The footprint at the robot's pose: (K, 2) map frame, m."""

@@ -195,45 +195,34 @@ def _pair_support(rel, own_cov, own_cap, covs, caps, eps):
     return support, d, u, perp
 
 
-#: support directions of `spread_outline`'s polygon (32: its corners stand under a centimetre
-#: off a lizi's body and spread, and a rectangle's four sides are among them)
-OUTLINE_DIRECTIONS = 32
+#: support directions of `spread_outline`'s polygon (64: it stands under 5 mm off a lizi's body
+#: and amcl's spread in a corridor, and a rectangle's four sides are among them)
+OUTLINE_DIRECTIONS = 64
 
 
-def spread_outline(
-    footprint: np.ndarray,
-    cov: np.ndarray | None,
-    cap: float,
-    eps: float,
-    own_cov: np.ndarray | None = None,
-    own_cap: float = 0.0,
-) -> np.ndarray:
-    """A robot's body grown by where it probably is against us: the outer polygon (K, 2), in
-    the frame of ``footprint`` (its robot frame, m), of the body plus the ``1 - eps`` spread
-    of the two robots' relative position (its covariance ``cov`` and our own ``own_cov``,
-    (2, 2) m^2 in that frame, None: exact; each spread at most ``cap`` / ``own_cap`` m: its
-    ellipse's axes clamped there, which keeps the outline convex where `pair_padding`'s cap
-    by direction would not, and is inside it).
+def spread_outline(footprint: np.ndarray, cov: np.ndarray | None, cap: float, eps: float):
+    """A robot's body grown by where it probably is: the outer polygon (K, 2), in the frame of
+    ``footprint`` (its robot frame, m), of the body plus the ``1 - eps`` spread of its
+    position (covariance ``cov``, (2, 2) m^2 in that frame; None: exact), at most ``cap`` m
+    (its ellipse's axes clamped there, which keeps the outline convex where `pair_padding`'s
+    cap by direction would not, and is inside it).
 
     The padding is what collvoid's polygon mode ("COCALU") adds to a footprint: the
     particles' outline, here their Gaussian's. Padding the body by its *widest* spread (what a
     robot shares, so that a consumer that reads no covariance keeps clear of it in every
-    direction) grows a lizi parked in a 2 m corridor, uncertain 0.5 m along it and 0.13 m
+    direction) grows a lizi parked in a 2 m corridor, uncertain 0.25 m along it and 0.06 m
     across, into a 1.4 m square that leaves no way past it; its outline by direction is
-    1.0 x 0.6 m. The polygon's support along each of `OUTLINE_DIRECTIONS` unit normals n is
-    the body's plus `spread_along` n (the two robots' combined as `pair_padding` does);
-    consecutive support lines meet at its vertices, so it holds the true sum. With no
-    spread the footprint is returned as it is."""
+    1.4 x 0.6 m. The polygon's support along each of `OUTLINE_DIRECTIONS` unit normals n is the
+    body's plus `spread_along` n; consecutive support lines meet at its vertices, so it holds
+    the true sum. The consumer's own spread is not added, as collvoid puts the others' shared
+    footprints into a costmap (its ``stationary_robots``); ORCA's pairs take both
+    (`pair_padding`). With no spread the footprint is returned as it is."""
     fp = np.asarray(footprint, dtype=np.float64).reshape(-1, 2)
-    if (cov is None or not np.any(cov)) and (own_cov is None or not np.any(own_cov)):
+    if cov is None or not np.any(cov):
         return fp
     ang = np.arange(OUTLINE_DIRECTIONS) * (2.0 * math.pi / OUTLINE_DIRECTIONS)
     n = np.stack((np.cos(ang), np.sin(ang)), axis=1)
-    spread = np.zeros(OUTLINE_DIRECTIONS)
-    for c, most in ((cov, cap), (own_cov, own_cap)):
-        if c is not None:
-            spread = np.hypot(spread, spread_along(_clamped(c, eps, most), n, eps, most))
-    h = (fp @ n.T).max(axis=0) + spread
+    h = (fp @ n.T).max(axis=0) + spread_along(_clamped(cov, eps, cap), n, eps, cap)
     n2, h2 = np.roll(n, -1, axis=0), np.roll(h, -1)
     det = math.sin(2.0 * math.pi / OUTLINE_DIRECTIONS)  # n x n2, the same for every pair
     x = (h * n2[:, 1] - h2 * n[:, 1]) / det

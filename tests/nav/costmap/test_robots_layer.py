@@ -12,6 +12,7 @@ from fleetsim.msgs import collvoid_msgs, geometry_msgs
 from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.nav.costmap.costmap_2d import INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE
 from fleetsim.nav.costmap.layered_costmap import LayeredCostmap
+from fleetsim.nav.multirobot.uncertainty import widest_spread
 from fleetsim.runtime import Node, Runtime
 
 SQUARE = [[-0.2, -0.2], [-0.2, 0.2], [0.2, 0.2], [0.2, -0.2]]
@@ -138,6 +139,36 @@ def test_a_local_costmap_marks_every_robot_with_its_own_padding():
     assert cost_at(cm, 3.0, 3.0) == LETHAL_OBSTACLE
     assert cost_at(cm, 3.0 + 0.22, 3.0) == LETHAL_OBSTACLE  # 0.2 x 0.95 + 0.05
     assert cost_at(cm, 3.0 + 0.27, 3.0) == INSCRIBED_INFLATED_OBSTACLE  # inflated, not marked
+
+
+def test_a_robot_sharing_its_spread_is_marked_by_its_outline_by_direction():
+    """A robot parked with amcl, uncertain 0.25 m along x and 0.03 m across, shares its
+    square padded by its widest spread (0.49 m all round, capped at twice its radius); the
+    layer marks its body plus the spread in each direction, so the way beside it stays open
+    (`uncertainty.spread_outline`)."""
+    rt = Runtime()
+    node = Node(rt, "move_base", "/lizi1")
+    layer_params = {"cost": LETHAL_OBSTACLE, "padding": 0.0, "static_scale": 1.0}
+    cm = LayeredCostmap.from_params({**PARAMS, "robots_layer": layer_params}, "gc")
+    cm.layer("robots_layer").connect(SimpleNamespace(node=node, global_frame="map"))
+    pub = Node(rt, "talker", "/").create_publisher(
+        collvoid_msgs.PoseTwistWithCovariance, "/position_share"
+    )
+    cov = np.diag([0.25**2, 0.03**2])
+    pad = widest_spread(cov, 0.1, 2 * math.hypot(0.2, 0.2))
+    msg = shared("lizi2", 3.0, 3.0, 0.0)
+    msg.footprint.polygon.points = [
+        geometry_msgs.Point32(x=a + math.copysign(pad, a), y=b + math.copysign(pad, b))
+        for a, b in SQUARE
+    ]
+    msg.pose.covariance[[0, 1, 6, 7]] = cov.reshape(-1)
+    pub.publish(msg)
+    rt.run(duration=0.05)
+    cm.update_map(5.0, 5.0, 0.0)
+    assert pad > 0.45
+    assert cost_at(cm, 3.0 + 0.2 + pad - 0.03, 3.0) == LETHAL_OBSTACLE  # along: all of it
+    assert cost_at(cm, 3.0, 3.0 + 0.2 + 0.06) == LETHAL_OBSTACLE  # across: body and spread
+    assert cost_at(cm, 3.0, 3.0 + 0.2 + 0.12) < LETHAL_OBSTACLE  # not the 0.49 m padding
 
 
 # -- clear_robots: the other robots' bodies, as a laser saw them, are erased ------------------

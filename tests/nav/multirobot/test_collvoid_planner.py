@@ -44,7 +44,8 @@ def empty_map(walls=()):
 class Fleet:
     """N unicycles, each with its own node and planner, sharing positions every cycle."""
 
-    def __init__(self, starts, goals, walls=(), **params):
+    def __init__(self, starts, goals, walls=(), footprint=LIZI, **params):
+        self.footprint = np.asarray(footprint, dtype=float)
         self.rt = Runtime()
         self.cm = empty_map(walls)
         self.pub = Node(self.rt, "sim", "/").create_publisher(
@@ -56,7 +57,9 @@ class Fleet:
         self.planners = []
         for i, (g, s) in enumerate(zip(goals, starts)):
             node = Node(self.rt, "move_base", f"/robot{i + 1}")
-            costmap_ros = SimpleNamespace(costmap=self.cm, footprint=LIZI, global_frame="map")
+            costmap_ros = SimpleNamespace(
+                costmap=self.cm, footprint=self.footprint, global_frame="map"
+            )
             pl = CollvoidLocalPlanner.from_namespace(
                 node, costmap_ros, {**LIMITS, **params}, f"robot{i + 1}"
             )
@@ -70,7 +73,8 @@ class Fleet:
 
     def share(self):
         for i, (x, y, yaw) in enumerate(self.state):
-            m = collvoid_msgs.PoseTwistWithCovariance(robot_id=f"robot{i + 1}", radius=BODY)
+            radius = float(np.hypot(*self.footprint.T).max())
+            m = collvoid_msgs.PoseTwistWithCovariance(robot_id=f"robot{i + 1}", radius=radius)
             m.header.stamp = Time.from_sec(self.rt.now())
             m.pose.pose.position = geometry_msgs.Point(x=x, y=y)
             m.pose.pose.orientation = geometry_msgs.Quaternion(
@@ -78,7 +82,9 @@ class Fleet:
             )
             v = self.vel[i, 0]
             m.holonomic_velocity = geometry_msgs.Vector3(x=v * math.cos(yaw), y=v * math.sin(yaw))
-            m.footprint.polygon.points = [geometry_msgs.Point32(x=a, y=b) for a, b in LIZI]
+            m.footprint.polygon.points = [
+                geometry_msgs.Point32(x=a, y=b) for a, b in self.footprint
+            ]
             self.pub.publish(m)
 
     def see(self):

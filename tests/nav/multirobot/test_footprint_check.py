@@ -160,6 +160,38 @@ def test_a_lizi_wedged_nose_first_backs_out_and_goes_through(escape, monkeypatch
     assert (f.planners[0].escapes >= 1) is escape
 
 
+@pytest.mark.parametrize("turn", [True, False])
+def test_a_jackal_wedged_nose_in_towards_a_parked_robot_backs_out_turning_away(turn, monkeypatch):
+    """The jackals' corridor of 4, seed 3: jackal1 (0.62 x 0.54 m with its padding) between
+    the corridor's wall and jackal3 parked on its goal, its nose 13 degrees in towards jackal3,
+    its way on along the wall. Every right turn swings its front corner into jackal3, and from
+    where a straight escape leaves it a crawl turning left is the clear move nearest the
+    holonomic velocity: it inched in and backed out for the rest of the run. Backing out on a
+    curve that turns it towards the holonomic velocity leaves it facing along the wall."""
+    if not turn:
+        monkeypatch.setattr("fleetsim.nav.controllers.collvoid_drive.ESCAPE_TURN", 0.0)
+    jackal = np.array([[-0.31, -0.27], [-0.31, 0.27], [0.31, 0.27], [0.31, -0.27]])
+    outline = outline_points(jackal, 0.05)
+    walls = [(-3.0, -1.5, 3.0, -0.45), (0.30, 0.30, 0.92, 0.84)]  # the wall, jackal3's body
+    limits = {"max_vel_theta": 1.57, "min_vel_theta": -1.57, "min_in_place_vel_theta": 0.5,
+              "acc_lim_x": 2.0, "acc_lim_theta": 3.0}  # fmt: skip
+    f = Fleet([(0.0, 0.0, math.radians(13.0))], [(2.5, -0.1, 0.0)], walls=walls,
+              footprint=jackal, **limits)  # fmt: skip
+    cm, reached = f.cm, False
+    for _ in range(100):  # 20 s
+        reached = f.run(0.2)
+        cost = footprint_costs(
+            cm.costs, cm.origin_x, cm.origin_y, cm.resolution, outline, f.state.copy()
+        )
+        assert cost[0] >= 0.0, f"footprint on a wall at {f.state[0]}"
+        if reached:
+            break
+    assert reached is turn
+    assert f.planners[0].escapes >= 1
+    if not turn:
+        assert f.planners[0].escapes > 5  # to and fro
+
+
 def test_a_wedged_lizi_does_not_back_out_into_a_robot_standing_behind_it():
     """As above, with another lizi standing 3 cm behind its body's disc (the mixed circle of
     16, seed 6: a pioneer3at wedged nose first backed into a lizi). The costmap check has the

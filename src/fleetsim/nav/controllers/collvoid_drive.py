@@ -40,6 +40,8 @@ from fleetsim.nav.multirobot.holonomic import (
 #: escape_reset_dist, 0.1 and 0.1; a little farther here, the room an arc needs to turn off)
 ESCAPE_SPEED = 0.1
 ESCAPE_DISTANCE = 0.15
+#: share of the fastest turn an escape may turn at (`CollvoidDrive._escape_turns`)
+ESCAPE_TURN = 0.5
 #: m/s: a holonomic velocity slower than this is content to stand still (no escape)
 STILL_HOLO = 0.02
 #: no truncation: the velocity obstacle's horizon, s
@@ -147,33 +149,51 @@ class CollvoidDrive:
         xy = np.array(pose[:2], dtype=np.float64)
         escape = min(ESCAPE_SPEED, back_top)
 
-        def may_escape(sign: float) -> bool:
-            """Whether escaping straight back (``sign`` -1) or ahead (+1) is clear. The
-            costmap's check has the other robots' images cleared: it is for walls, and the
-            robots' half-planes must admit the motion too (mixed circle of 16, seed 6: a
-            pioneer wedged nose first backed into a lizi standing behind it)."""
+        def may_escape(sign: float, turn: float = 0.0) -> bool:
+            """Whether escaping back (``sign`` -1) or ahead (+1), turning at ``turn`` rad/s, is
+            clear. The costmap's check has the other robots' images cleared: it is for walls,
+            and the robots' half-planes must admit the motion too (mixed circle of 16, seed 6:
+            a pioneer wedged nose first backed into a lizi standing behind it)."""
             lo, hi = speed_interval(points[n_obst:], dirs[n_obst:], sign * u, escape)
             if not (lo <= hi and hi >= escape):
                 return False
-            return not clear((sign * escape, 0.0), sign * escape * u)[2]
+            return not clear((sign * escape, turn), sign * escape * u)[2]
 
         if self.escape_from is not None:
             near = float(np.hypot(*(xy - self.escape_from))) < ESCAPE_DISTANCE
-            sign = self.escape_sign
-            if near and escape > 0.0 and may_escape(sign):
+            sign, turn = self.escape_sign, self.escape_turn
+            if near and escape > 0.0 and may_escape(sign, turn):
                 self.replaced = True
-                return sign * escape, 0.0, 0.0
+                return sign * escape, 0.0, turn
             self.escape_from = None
         v, w, self.replaced = clear((cmd[0], cmd[2]), self.last_holo)
         still = abs(v) < 1e-3 and abs(w) < 1e-3
         wants = float(np.hypot(*self.last_holo)) > STILL_HOLO
         if self.replaced and still and wants and not self.waiting and escape > 0.0:
             for sign in (-1.0, 1.0):
-                if may_escape(sign):
-                    self.escape_from, self.escape_sign = xy, sign
-                    self.escapes += 1
-                    return sign * escape, 0.0, 0.0
+                for turn in self._escape_turns(yaw, escape):
+                    if may_escape(sign, turn):
+                        self.escape_from, self.escape_sign = xy, sign
+                        self.escape_turn = turn
+                        self.escapes += 1
+                        return sign * escape, 0.0, turn
         return v, 0.0, w
+
+    def _escape_turns(self, yaw: float, speed: float) -> list[float]:
+        """The turn rates an escape at ``speed`` m/s tries, best first: the one that leaves
+        the robot facing the holonomic velocity at the escape's end (at most
+        ``ESCAPE_TURN`` of the fastest turn), then straight. base_local_planner escapes straight;
+        a jackal wedged with its nose 13 degrees towards a robot parked beside the way (the
+        jackals' corridor of 4, seed 3) backed out straight, and every clear move from there
+        (each right turn swung its front corner into that robot) turned it back in, for good.
+        fleetsim's TrajectoryPlannerROS backs on such a curve too (`escape`)."""
+        holo = self.last_holo
+        if float(np.hypot(*holo)) <= STILL_HOLO:
+            return [0.0]
+        err = (math.atan2(holo[1], holo[0]) - yaw + math.pi) % (2.0 * math.pi) - math.pi
+        fastest = ESCAPE_TURN * min(self.params.max_vel_theta, -self.params.min_vel_theta)
+        turn = _clamp(err * speed / ESCAPE_DISTANCE, -fastest, fastest)
+        return [turn, 0.0] if abs(turn) > 1e-3 else [0.0]
 
     @staticmethod
     def _rollout(pose, vx: float, vy: float, w: float, steps: int = 10) -> np.ndarray:

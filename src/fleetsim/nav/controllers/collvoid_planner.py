@@ -155,6 +155,7 @@ class CollvoidLocalPlanner(
         self.walls_blocked = False  # this cycle the walls left the circumscribed disc no way
         self.escape_from: np.ndarray | None = None  # where a wedged robot began backing out
         self.escape_sign = -1.0  # backing out (-1) or ahead (+1)
+        self.escape_turn = 0.0  # rad/s, its turn (`_escape_turns`)
         self.escapes = 0  # how often it did
         self.share = PositionShare(node, eps=p.eps)
         self.deadlock = DeadlockRule.from_params(self.robot_id, p)

@@ -143,7 +143,7 @@ def test_a_local_costmap_marks_every_robot_with_its_own_padding():
 
 def test_a_robot_sharing_its_spread_is_marked_by_its_outline_by_direction():
     """A robot parked with amcl, uncertain 0.25 m along x and 0.03 m across, shares its
-    square padded by its widest spread (0.49 m all round, capped at twice its radius); the
+    square padded by its widest spread (0.54 m all round); the
     layer marks its body plus the spread in each direction, so the way beside it stays open
     (`uncertainty.spread_outline`)."""
     rt = Runtime()

@@ -192,6 +192,33 @@ def test_a_jackal_wedged_nose_in_towards_a_parked_robot_backs_out_turning_away(t
         assert f.planners[0].escapes > 5  # to and fro
 
 
+def test_the_escape_turns_towards_the_holonomic_velocity_then_tries_straight():
+    from types import SimpleNamespace
+
+    from fleetsim.nav.controllers.collvoid_drive import (
+        ESCAPE_DISTANCE,
+        ESCAPE_TURN,
+        CollvoidDrive,
+    )
+
+    def turns(holo, yaw, lo=-1.5, hi=1.5):
+        stub = SimpleNamespace(
+            last_holo=np.array(holo), params=SimpleNamespace(max_vel_theta=hi, min_vel_theta=lo)
+        )
+        return CollvoidDrive._escape_turns(stub, yaw, 0.1)
+
+    # facing 0.3 rad left of the velocity: turn right, to face it after ESCAPE_DISTANCE
+    right = turns([0.3, 0.0], 0.3)
+    assert right[0] == pytest.approx(-0.3 * 0.1 / ESCAPE_DISTANCE) and right[1] == 0.0
+    assert turns([0.3, 0.0], -0.3)[0] == pytest.approx(0.3 * 0.1 / ESCAPE_DISTANCE)
+    # across the +-pi seam the short way round; capped at ESCAPE_TURN of the fastest turn
+    assert turns([-0.3, -0.01], math.pi - 0.1)[0] > 0.0
+    assert turns([0.0, -0.3], math.pi / 2)[0] == pytest.approx(-ESCAPE_TURN * 1.5)
+    assert turns([0.3, 0.0], 0.0) == [0.0]  # already facing it: straight only
+    # a base that cannot turn clockwise (min_vel_theta >= 0) never turns that way
+    assert turns([0.3, 0.0], 0.3, lo=0.2) == [0.0]
+
+
 def test_a_wedged_lizi_does_not_back_out_into_a_robot_standing_behind_it():
     """As above, with another lizi standing 3 cm behind its body's disc (the mixed circle of
     16, seed 6: a pioneer3at wedged nose first backed into a lizi). The costmap check has the

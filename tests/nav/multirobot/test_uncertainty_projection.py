@@ -205,8 +205,10 @@ def test_the_outline_is_the_body_plus_the_spread_in_every_direction():
 
 
 def test_without_a_spread_the_outline_is_the_footprint_itself():
-    assert spread_outline(LIZI, None, 0.5, 0.1).tolist() == LIZI.tolist()
-    assert spread_outline(LIZI, np.zeros((2, 2)), 0.5, 0.1).tolist() == LIZI.tolist()
+    # the polygon of support lines is the footprint's own outline (with repeated corners)
+    for cov in (None, np.zeros((2, 2))):
+        out = spread_outline(LIZI, cov, 0.5, 0.1)
+        assert set(map(tuple, np.round(out, 12))) == set(map(tuple, np.round(LIZI, 12)))
     table = NeighbourTable()
     table.update(message("fake"))
     r = table.robots["fake"]
@@ -214,7 +216,7 @@ def test_without_a_spread_the_outline_is_the_footprint_itself():
 
 
 def test_a_parked_robot_uncertain_along_a_corridor_leaves_room_beside_it():
-    """A lizi parked in the middle of a 2 m corridor (along x), amcl's particles 0.2 m along
+    """A lizi parked in the middle of a 2 m corridor (along x), amcl's particles 0.25 m along
     it and 0.06 m across: padded by its widest spread (what it shares) it closes the corridor
     to another lizi (0.32 m wide, and a 5 cm cell either side), by the spread in each
     direction it leaves room."""
@@ -231,16 +233,36 @@ def test_a_parked_robot_uncertain_along_a_corridor_leaves_room_beside_it():
     room_shared = 1.0 - r.footprint[:, 1].max()  # to the wall on either side
     room = 1.0 - r.outline(0.1)[:, 1].max()
     assert room_shared < 0.32 + 2 * 0.05 < room
-    # turned with the robot: parked across the corridor, it is uncertain along its own y
-    half = math.pi / 4
+    # turned 30 degrees, the spread stays the map's: the outline, placed, has the body's
+    # support plus the map covariance's spread along every map direction
+    half = math.radians(30.0) / 2
     msg.pose.pose.orientation = geometry_msgs.Quaternion(z=math.sin(half), w=math.cos(half))
+    cov = np.array([[0.2**2, 0.004], [0.004, 0.06**2]])
+    msg.pose.covariance[[0, 1, 6, 7]] = cov.reshape(-1)
+    pad = widest_spread(cov, 0.1, 2 * math.hypot(0.19, 0.16))
+    msg.footprint.polygon.points = [
+        geometry_msgs.Point32(x=a, y=b) for a, b in padded_footprint(LIZI, pad)
+    ]
     table.update(msg)
     r = table.robots["amcl"]
-    body = r.outline(0.1)
     c, s = math.cos(r.yaw), math.sin(r.yaw)
-    in_map = body @ np.array([[c, s], [-s, c]])
-    assert in_map[:, 1].max() == pytest.approx(0.19 + K * 0.06, abs=0.005)
-    assert in_map[:, 0].max() == pytest.approx(0.16 + 2 * math.hypot(0.19, 0.16), abs=0.005)
+    to_map = np.array([[c, s], [-s, c]])  # row vectors: p @ to_map is R p
+    ang = np.linspace(0.0, 2.0 * math.pi, 361)
+    n = np.stack((np.cos(ang), np.sin(ang)), axis=1)
+    want = ((LIZI @ to_map) @ n.T).max(axis=0) + spread_along(cov, n, 0.1, 2 * r.body_radius)
+    got = ((r.outline(0.1) @ to_map) @ n.T).max(axis=0)
+    assert (got >= want - 1e-9).all() and (got - want).max() < 0.005
+    # padded (a planner's inscribed radius): the same plus the padding in every direction
+    padded = ((r.outline(0.1, pad=0.16) @ to_map) @ n.T).max(axis=0)
+    assert (padded >= want + 0.16 - 1e-9).all() and (padded - want - 0.16).max() < 0.005
+
+
+def test_with_eps_zero_the_outline_is_the_body_and_a_disc_of_the_cap():
+    out = spread_outline(LIZI, np.diag([0.0, 0.01]), 0.5, 0.0)
+    r = np.hypot(out[:, 0], out[:, 1])
+    assert r.max() < math.hypot(0.19, 0.16) + 0.5 + 0.005  # bounded, where a cap by
+    assert out[:, 0].max() == pytest.approx(0.19 + 0.5)  # direction of a degenerate
+    assert out[:, 1].max() == pytest.approx(0.16 + 0.5)  # spread was not convex
 
 
 @pytest.mark.parametrize(

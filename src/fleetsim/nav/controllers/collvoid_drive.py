@@ -9,14 +9,15 @@ holonomic ORCA velocity to the command a base can follow.
   towards its way; then the command's rollout over ``time_horizon_obst`` is checked
   with the real footprint on the local costmap and, if it touches an obstacle, replaced by the
   clear command that best follows the holonomic velocity (`footprint_safe_command`); a robot
-  wedged (the best clear command is to stand) backs out straight a little, or where it
-  cannot, goes straight ahead a little;
+  wedged (the best clear command is to stand) backs out a little, on a curve towards the
+  holonomic velocity where that is clear, else straight, or where it cannot, goes ahead a
+  little the same way;
 * every command within ``acc_lim_x``/``acc_lim_y``/``acc_lim_theta`` of the last;
 * within the goal's xy tolerance, the turn in place to the goal yaw (base_local_planner's).
 
 `CollvoidDrive` is mixed into the planner, which owns the state it reads (``params``,
 ``lines``, ``last_holo``, ``yielding_to``, ``waiting``, ``turning_to``, ``outline``,
-``costmap``, ``dt``, ``escape_from``, ``escape_sign``, ``escapes``).
+``costmap``, ``dt``, ``escape_from``, ``escape_sign``, ``escape_turn``, ``escapes``).
 """
 
 from __future__ import annotations
@@ -115,9 +116,10 @@ class CollvoidDrive:
 
         When the clear command nearest the holonomic velocity is to stand still while that
         velocity is not (wedged nose first where no arc is clear and a turn on the spot hits a
-        corner), the robot escapes as base_local_planner does: straight back at `ESCAPE_SPEED`
-        until `ESCAPE_DISTANCE` from where it stuck, while that stays clear and the robots'
-        half-planes admit it; where it cannot back out, straight ahead the same way (a robot
+        corner), the robot escapes as base_local_planner does: back at `ESCAPE_SPEED` until
+        `ESCAPE_DISTANCE` from where it stuck, while that stays clear and the robots'
+        half-planes admit it, on a curve towards the holonomic velocity where that is clear
+        (`_escape_turns`), else straight; where it cannot back out, ahead the same way (a robot
         wedged tail first: mixed circle of 16, seed 3, pioneer16 stood 0.4 m from its goal
         from 45 s to the end, its goal to its right, a parked pioneer behind its left corner,
         so every turn towards the goal hit that robot, while straight ahead was clear)."""
@@ -188,10 +190,9 @@ class CollvoidDrive:
         (each right turn swung its front corner into that robot) turned it back in, for good.
         fleetsim's TrajectoryPlannerROS backs on such a curve too (`escape`)."""
         holo = self.last_holo
-        if float(np.hypot(*holo)) <= STILL_HOLO:
-            return [0.0]
-        err = (math.atan2(holo[1], holo[0]) - yaw + math.pi) % (2.0 * math.pi) - math.pi
-        fastest = ESCAPE_TURN * min(self.params.max_vel_theta, -self.params.min_vel_theta)
+        err = math.remainder(math.atan2(holo[1], holo[0]) - yaw, 2 * math.pi)
+        p = self.params
+        fastest = ESCAPE_TURN * max(0.0, min(p.max_vel_theta, -p.min_vel_theta))
         turn = _clamp(err * speed / ESCAPE_DISTANCE, -fastest, fastest)
         return [turn, 0.0] if abs(turn) > 1e-3 else [0.0]
 

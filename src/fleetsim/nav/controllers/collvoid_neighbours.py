@@ -102,7 +102,7 @@ class CollvoidNeighbours:
         try:
             tx, ty, tyaw = self._map_to_local()
         except TransformError:
-            self.near_footprints = []
+            self.near_robots = []
             return xy, ids, pos, nvel, radii, resp, controlled, yaws, radii
         map_xy = rotated(xy - [tx, ty], -tyaw)
         near = self.share.table.near(
@@ -116,7 +116,5 @@ class CollvoidNeighbours:
         resp = np.where(~near.controlled | still, 1.0, 0.5)
         yaws = np.array([r.yaw for r in near.robots]) + tyaw
         radii, wide = self.neighbour_radii(own_r, map_xy, near, rotated(vel, -tyaw))
-        # robot frames: the bodies grown by their spreads by direction (as shared, with the
-        # widest spread all round, a lizi parked with amcl closed a 2 m corridor)
-        self.near_footprints = [r.outline(p.eps) for r in near.robots]
+        self.near_robots = near.robots  # their outlines when parked (`_near_outline`)
         return map_xy, near.ids, pos, nvel, radii, resp, near.controlled, yaws, wide

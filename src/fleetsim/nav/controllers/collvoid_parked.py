@@ -6,7 +6,7 @@ from where the robot stands), a plan out of the local costmap's reach (`_plan_in
 one through a parked robot while the robot is stuck (`_plan_through_parked`).
 
 `CollvoidParked` is mixed into the planner, which owns the state it reads (``params``,
-``node``, ``costmap``, ``plan``, ``plan_index``, ``wall_radius``, ``near_footprints``,
+``node``, ``costmap``, ``plan``, ``plan_index``, ``wall_radius``, ``near_robots``,
 ``still_since``, ``as_bodies``, ``replanned_for``, ``progress``, ``where``).
 """
 
@@ -22,7 +22,6 @@ from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
 from fleetsim.nav.costmap.footprint import (
     footprint_at,
     inside_polygon,
-    padded_footprint,
     polygon_cells,
 )
 
@@ -96,14 +95,20 @@ class CollvoidParked:
                 as_bodies[ids[k]] = now + BODIES_TIME
         cm, bodies = self.costmap, []
         for k in np.flatnonzero(out):
-            fp = self.near_footprints[k]
-            grown = padded_footprint(fp, cm.resolution)
+            grown = self._near_outline(k, cm.resolution)
             rows, cols = polygon_cells(cm, footprint_at(grown, *pos[k], yaws[k]))
             seen = np.count_nonzero(cm.costs[rows, cols] == LETHAL_OBSTACLE) >= SEEN_CELLS
             out[k] = seen or ids[k] in as_bodies
             if out[k]:
-                bodies.append(footprint_at(fp, *pos[k], yaws[k]))
+                bodies.append(footprint_at(self._near_outline(k), *pos[k], yaws[k]))
         return out, bodies
+
+    def _near_outline(self, k: int, pad: float = 0.0) -> np.ndarray:
+        """Neighbour ``k``'s body as it enters the costmap, padded by ``pad`` m (robot frame):
+        its footprint as shared, or, when it shares a covariance, its body grown by its spread
+        by direction (`Neighbour.outline`; its shared footprint is padded by its widest spread
+        all round: a lizi parked with amcl closed a 2 m corridor)."""
+        return self.near_robots[k].outline(self.params.eps, pad=pad)
 
     def _plan_in_reach(self, xy: np.ndarray) -> None:
         """Raise `NoValidTrajectory` (move_base plans again, from where the robot stands) when
@@ -143,8 +148,7 @@ class CollvoidParked:
             rid = ids[k]
             if now < self.replanned_for.get(rid, -math.inf):
                 continue
-            fp = padded_footprint(self.near_footprints[k], self.wall_radius)
-            body = footprint_at(fp, *pos[k], yaws[k])
+            body = footprint_at(self._near_outline(k, self.wall_radius), *pos[k], yaws[k])
             inside = inside_polygon(np.concatenate([goal, ahead]), body)  # one polygon
             if inside[0]:  # standing on our goal
                 continue

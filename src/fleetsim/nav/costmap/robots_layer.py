@@ -91,6 +91,12 @@ class RobotsLayerParams:
         help="added round a robot's shared footprint for clear_robots (two 5 cm cells: the "
         "cells its outline's hits fall in)",
     )
+    eps: float = param(
+        0.1,
+        range=(0.0, 0.999),
+        help="the fleet's eps (collvoid's, as me_publisher's and the local planner's): a "
+        "robot sharing a covariance is marked as its body plus that quantile of its spread",
+    )
     padding: float = param(
         -1.0,
         unit="m",
@@ -124,7 +130,7 @@ class RobotsLayer(Layer):
         from fleetsim.nav.multirobot.position_share import PositionShare
 
         node = costmap_ros.node
-        self.table = PositionShare(node).table
+        self.table = PositionShare(node, eps=self.params.eps).table
         self.now = node.now
         self.robot_id = self.params.robot_id or node.tf_prefix or node.namespace.strip("/")
         frame = costmap_ros.global_frame
@@ -163,8 +169,7 @@ class RobotsLayer(Layer):
             if speed < p.still_speed:
                 # its body and spread by direction (its shared footprint is padded by its
                 # widest spread all round: a lizi parked with amcl closed a 2 m corridor)
-                body = r.outline(self.table.eps) * p.static_scale
-                marked.append(placed(r, padded_footprint(body, self._grow)))
+                marked.append(placed(r, r.outline(p.eps, p.static_scale, self._grow)))
             elif p.clear_robots:
                 pad = p.seen_padding + SEEN_LAG * speed
                 seen.append(placed(r, padded_footprint(r.footprint, pad)))

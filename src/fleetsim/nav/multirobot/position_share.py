@@ -41,6 +41,7 @@ from typing import Any
 import numpy as np
 
 from fleetsim.msgs import collvoid_msgs
+from fleetsim.nav.costmap.footprint import padded_footprint
 from fleetsim.nav.multirobot.uncertainty import shared_padding, spread_outline, widest_spread
 from fleetsim.tf.names import normalize_frame
 from fleetsim.tf.quaternions import yaw_from_quaternion
@@ -95,17 +96,20 @@ class Neighbour:
     #: covariance)
     body_footprint: np.ndarray | None = None
 
-    def outline(self, eps: float) -> np.ndarray:
-        """The body grown by where it probably is, by direction: (K, 2) robot frame, m
-        (`uncertainty.spread_outline`, capped at twice its body radius as the pair padding caps
-        it). The footprint as sent when it shares no covariance."""
+    def outline(self, eps: float, scale: float = 1.0, pad: float = 0.0) -> np.ndarray:
+        """The body, scaled by ``scale``, grown by where it probably is, by direction, and by
+        ``pad`` m: (K, 2) robot frame, m (`uncertainty.spread_outline`, the spread capped at
+        twice its body radius as the pair padding caps it). Without a covariance the footprint
+        as sent, scaled and padded as costmap_2d pads a footprint (`padded_footprint`)."""
         body = self.footprint if self.body_footprint is None else self.body_footprint
+        if scale != 1.0:
+            body = body * scale
         if self.covariance is None:
-            return body
+            return padded_footprint(body, pad) if pad else body
         c, s = math.cos(self.yaw), math.sin(self.yaw)
-        to_robot = np.array([[c, s], [-s, c]])
+        to_robot = np.array([[c, s], [-s, c]])  # map -> robot frame
         cov = to_robot @ self.covariance @ to_robot.T
-        return spread_outline(body, cov, 2.0 * self.body_radius, eps)
+        return spread_outline(body, cov, 2.0 * self.body_radius, eps, pad)
 
     def polygon(self) -> np.ndarray:
         """The footprint at the robot's pose: (K, 2) map frame, m."""

@@ -195,34 +195,43 @@ def _pair_support(rel, own_cov, own_cap, covs, caps, eps):
     return support, d, u, perp
 
 
-#: support directions of `spread_outline`'s polygon (64: it stands under 5 mm off a lizi's body
-#: and amcl's spread in a corridor, and a rectangle's four sides are among them)
+#: support directions of `spread_outline`'s polygon (64: it stands 2 mm off a lizi's body and
+#: amcl's spread in a corridor, 6 mm off a thin spread turned off the body's axes; a
+#: rectangle's four sides are among them)
 OUTLINE_DIRECTIONS = 64
 
 
-def spread_outline(footprint: np.ndarray, cov: np.ndarray | None, cap: float, eps: float):
-    """A robot's body grown by where it probably is: the outer polygon (K, 2), in the frame of
-    ``footprint`` (its robot frame, m), of the body plus the ``1 - eps`` spread of its
-    position (covariance ``cov``, (2, 2) m^2 in that frame; None: exact), at most ``cap`` m
+def spread_outline(
+    footprint: np.ndarray, cov: np.ndarray | None, cap: float, eps: float, pad: float = 0.0
+) -> np.ndarray:
+    """A robot's body grown by where it probably is: the outer polygon (`OUTLINE_DIRECTIONS`,
+    2), in the frame of ``footprint`` (its robot frame, m), of the body plus the ``1 - eps``
+    spread of its position (covariance ``cov``, (2, 2) m^2 in that frame), at most ``cap`` m
     (its ellipse's axes clamped there, which keeps the outline convex where `pair_padding`'s
-    cap by direction would not, and is inside it).
+    cap by direction would not, and is inside it; for ``eps`` 0 a disc of ``cap``), plus
+    ``pad`` m in every direction (a planner's padding: costmap_2d's padFootprint, which moves
+    each coordinate by its sign, pads a polygon turned off its axes by less).
 
     The padding is what collvoid's polygon mode ("COCALU") adds to a footprint: the
     particles' outline, here their Gaussian's. Padding the body by its *widest* spread (what a
     robot shares, so that a consumer that reads no covariance keeps clear of it in every
     direction) grows a lizi parked in a 2 m corridor, uncertain 0.25 m along it and 0.06 m
-    across, into a 1.4 m square that leaves no way past it; its outline by direction is
-    1.4 x 0.6 m. The polygon's support along each of `OUTLINE_DIRECTIONS` unit normals n is the
-    body's plus `spread_along` n; consecutive support lines meet at its vertices, so it holds
-    the true sum. The consumer's own spread is not added, as collvoid puts the others' shared
-    footprints into a costmap (its ``stationary_robots``); ORCA's pairs take both
-    (`pair_padding`). With no spread the footprint is returned as it is."""
+    across, into a 1.37 x 1.31 m box that leaves no way past it; its outline by direction is
+    1.37 x 0.58 m. The polygon's support along each unit normal n of `OUTLINE_DIRECTIONS` is
+    the body's plus `spread_along` n plus ``pad``; consecutive support lines meet at its
+    vertices, so it holds the true sum (2 mm outside it there). The consumer's own spread is
+    not added, as collvoid puts the others' shared footprints into a costmap (its
+    ``stationary_robots``); ORCA's pairs take both (`pair_padding`). Without a spread (None
+    or zero) use the footprint itself (`Neighbour.outline` does)."""
     fp = np.asarray(footprint, dtype=np.float64).reshape(-1, 2)
-    if cov is None or not np.any(cov):
-        return fp
     ang = np.arange(OUTLINE_DIRECTIONS) * (2.0 * math.pi / OUTLINE_DIRECTIONS)
     n = np.stack((np.cos(ang), np.sin(ang)), axis=1)
-    h = (fp @ n.T).max(axis=0) + spread_along(_clamped(cov, eps, cap), n, eps, cap)
+    h = (fp @ n.T).max(axis=0) + pad
+    if cov is not None and np.any(cov):
+        if math.isfinite(gaussian_scale(eps)):
+            h = h + spread_along(_clamped(cov, eps, cap), n, eps, cap)
+        else:  # eps 0: all of an unbounded Gaussian, capped in every direction
+            h = h + cap
     n2, h2 = np.roll(n, -1, axis=0), np.roll(h, -1)
     det = math.sin(2.0 * math.pi / OUTLINE_DIRECTIONS)  # n x n2, the same for every pair
     x = (h * n2[:, 1] - h2 * n[:, 1]) / det
@@ -231,14 +240,10 @@ def spread_outline(footprint: np.ndarray, cov: np.ndarray | None, cap: float, ep
 
 
 def _clamped(cov: np.ndarray, eps: float, most: float) -> np.ndarray:
-    """``cov`` with the eigenvalues whose ``1 - eps`` spread exceeds ``most`` m brought down to
-    it (an ellipse no wider than ``most``; the eigenvalues as they are for ``eps`` 0, whose
-    spread is ``most`` in every direction with variance anyway)."""
-    k = gaussian_scale(eps)
-    if not math.isfinite(k):
-        return cov
+    """``cov`` with the eigenvalues whose ``1 - eps`` spread (``eps`` > 0) exceeds ``most`` m
+    brought down to it: an ellipse no wider than ``most``."""
     lam, axes = np.linalg.eigh(np.asarray(cov, dtype=np.float64))
-    lam = np.clip(lam, 0.0, (most / k) ** 2)
+    lam = np.clip(lam, 0.0, (most / gaussian_scale(eps)) ** 2)
     return (axes * lam) @ axes.T
 
 

@@ -121,18 +121,25 @@ def test_navfn_plans_around_a_parked_robot_and_through_one_on_the_goal():
     assert np.hypot(*(path[-1, :2] - [5.5, 0.6])) < 0.1
 
 
-def test_a_local_costmap_marks_every_robot_with_its_own_padding():
-    """A laser above the other robots' bodies does not see them: a local costmap marks them
-    from /position_share, moving ones too, lethal, padded by ``padding`` m instead of this
-    robot's inscribed radius (its planner checks the footprint itself)."""
+def lethal_costmap(ns, layer_params):
+    """(runtime, a costmap of the robots layer with ``layer_params`` listening as the robot in
+    ``ns``, a /position_share publisher)."""
     rt = Runtime()
-    node = Node(rt, "move_base", "/hunter1")
-    layer_params = {"cost": LETHAL_OBSTACLE, "still_speed": 100.0, "padding": 0.05}
+    node = Node(rt, "move_base", ns)
     cm = LayeredCostmap.from_params({**PARAMS, "robots_layer": layer_params}, "lc")
     cm.layer("robots_layer").connect(SimpleNamespace(node=node, global_frame="map"))
     pub = Node(rt, "talker", "/").create_publisher(
         collvoid_msgs.PoseTwistWithCovariance, "/position_share"
     )
+    return rt, cm, pub
+
+
+def test_a_local_costmap_marks_every_robot_with_its_own_padding():
+    """A laser above the other robots' bodies does not see them: a local costmap marks them
+    from /position_share, moving ones too, lethal, padded by ``padding`` m instead of this
+    robot's inscribed radius (its planner checks the footprint itself)."""
+    layer_params = {"cost": LETHAL_OBSTACLE, "still_speed": 100.0, "padding": 0.05}
+    rt, cm, pub = lethal_costmap("/hunter1", layer_params)
     pub.publish(shared("hunter2", 3.0, 3.0, 0.0, vx=0.5))
     rt.run(duration=0.05)
     cm.update_map(5.0, 5.0, 0.0)
@@ -146,14 +153,8 @@ def test_a_robot_sharing_its_spread_is_marked_by_its_outline_by_direction():
     square padded by its widest spread (0.54 m all round); the
     layer marks its body plus the spread in each direction, so the way beside it stays open
     (`uncertainty.spread_outline`)."""
-    rt = Runtime()
-    node = Node(rt, "move_base", "/lizi1")
     layer_params = {"cost": LETHAL_OBSTACLE, "padding": 0.0, "static_scale": 1.0}
-    cm = LayeredCostmap.from_params({**PARAMS, "robots_layer": layer_params}, "gc")
-    cm.layer("robots_layer").connect(SimpleNamespace(node=node, global_frame="map"))
-    pub = Node(rt, "talker", "/").create_publisher(
-        collvoid_msgs.PoseTwistWithCovariance, "/position_share"
-    )
+    rt, cm, pub = lethal_costmap("/lizi1", layer_params)
     cov = np.diag([0.25**2, 0.03**2])
     pad = widest_spread(cov, 0.1, 2 * math.hypot(0.2, 0.2))
     msg = shared("lizi2", 3.0, 3.0, 0.0)

@@ -20,14 +20,14 @@ from fleetsim.nav.multirobot.footprint_check import (
 OUTLINE = outline_points(LIZI, 0.05)
 
 
-def drive_off_the_walls(f, seconds: float) -> bool:
-    """Run robot 1 of ``f`` for up to ``seconds`` (0.2 s at a time), its footprint never on a
-    wall; whether it reached its goal."""
+def drive_off_the_walls(f, seconds: float, outline=OUTLINE) -> bool:
+    """Run robot 1 of ``f`` for up to ``seconds`` (0.2 s at a time), its footprint (``outline``)
+    never on a wall; whether it reached its goal."""
     cm = f.cm
     for _ in range(round(seconds / 0.2)):
         reached = f.run(0.2)
         cost = footprint_costs(
-            cm.costs, cm.origin_x, cm.origin_y, cm.resolution, OUTLINE, f.state.copy()
+            cm.costs, cm.origin_x, cm.origin_y, cm.resolution, outline, f.state.copy()
         )
         assert cost[0] >= 0.0, f"footprint on a wall at {f.state[0]}"
         if reached:
@@ -177,16 +177,7 @@ def test_a_jackal_wedged_nose_in_towards_a_parked_robot_backs_out_turning_away(t
               "acc_lim_x": 2.0, "acc_lim_theta": 3.0}  # fmt: skip
     f = Fleet([(0.0, 0.0, math.radians(13.0))], [(2.5, -0.1, 0.0)], walls=walls,
               footprint=jackal, **limits)  # fmt: skip
-    cm, reached = f.cm, False
-    for _ in range(100):  # 20 s
-        reached = f.run(0.2)
-        cost = footprint_costs(
-            cm.costs, cm.origin_x, cm.origin_y, cm.resolution, outline, f.state.copy()
-        )
-        assert cost[0] >= 0.0, f"footprint on a wall at {f.state[0]}"
-        if reached:
-            break
-    assert reached is turn
+    assert drive_off_the_walls(f, 20.0, outline) is turn
     assert f.planners[0].escapes >= 1
     if not turn:
         assert f.planners[0].escapes > 5  # to and fro

@@ -176,6 +176,7 @@ def test_a_robot_sharing_a_covariance_is_its_body_padded_in_the_direction_that_m
     table = NeighbourTable()
     pad = widest_spread(ALONG_X, 0.1, 2 * math.hypot(0.19, 0.16))
     msg = message("amcl", cov=ALONG_X, x=4.0)
+    msg.holonomic_velocity.x = -0.3  # on its way: its disc (it may turn)
     msg.footprint.polygon.points = [
         geometry_msgs.Point32(x=a, y=b) for a, b in padded_footprint(LIZI, pad)
     ]
@@ -186,6 +187,38 @@ def test_a_robot_sharing_a_covariance_is_its_body_padded_in_the_direction_that_m
     body = math.hypot(0.19, 0.16)
     # ahead along the corridor: padded by 0.05 m, not the 0.32 m of its widest spread
     assert body + 0.03 < got < body + 0.08 < msg.radius - 0.3
+    # standing still it is its body's outline: ahead, its half width (0.16 m), not its disc
+    msg.holonomic_velocity.x = 0.0
+    table.update(msg)
+    near = table.near(1.0, (0.0, 0.0), 10.0, 5)
+    still = CollvoidLocalPlanner.neighbour_radii(planner_stub(), 0.35, np.zeros(2), near)[0][0]
+    assert 0.16 + 0.03 < still < 0.16 + 0.08 < got - 0.05
+
+
+def test_a_body_in_the_pair_padding_shares_the_tangent_of_its_outline():
+    """`pair_padding` with ``bodies``: the radius R (beyond ``base``) with R = the body's
+    support plus the spread along the normal of the leg at R (the disc then shares the true
+    shape's tangent), never more than with the body's circumscribed disc."""
+    rng = np.random.default_rng(4)
+    body = LIZI @ np.array([[math.cos(0.4), math.sin(0.4)], [-math.sin(0.4), math.cos(0.4)]])
+    circ = math.hypot(0.19, 0.16)
+    for _ in range(20):
+        rel = rng.uniform(-3.0, 3.0, (1, 2))
+        rel[0] += np.sign(rel[0]) * 0.8
+        vrel = rng.uniform(-0.5, 0.5, (1, 2))
+        args = (None, 0.5, np.array([ALONG_X]), np.array([0.5]), 0.1, vrel)
+        with_body = pair_padding(rel, np.array([0.26]), *args, bodies=body[None], iterations=30)
+        disc = circ + pair_padding(rel, np.array([0.26 + circ]), *args, iterations=30)
+        assert with_body[0] <= disc[0] + 1e-6
+        # self-consistent on one of the legs: R = body support + spread along its normal
+        d = float(np.hypot(*rel[0]))
+        u = rel[0] / d
+        perp = np.array([-u[1], u[0]])
+        s = min(1.0, (0.26 + with_body[0]) / d)
+        c = math.sqrt(1.0 - s * s)
+        legs = [s * u + c * perp, s * u - c * perp]
+        shapes = [(body @ n).max() + spread_along(ALONG_X, n[None], 0.1, 0.5)[0] for n in legs]
+        assert min(abs(h - with_body[0]) for h in shapes) < 1e-3 or s == 1.0
 
 
 def test_the_outline_is_the_body_plus_the_spread_in_every_direction():

@@ -101,6 +101,7 @@ def pair_padding(
     eps: float,
     vrel: np.ndarray | None = None,
     iterations: int = 12,  # bisection steps (16 neighbours: ~0.7 ms a cycle)
+    bodies: np.ndarray | None = None,
 ) -> np.ndarray:
     """What each pair's combined radius grows by for the two robots' localization spreads, m.
 
@@ -125,7 +126,11 @@ def pair_padding(
     rel : (N, 2) the others relative to this robot, m, the frame of the covariances;
     base : (N,) combined radii without localization, m; own_cov : (2, 2) or None (exact);
     own_cap : m; covs : (N, 2, 2) the others' covariances (zeros: exact); caps : (N,) m.
-    Returns (N,) m, exactly 0.0 where neither robot is uncertain.
+    bodies : (N, K, 2) m or None: the others' outlines about their centres (this frame). Given,
+    ``base`` leaves the other's body out, and the shape's support (so the result) takes the
+    body's support along the normal too: a standing robot's true shape instead of its
+    circumscribed disc (a lizi is 0.32 m across, its disc 0.50 m).
+    Returns (N,) m, exactly 0.0 where neither robot is uncertain (without ``bodies``).
     """
     rel = np.asarray(rel, dtype=np.float64).reshape(-1, 2)
     support, d, u, perp = _pair_support(rel, own_cov, own_cap, covs, caps, eps)
@@ -140,16 +145,26 @@ def pair_padding(
         side = np.where(np.abs(cross) > 1e-3 * d * np.hypot(v[:, 0], v[:, 1]), -np.sign(cross), 0.0)
     base = np.asarray(base, dtype=np.float64).reshape(-1)
 
+    if bodies is None:
+        shape = support
+    else:
+        pts = np.asarray(bodies, dtype=np.float64).reshape(rel.shape[0], -1, 2)
+
+        def shape(normals: np.ndarray) -> np.ndarray:
+            return support(normals) + np.einsum("nkd,nd->nk", pts, normals).max(axis=1)
+
     def excess(pad: np.ndarray) -> np.ndarray:
-        """support(n(base + pad)) - pad: >= 0 at pad 0, <= 0 at pad = the largest support."""
+        """shape(n(base + pad)) - pad: >= 0 at pad 0, <= 0 at pad = the largest support."""
         s = np.clip((base + pad) / np.maximum(d, 1e-12), 0.0, 1.0)[:, None]
         c = np.sqrt(1.0 - s * s)
-        right, left = support(s * u + c * perp), support(s * u - c * perp)
+        right, left = shape(s * u + c * perp), shape(s * u - c * perp)
         return np.where(side > 0, right, np.where(side < 0, left, np.maximum(right, left))) - pad
 
     lo = np.zeros(rel.shape[0])
     # each spread is a norm of n (capped), so no support exceeds the sum of two orthogonal ones
     hi = support(u) + support(perp)
+    if bodies is not None:
+        hi = hi + np.hypot(pts[:, :, 0], pts[:, :, 1]).max(axis=1)
     for _ in range(iterations):
         mid = 0.5 * (lo + hi)
         up = excess(mid) >= 0.0

@@ -21,14 +21,6 @@ from fleetsim.nav.multirobot.uncertainty import pair_padding, side_by_side_paddi
 MAP_FRAME = "map"
 
 
-def _map_outline(robot: Any) -> np.ndarray:
-    """A neighbour's body footprint (without its localization padding) turned into the map
-    frame about its centre, (K, 2) m."""
-    fp = robot.footprint if robot.body_footprint is None else robot.body_footprint
-    c, s = math.cos(robot.yaw), math.sin(robot.yaw)
-    return fp @ np.array([[c, s], [-s, c]])
-
-
 class CollvoidNeighbours:
     """Neighbours and radii for the collvoid planner (see the module doc)."""
 
@@ -91,11 +83,13 @@ class CollvoidNeighbours:
         orca = body + pad
         # a robot standing still that shares its spread: by its body's outline, not its disc
         # (the lizis' corridor of 4 with amcl, seeds 1-8: 2 robots 20 s without progress, 7
-        # with the disc; parked robots only, no goal left: 7)
+        # with the disc; parked robots only, no goal left: 7). Their disc rows above are
+        # computed and dropped: leaving them out of the batch changes the others' last bits
+        # (the bisection's einsum), and with them the measured runs
         still = np.hypot(near.velocities[:, 0], near.velocities[:, 1]) < STILL_SPEED
         k = np.flatnonzero(shared & still)
         if k.size:
-            shapes = [_map_outline(near.robots[i]) for i in k]
+            shapes = [near.robots[i].body_in_map() for i in k]
             most = max(len(o) for o in shapes)  # other robots' footprints: repeat a corner
             outlines = np.stack(
                 [np.concatenate([o, o[-1:].repeat(most - len(o), 0)]) for o in shapes]

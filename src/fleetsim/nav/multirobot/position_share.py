@@ -96,12 +96,22 @@ class Neighbour:
     #: covariance)
     body_footprint: np.ndarray | None = None
 
+    @property
+    def body(self) -> np.ndarray:
+        """(K, 2) the footprint without the localization padding, robot frame, m."""
+        return self.footprint if self.body_footprint is None else self.body_footprint
+
+    def body_in_map(self) -> np.ndarray:
+        """`body` turned into the map frame about the robot's centre, (K, 2) m."""
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        return self.body @ np.array([[c, s], [-s, c]])
+
     def outline(self, eps: float, scale: float = 1.0, pad: float = 0.0) -> np.ndarray:
         """The body, scaled by ``scale``, grown by where it probably is, by direction, and by
         ``pad`` m: (K, 2) robot frame, m (`uncertainty.spread_outline`, the spread capped at
         twice its body radius as the pair padding caps it). Without a covariance the footprint
         as sent, scaled and padded as costmap_2d pads a footprint (`padded_footprint`)."""
-        body = self.footprint if self.body_footprint is None else self.body_footprint
+        body = self.body
         if scale != 1.0:
             body = body * scale
         if self.covariance is None:

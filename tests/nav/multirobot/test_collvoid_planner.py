@@ -44,8 +44,8 @@ def empty_map(walls=()):
 class Fleet:
     """N unicycles, each with its own node and planner, sharing positions every cycle."""
 
-    def __init__(self, starts, goals, walls=(), footprint=LIZI, **params):
-        self.footprint = np.asarray(footprint, dtype=float)
+    def __init__(self, starts, goals, walls=(), footprint=LIZI, padding=0.0, **params):
+        self.footprint = np.asarray(footprint, dtype=float)  # padded by ``padding`` m
         self.rt = Runtime()
         self.cm = empty_map(walls)
         self.pub = Node(self.rt, "sim", "/").create_publisher(
@@ -58,7 +58,10 @@ class Fleet:
         for i, (g, s) in enumerate(zip(goals, starts)):
             node = Node(self.rt, "move_base", f"/robot{i + 1}")
             costmap_ros = SimpleNamespace(
-                costmap=self.cm, footprint=self.footprint, global_frame="map"
+                costmap=self.cm,
+                footprint=self.footprint,
+                footprint_padding=padding,
+                global_frame="map",
             )
             pl = CollvoidLocalPlanner.from_namespace(
                 node, costmap_ros, {**LIMITS, **params}, f"robot{i + 1}"

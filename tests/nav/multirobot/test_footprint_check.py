@@ -183,6 +183,29 @@ def test_a_jackal_wedged_nose_in_towards_a_parked_robot_backs_out_turning_away(t
         assert f.planners[0].escapes > 5  # to and fro
 
 
+@pytest.mark.parametrize("padding", [0.05, 0.0])
+def test_a_jackal_flush_on_a_wall_peels_off_within_its_padding(padding):
+    """The jackals' corridor of 4, seed 27: jackal1 passed jackal3 parked on its goal along
+    the wall and ended with its padded footprint flush on the wall's cells, its goal 0.8 m
+    ahead and 0.65 m off the wall, the corridor's end wall beyond. A rectangle flush on a wall
+    cannot turn either way (each turn swings a wall-side corner into it), and straight on
+    ends at the end wall: it crept ahead and escaped back for the rest of the run. Wedged
+    again where it was wedged before, it turns off the wall within its padding (0.05 m), its
+    body never on a lethal cell. Without a padding to use (``padding`` 0: the same footprint
+    as the body) it stays wedged."""
+    jackal = np.array([[-0.31, -0.27], [-0.31, 0.27], [0.31, 0.27], [0.31, -0.27]])
+    body = np.array([[-0.26, -0.22], [-0.26, 0.22], [0.26, 0.22], [0.26, -0.22]])
+    walls = [(-3.0, 0.30, 3.0, 1.5), (1.55, -1.5, 3.0, 1.5), (-3.0, -1.5, 3.0, -1.2)]
+    limits = {"max_vel_theta": 1.57, "min_vel_theta": -1.57, "min_in_place_vel_theta": 0.5,
+              "acc_lim_x": 2.0, "acc_lim_theta": 3.0}  # fmt: skip
+    f = Fleet([(0.0, 0.029, 0.0)], [(0.8, -0.62, 0.0)], walls=walls, footprint=jackal,
+              padding=padding, **limits)  # fmt: skip
+    f.planners[0].set_plan(np.array([[x, 0.0 if x < 0.6 else -0.62 * (x - 0.6) / 0.2, 0.0]
+                                     for x in np.linspace(0.0, 0.8, 17)]))  # fmt: skip
+    assert drive_off_the_walls(f, 20.0, outline_points(body, 0.05)) is (padding > 0.0)
+    assert (f.planners[0].way_outs >= 1) is (padding > 0.0)
+
+
 def test_the_escape_turns_towards_the_holonomic_velocity_then_tries_straight():
     from types import SimpleNamespace
 

@@ -27,6 +27,7 @@ import math
 import numpy as np
 
 from fleetsim.nav.controllers.base import VelocityCommand
+from fleetsim.nav.costmap.footprint import footprint_cost_at
 from fleetsim.nav.multirobot.footprint_check import footprint_safe_command
 from fleetsim.nav.multirobot.holonomic import (
     rotated,
@@ -51,6 +52,14 @@ UNTRUNCATED = 1e3
 
 def _clamp(v: float, lo: float, hi: float) -> float:
     return max(lo, min(hi, v))
+
+
+def _touches(grid, outline: np.ndarray, pose) -> bool:
+    """Whether ``outline`` (M, 2) m at ``pose`` lies on a lethal or unknown cell of ``grid``
+    (costs, origin, resolution)."""
+    costs, origin, res = grid
+    x, y, yaw = (float(a) for a in pose)
+    return footprint_cost_at(costs, float(origin[0]), float(origin[1]), res, outline, x, y, yaw) < 0
 
 
 class CollvoidDrive:
@@ -136,14 +145,20 @@ class CollvoidDrive:
             )  # fmt: skip
         horizon = self.horizon_obst if self.horizon_obst < UNTRUNCATED else p.time_horizon_obst
 
-        def clear(wanted, holo):
+        body = self.body_outline
+        outline = self.outline
+        if body is not None and _touches(self.grid, outline, pose):
+            # within its padding of an obstacle: its body is checked (rather than nothing)
+            outline = body
+
+        def clear(wanted, holo, outline=outline):
             return footprint_safe_command(
                 wanted,
                 holo,
                 tuple(float(a) for a in pose),
                 (float(velocity[0]), float(velocity[2])),
                 self.grid,  # this cycle's local costmap, the other robots' images cleared
-                self.outline,
+                outline,
                 (-caps[1], caps[0], p.min_vel_theta, p.max_vel_theta, p.acc_lim_x, p.acc_lim_theta),
                 horizon,
             )
@@ -171,7 +186,21 @@ class CollvoidDrive:
         v, w, self.replaced = clear((cmd[0], cmd[2]), self.last_holo)
         still = abs(v) < 1e-3 and abs(w) < 1e-3
         wants = float(np.hypot(*self.last_holo)) > STILL_HOLO
-        if self.replaced and still and wants and not self.waiting and escape > 0.0:
+        if not (self.replaced and still and wants and not self.waiting):
+            return v, 0.0, w
+        # wedged again where it was wedged before: backing out did not free it (a rectangle
+        # flush on a wall, which no turn leaves without swinging a corner into the wall, and
+        # straight on only ends at the next wall); its padding is the room it peels off in
+        again = self.wedged_at is not None and (
+            float(np.hypot(*(xy - self.wedged_at))) < ESCAPE_DISTANCE
+        )
+        self.wedged_at = xy
+        if again and body is not None and outline is not body:
+            bv, bw, _ = clear((cmd[0], cmd[2]), self.last_holo, body)
+            if abs(bv) >= 1e-3 or abs(bw) >= 1e-3:
+                self.way_outs += 1
+                return bv, 0.0, bw
+        if escape > 0.0:
             for sign in (-1.0, 1.0):
                 for turn in self._escape_turns(yaw, escape):
                     if may_escape(sign, turn):

@@ -85,6 +85,7 @@ from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
 from fleetsim.nav.costmap.footprint import (
     footprint_radii,
     outline_points,
+    padded_footprint,
     polygon_cells,
 )
 from fleetsim.nav.multirobot.crossing import GiveWay
@@ -151,6 +152,14 @@ class CollvoidLocalPlanner(
         if p.holonomic_robot:
             self.wall_radius = self.body_radius
         self.outline = outline_points(costmap_ros.footprint, self.costmap.resolution)
+        # the body (the footprint without its padding): what a robot within its padding of a
+        # wall is checked with, and how a robot flush on a wall peels off it (`CollvoidDrive`)
+        padding = float(getattr(costmap_ros, "footprint_padding", 0.0))
+        body = padded_footprint(costmap_ros.footprint, -padding)
+        res = self.costmap.resolution
+        self.body_outline = outline_points(body, res) if padding > 0.0 else None
+        self.wedged_at: np.ndarray | None = None  # where the robot was last wedged
+        self.way_outs = 0  # how often it peeled off within its padding
         self.replaced = False  # this cycle's command was replaced by a footprint-clear one
         self.walls_blocked = False  # this cycle the walls left the circumscribed disc no way
         self.escape_from: np.ndarray | None = None  # where a wedged robot began backing out
@@ -230,6 +239,7 @@ class CollvoidLocalPlanner(
             self.retreat.reset()
             self.give_way.reset()
             self.escape_from = None
+            self.wedged_at = None
             self.replanned_for.clear()
             self.progress = (math.inf, self.node.now())
 

@@ -129,6 +129,12 @@ class Costmap2DROS:
         """The padded footprint polygon, (K, 2) m in the robot frame."""
         return self.layered.footprint
 
+    @property
+    def footprint_padding(self) -> float:
+        """m the footprint is padded by (``footprint_padding``): the padded footprint shrunk
+        by it is the robot's body (Costmap2DROS's unpadded footprint)."""
+        return float(self.layered.params.footprint_padding)
+
     def _warn(self, key: str, text: str, period: float = 5.0) -> None:
         """Warn at most once every ``period`` s of sim time per key (ROS_WARN_THROTTLE)."""
         now = self.node.now()

@@ -17,7 +17,8 @@ holonomic ORCA velocity to the command a base can follow.
 
 `CollvoidDrive` is mixed into the planner, which owns the state it reads (``params``,
 ``lines``, ``last_holo``, ``yielding_to``, ``waiting``, ``turning_to``, ``outline``,
-``costmap``, ``dt``, ``escape_from``, ``escape_sign``, ``escape_turn``, ``escapes``).
+``costmap``, ``dt``, ``escape_from``, ``escape_sign``, ``escape_turn``, ``escapes``,
+``escaped_at``, ``body_outline``, ``peeling``, ``way_outs``).
 """
 
 from __future__ import annotations
@@ -145,11 +146,11 @@ class CollvoidDrive:
             )  # fmt: skip
         horizon = self.horizon_obst if self.horizon_obst < UNTRUNCATED else p.time_horizon_obst
 
-        body = self.body_outline
         outline = self.outline
-        if body is not None and _touches(self.grid, outline, pose):
-            # within its padding of an obstacle: its body is checked (rather than nothing)
-            outline = body
+        if self.peeling:  # off a wall within its padding: the body is checked until it is out
+            self.peeling = _touches(self.grid, outline, pose)
+            if self.peeling:
+                outline = self.body_outline
 
         def clear(wanted, holo, outline=outline):
             return footprint_safe_command(
@@ -188,23 +189,25 @@ class CollvoidDrive:
         wants = float(np.hypot(*self.last_holo)) > STILL_HOLO
         if not (self.replaced and still and wants and not self.waiting):
             return v, 0.0, w
-        # wedged again where it was wedged before: backing out did not free it (a rectangle
+        # wedged again where its last escape began: backing out did not free it (a rectangle
         # flush on a wall, which no turn leaves without swinging a corner into the wall, and
-        # straight on only ends at the next wall); its padding is the room it peels off in
-        again = self.wedged_at is not None and (
-            float(np.hypot(*(xy - self.wedged_at))) < ESCAPE_DISTANCE
-        )
-        self.wedged_at = xy
-        if again and body is not None and outline is not body:
-            bv, bw, _ = clear((cmd[0], cmd[2]), self.last_holo, body)
+        # straight on only ends at the next wall); its padding is the room it peels off in.
+        # Then the next wedge here escapes again: escapes and way outs take turns
+        escaped = self.escaped_at
+        self.escaped_at = None
+        again = escaped is not None and float(np.hypot(*(xy - escaped))) < ESCAPE_DISTANCE
+        if again and self.body_outline is not None:
+            bv, bw, _ = clear((cmd[0], cmd[2]), self.last_holo, self.body_outline)
             if abs(bv) >= 1e-3 or abs(bw) >= 1e-3:
                 self.way_outs += 1
+                self.peeling = True
                 return bv, 0.0, bw
         if escape > 0.0:
             for sign in (-1.0, 1.0):
                 for turn in self._escape_turns(yaw, escape):
                     if may_escape(sign, turn):
                         self.escape_from, self.escape_sign = xy, sign
+                        self.escaped_at = xy
                         self.escape_turn = turn
                         self.escapes += 1
                         return sign * escape, 0.0, turn

@@ -158,8 +158,10 @@ class CollvoidLocalPlanner(
         body = padded_footprint(costmap_ros.footprint, -padding)
         res = self.costmap.resolution
         self.body_outline = outline_points(body, res) if padding > 0.0 else None
-        self.wedged_at: np.ndarray | None = None  # where the robot was last wedged
+        #: where the last escape began (a way out is taken when wedged there again)
+        self.escaped_at: np.ndarray | None = None
         self.way_outs = 0  # how often it peeled off within its padding
+        self.peeling = False  # since then its padded footprint has touched an obstacle
         self.replaced = False  # this cycle's command was replaced by a footprint-clear one
         self.walls_blocked = False  # this cycle the walls left the circumscribed disc no way
         self.escape_from: np.ndarray | None = None  # where a wedged robot began backing out
@@ -239,7 +241,8 @@ class CollvoidLocalPlanner(
             self.retreat.reset()
             self.give_way.reset()
             self.escape_from = None
-            self.wedged_at = None
+            self.escaped_at = None
+            self.peeling = False
             self.replanned_for.clear()
             self.progress = (math.inf, self.node.now())
 

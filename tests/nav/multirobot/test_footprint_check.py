@@ -206,6 +206,29 @@ def test_a_jackal_flush_on_a_wall_peels_off_within_its_padding(padding):
     assert (f.planners[0].way_outs >= 1) is (padding > 0.0)
 
 
+def test_a_fallback_command_holds_its_direction_while_it_serves():
+    """The holonomic velocity points square to the lizi's left and a wall ahead refuses the
+    wanted command: a forward turn left and a backward turn right end about as near where it
+    leads. Scored afresh from the measured velocity each cycle, a pioneer3at by its goal took
+    one, then the other, and stood for 40 s (the corridor of 4, seed 28). The way the last
+    fallback command went is held unless the other way ends `REVERSE_MARGIN` nearer; and where
+    that way is blocked the robot turns round all the same."""
+    cm = empty_map([(0.6, -1.0, 0.8, 1.0)])
+    limits = (-0.5, 0.5, -1.5, 1.5, 2.0, 3.0)
+    args = ((0.5, 0.0), np.array([0.0, 0.3]), (0.0, 0.0, 0.0), (0.0, 0.0), grid_of(cm), OUTLINE)
+    v0, w0, replaced = footprint_safe_command(*args, limits, 1.0)
+    assert replaced and v0 > 0.0 and w0 > 0.0  # ahead, turning left (nearest the wanted one)
+    assert footprint_safe_command(*args, limits, 1.0, 1.0)[:2] == (v0, w0)
+    vb, wb, _ = footprint_safe_command(*args, limits, 1.0, -1.0)
+    assert vb < 0.0 and wb < 0.0  # backing, turning right: its centre goes left all the same
+    # a wall 1 cm from its nose: the direction held is blocked, so it is not taken (it
+    # stands, where the backward turn is not REVERSE_MARGIN nearer; then it is wedged)
+    nose = empty_map([(0.21, -1.0, 0.4, 1.0)])
+    args = ((0.5, 0.0), np.array([0.0, 0.3]), (0.0, 0.0, 0.0), (0.0, 0.0), grid_of(nose), OUTLINE)
+    assert footprint_safe_command(*args, limits, 1.0)[0] < 0.0
+    assert footprint_safe_command(*args, limits, 1.0, 1.0)[:2] == (0.0, 0.0)
+
+
 def test_the_escape_turns_towards_the_holonomic_velocity_then_tries_straight():
     from types import SimpleNamespace
 

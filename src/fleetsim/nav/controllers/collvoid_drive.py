@@ -152,6 +152,10 @@ class CollvoidDrive:
             if self.peeling:
                 outline = self.body_outline
 
+        # the way the last fallback command went (held while it serves, `REVERSE_MARGIN`)
+        direction = math.copysign(1.0, self.fallback_v) if abs(self.fallback_v) > 1e-3 else 0.0
+        self.fallback_v = 0.0
+
         def clear(wanted, holo, outline=outline):
             return footprint_safe_command(
                 wanted,
@@ -162,6 +166,7 @@ class CollvoidDrive:
                 outline,
                 (-caps[1], caps[0], p.min_vel_theta, p.max_vel_theta, p.acc_lim_x, p.acc_lim_theta),
                 horizon,
+                direction,
             )
 
         xy = np.array(pose[:2], dtype=np.float64)
@@ -185,6 +190,8 @@ class CollvoidDrive:
                 return sign * escape, 0.0, turn
             self.escape_from = None
         v, w, self.replaced = clear((cmd[0], cmd[2]), self.last_holo)
+        if self.replaced:
+            self.fallback_v = v
         still = abs(v) < 1e-3 and abs(w) < 1e-3
         wants = float(np.hypot(*self.last_holo)) > STILL_HOLO
         if not (self.replaced and still and wants and not self.waiting):

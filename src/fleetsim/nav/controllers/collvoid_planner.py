@@ -168,6 +168,7 @@ class CollvoidLocalPlanner(
         self.escape_sign = -1.0  # backing out (-1) or ahead (+1)
         self.escape_turn = 0.0  # rad/s, its turn (`_escape_turns`)
         self.escapes = 0  # how often it did
+        self.fallback_v = 0.0  # m/s, last cycle's footprint-clear replacement's speed (or 0)
         self.share = PositionShare(node, eps=p.eps)
         self.deadlock = DeadlockRule.from_params(self.robot_id, p)
         self._covariance: np.ndarray | None = None  # own localization's, map frame

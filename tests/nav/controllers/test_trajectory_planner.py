@@ -2,7 +2,6 @@
 
 import logging
 import math
-import types
 
 import numpy as np
 import pytest
@@ -351,9 +350,7 @@ class _CostmapROS:
     def __init__(self, costmap, pose, frame, footprint=None, padding=0.0):
         self.costmap, self._pose, self.global_frame = costmap, pose, frame
         self.footprint = footprint
-        self.layered = types.SimpleNamespace(
-            params=types.SimpleNamespace(footprint_padding=padding)
-        )
+        self.footprint_padding = padding
 
     def robot_pose(self):
         return self._pose

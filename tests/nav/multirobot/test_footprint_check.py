@@ -211,8 +211,8 @@ def test_a_fallback_command_holds_its_direction_while_it_serves():
     wanted command: a forward turn left and a backward turn right end about as near where it
     leads. Scored afresh from the measured velocity each cycle, a pioneer3at by its goal took
     one, then the other, and stood for 40 s (the corridor of 4, seed 28). The way the last
-    fallback command went is held unless the other way ends `REVERSE_MARGIN` nearer; and where
-    that way is blocked the robot turns round all the same."""
+    fallback command went is held unless the other way ends `REVERSE_MARGIN` nearer; where
+    that way is blocked it is not taken (the robot stands, and its drive escapes)."""
     cm = empty_map([(0.6, -1.0, 0.8, 1.0)])
     limits = (-0.5, 0.5, -1.5, 1.5, 2.0, 3.0)
     args = ((0.5, 0.0), np.array([0.0, 0.3]), (0.0, 0.0, 0.0), (0.0, 0.0), grid_of(cm), OUTLINE)
@@ -227,6 +227,30 @@ def test_a_fallback_command_holds_its_direction_while_it_serves():
     args = ((0.5, 0.0), np.array([0.0, 0.3]), (0.0, 0.0, 0.0), (0.0, 0.0), grid_of(nose), OUTLINE)
     assert footprint_safe_command(*args, limits, 1.0)[0] < 0.0
     assert footprint_safe_command(*args, limits, 1.0, 1.0)[:2] == (0.0, 0.0)
+
+
+def test_the_drive_hands_the_last_fallbacks_direction_to_the_next_and_drops_it_on_a_new_goal(
+    monkeypatch,
+):
+    """The direction held (`REVERSE_MARGIN`) is that of the last cycle's replacement: none
+    after a cycle whose command stood, none for a new goal or after the goal turn."""
+    seen, answers = [], iter([(0.2, 0.1, True), (-0.1, 0.0, True), (0.3, 0.0, False)] * 9)
+
+    def fake(wanted, holonomic, pose, velocity, grid, outline, limits, horizon, direction=0.0):
+        seen.append(direction)
+        return next(answers)
+
+    monkeypatch.setattr("fleetsim.nav.controllers.collvoid_drive.footprint_safe_command", fake)
+    f = Fleet([(0.0, 0.0, 0.0)], [(3.0, 0.0, 0.0)])
+    pl = f.planners[0]
+    for _ in range(4):
+        pl.compute_velocity_commands((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    assert seen == [0.0, 1.0, -1.0, 0.0]  # ahead, back, kept (not replaced), ahead
+    pl.set_plan(np.array([[0.0, 0.0, 0.0], [0.0, 2.0, 0.0]]))  # a new goal 3.6 m away
+    pl.compute_velocity_commands((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+    assert seen[-1] == 0.0 and pl.fallback_v == -0.1
+    pl.compute_velocity_commands((0.0, 2.0, 0.0), (0.0, 0.0, 0.0))  # within the goal: turning
+    assert pl.fallback_v == 0.0
 
 
 def test_the_escape_turns_towards_the_holonomic_velocity_then_tries_straight():

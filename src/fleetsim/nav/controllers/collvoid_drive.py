@@ -8,17 +8,23 @@ holonomic ORCA velocity to the command a base can follow.
   (`speed_nearest_still`), and so does one giving way at a crossing, turning on the spot
   towards its way; then the command's rollout over ``time_horizon_obst`` is checked
   with the real footprint on the local costmap and, if it touches an obstacle, replaced by the
-  clear command that best follows the holonomic velocity (`footprint_safe_command`); a robot
-  wedged (the best clear command is to stand) backs out a little, on a curve towards the
-  holonomic velocity where that is clear, else straight, or where it cannot, goes ahead a
-  little the same way;
+  clear command that best follows the holonomic velocity (`footprint_safe_command`; it holds
+  the direction, ahead or back, of the last cycle's replacement unless the other way ends
+  `REVERSE_MARGIN` nearer); a robot wedged (the best clear command is to stand) backs out a
+  little, on a curve towards the holonomic velocity where that is clear, else straight, or
+  where it cannot, goes ahead a little the same way; wedged again where that escape began, it
+  takes the clear command its body (the footprint without ``footprint_padding``) allows, and
+  its body is checked until its padded footprint is clear again (the way out of the padding;
+  the next wedge there escapes again);
 * every command within ``acc_lim_x``/``acc_lim_y``/``acc_lim_theta`` of the last;
 * within the goal's xy tolerance, the turn in place to the goal yaw (base_local_planner's).
 
-`CollvoidDrive` is mixed into the planner, which owns the state it reads (``params``,
-``lines``, ``last_holo``, ``yielding_to``, ``waiting``, ``turning_to``, ``outline``,
-``costmap``, ``dt``, ``escape_from``, ``escape_sign``, ``escape_turn``, ``escapes``,
-``escaped_at``, ``body_outline``, ``peeling``, ``way_outs``).
+`CollvoidDrive` is mixed into the planner, which owns the state it reads and writes
+(``params``, ``lines``, ``contact_lines``, ``grid``, ``last_holo``, ``last_w``, ``yielding_to``,
+``waiting``, ``turning_to``, ``outline``, ``body_outline``, ``horizon_obst``, ``dt``,
+``replaced``, ``local_plan``, ``escape_from``, ``escape_sign``, ``escape_turn``, ``escapes``,
+``escaped_at``, ``peeling``, ``way_outs``, ``fallback_v``, ``rotating_to_goal``,
+``reached_goal``, ``xy_tolerance_latch``).
 """
 
 from __future__ import annotations
@@ -132,7 +138,14 @@ class CollvoidDrive:
         (`_escape_turns`), else straight; where it cannot back out, ahead the same way (a robot
         wedged tail first: mixed circle of 16, seed 3, pioneer16 stood 0.4 m from its goal
         from 45 s to the end, its goal to its right, a parked pioneer behind its left corner,
-        so every turn towards the goal hit that robot, while straight ahead was clear)."""
+        so every turn towards the goal hit that robot, while straight ahead was clear).
+
+        Wedged again where its last escape began (backing out did not free it: a rectangle
+        flush on a wall, where each turn swings a wall-side corner into the wall and straight
+        on ends at the next wall; the jackals' corridor of 4, seed 27), the robot takes the
+        clear command its body allows, as TrajectoryPlannerROS's padding way out does, and
+        its body is checked until its padded footprint is clear again. No way out is tried
+        where no escape was (a robot that cannot back out or go ahead stands, as before)."""
         p, yaw = self.params, pose[2]
         points, dirs, n_obst = self.lines
         u = np.array([math.cos(yaw), math.sin(yaw)])
@@ -208,6 +221,7 @@ class CollvoidDrive:
             if abs(bv) >= 1e-3 or abs(bw) >= 1e-3:
                 self.way_outs += 1
                 self.peeling = True
+                self.fallback_v = bv  # the way it goes is held, as a fallback's
                 return bv, 0.0, bw
         if escape > 0.0:
             for sign in (-1.0, 1.0):
@@ -251,6 +265,7 @@ class CollvoidDrive:
 
     def _at_goal(self, yaw: float, goal_yaw: float) -> VelocityCommand:
         p = self.params
+        self.fallback_v = 0.0  # no fallback direction carried past the goal
         ang = math.remainder(goal_yaw - yaw, 2 * math.pi)
         if abs(ang) <= p.yaw_goal_tolerance:
             self.rotating_to_goal = False

@@ -39,7 +39,9 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    the real footprint on the local costmap and, if that touches a lethal cell, replaced by
    the clear command that best follows the holonomic velocity
    (`fleetsim.nav.multirobot.footprint_check`: collvoid checks static obstacles with the
-   footprint, base_local_planner-style, and keeps its velocity obstacles for the robots);
+   footprint, base_local_planner-style, and keeps its velocity obstacles for the robots),
+   holding the last replacement's direction; a wedged robot escapes, and wedged again there,
+   turns off the wall within its ``footprint_padding`` (`collvoid_drive`);
 6. within ``xy_goal_tolerance`` the robot stops and turns in place to the goal yaw, as
    base_local_planner does (at ``max_vel_theta``, slowed only to stop on the yaw);
 7. the plan goes back to move_base (`NoValidTrajectory`: it plans again from where the robot
@@ -161,7 +163,7 @@ class CollvoidLocalPlanner(
         #: where the last escape began (a way out is taken when wedged there again)
         self.escaped_at: np.ndarray | None = None
         self.way_outs = 0  # how often it peeled off within its padding
-        self.peeling = False  # since then its padded footprint has touched an obstacle
+        self.peeling = False  # from a way out until its padded footprint is clear again
         self.replaced = False  # this cycle's command was replaced by a footprint-clear one
         self.walls_blocked = False  # this cycle the walls left the circumscribed disc no way
         self.escape_from: np.ndarray | None = None  # where a wedged robot began backing out
@@ -244,6 +246,7 @@ class CollvoidLocalPlanner(
             self.escape_from = None
             self.escaped_at = None
             self.peeling = False
+            self.fallback_v = 0.0
             self.replanned_for.clear()
             self.progress = (math.inf, self.node.now())
 

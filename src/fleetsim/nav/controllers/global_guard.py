@@ -81,7 +81,7 @@ class GlobalCostmapGuard:
         """The body's outline points, half a global cell apart (kept while the footprint, its
         padding and the global resolution stay the same)."""
         fp = self.local_costmap.footprint
-        padding = self.local_costmap.layered.params.footprint_padding
+        padding = self.local_costmap.footprint_padding
         key = (fp.tobytes(), padding, resolution)
         if key != self._body_key:
             body = padded_footprint(fp, -padding)

@@ -16,7 +16,8 @@ here the same split is made after the fact:
 * `footprint_safe_command` keeps the planner's command when its rollout is clear, else takes
   the clear one from a (v, w) grid over the robot's limits whose rollout ends nearest where
   the holonomic velocity leads (forwards or backwards: a lizi beside a wall that cannot turn
-  on the spot backs out straight).
+  on the spot backs out straight), holding the direction of the caller's last replacement
+  unless the other way ends `REVERSE_MARGIN` nearer.
 
 The rollout's simulation is base_local_planner's, written again here rather than imported:
 `fleetsim.nav.controllers.rollout.trajectory_costs` also scores path and goal distance maps,
@@ -123,7 +124,8 @@ def footprint_safe_command(
     measured (v, w).
 
     direction : the sign of the last fallback command's speed (0: none): a command the other
-    way round must end `REVERSE_MARGIN` nearer.
+    way round must end `REVERSE_MARGIN` nearer (standing and turning on the spot are not
+    penalised, so where the held direction is blocked standing may win: the caller's wedge).
 
     When the robot's footprint already collides where it stands, nothing can be judged and
     ``wanted`` is kept; when every command collides, those that collide last compete.

@@ -15,7 +15,7 @@ from fleetsim.nav.controllers import (
 )
 from fleetsim.nav.controllers.map_grid import distances_from_targets
 from fleetsim.nav.costmap import Costmap2D
-from fleetsim.nav.costmap.footprint import footprint_from_radius
+from fleetsim.nav.costmap.footprint import footprint_from_radius, padded_footprint
 
 
 def corridor():
@@ -345,12 +345,13 @@ def test_escaping_with_alignment_backs_on_rather_than_turn_away_from_the_path(al
 
 class _CostmapROS:
     """What `GlobalCostmapGuard` reads of a Costmap2DROS: the grid, its frame, the robot's pose, the
-    (padded) footprint and its padding."""
+    (padded) footprint and the body without its padding."""
 
     def __init__(self, costmap, pose, frame, footprint=None, padding=0.0):
         self.costmap, self._pose, self.global_frame = costmap, pose, frame
         self.footprint = footprint
-        self.footprint_padding = padding
+        body = None if footprint is None else padded_footprint(footprint, -padding)
+        self.unpadded_footprint = body
 
     def robot_pose(self):
         return self._pose

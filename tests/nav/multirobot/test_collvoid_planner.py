@@ -15,7 +15,7 @@ from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.nav.controllers.collvoid_params import CollvoidParams
 from fleetsim.nav.controllers.collvoid_planner import CollvoidLocalPlanner
 from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE, NO_INFORMATION, Costmap2D
-from fleetsim.nav.costmap.footprint import footprint_at, polygon_cells
+from fleetsim.nav.costmap.footprint import footprint_at, padded_footprint, polygon_cells
 from fleetsim.nav.move_base_plugins import LOCAL_PLANNERS
 from fleetsim.nav.multirobot.deadlock import DeadlockRule, priority_key
 from fleetsim.nav.multirobot.holonomic import (
@@ -60,7 +60,7 @@ class Fleet:
             costmap_ros = SimpleNamespace(
                 costmap=self.cm,
                 footprint=self.footprint,
-                footprint_padding=padding,
+                unpadded_footprint=padded_footprint(self.footprint, -padding),
                 global_frame="map",
             )
             pl = CollvoidLocalPlanner.from_namespace(

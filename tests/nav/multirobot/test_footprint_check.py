@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 from test_collvoid_planner import BODY, LIZI, Fleet, empty_map
 
-from fleetsim.nav.costmap.footprint import footprint_costs, outline_points
+from fleetsim.nav.costmap.footprint import footprint_costs, outline_points, padded_footprint
 from fleetsim.nav.multirobot.footprint_check import (
     STEPS,
     first_collisions,
@@ -18,6 +18,10 @@ from fleetsim.nav.multirobot.footprint_check import (
 )
 
 OUTLINE = outline_points(LIZI, 0.05)
+#: the multi-robot scenarios' jackal: its chassis padded by 5 cm, and its limits
+JACKAL = np.array([[-0.31, -0.27], [-0.31, 0.27], [0.31, 0.27], [0.31, -0.27]])
+JACKAL_LIMITS = {"max_vel_theta": 1.57, "min_vel_theta": -1.57, "min_in_place_vel_theta": 0.5,
+                 "acc_lim_x": 2.0, "acc_lim_theta": 3.0}  # fmt: skip
 
 
 def drive_off_the_walls(f, seconds: float, outline=OUTLINE) -> bool:
@@ -170,14 +174,10 @@ def test_a_jackal_wedged_nose_in_towards_a_parked_robot_backs_out_turning_away(t
     curve that turns it towards the holonomic velocity leaves it facing along the wall."""
     if not turn:
         monkeypatch.setattr("fleetsim.nav.controllers.collvoid_drive.ESCAPE_TURN", 0.0)
-    jackal = np.array([[-0.31, -0.27], [-0.31, 0.27], [0.31, 0.27], [0.31, -0.27]])
-    outline = outline_points(jackal, 0.05)
     walls = [(-3.0, -1.5, 3.0, -0.45), (0.30, 0.30, 0.92, 0.84)]  # the wall, jackal3's body
-    limits = {"max_vel_theta": 1.57, "min_vel_theta": -1.57, "min_in_place_vel_theta": 0.5,
-              "acc_lim_x": 2.0, "acc_lim_theta": 3.0}  # fmt: skip
     f = Fleet([(0.0, 0.0, math.radians(13.0))], [(2.5, -0.1, 0.0)], walls=walls,
-              footprint=jackal, **limits)  # fmt: skip
-    assert drive_off_the_walls(f, 20.0, outline) is turn
+              footprint=JACKAL, **JACKAL_LIMITS)  # fmt: skip
+    assert drive_off_the_walls(f, 20.0, outline_points(JACKAL, 0.05)) is turn
     assert f.planners[0].escapes >= 1
     if not turn:
         assert f.planners[0].escapes > 5  # to and fro
@@ -193,13 +193,10 @@ def test_a_jackal_flush_on_a_wall_peels_off_within_its_padding(padding):
     again where it was wedged before, it turns off the wall within its padding (0.05 m), its
     body never on a lethal cell. Without a padding to use (``padding`` 0: the same footprint
     as the body) it stays wedged."""
-    jackal = np.array([[-0.31, -0.27], [-0.31, 0.27], [0.31, 0.27], [0.31, -0.27]])
-    body = np.array([[-0.26, -0.22], [-0.26, 0.22], [0.26, 0.22], [0.26, -0.22]])
+    body = padded_footprint(JACKAL, -0.05)  # the chassis, 0.52 x 0.44 m
     walls = [(-3.0, 0.30, 3.0, 1.5), (1.55, -1.5, 3.0, 1.5), (-3.0, -1.5, 3.0, -1.2)]
-    limits = {"max_vel_theta": 1.57, "min_vel_theta": -1.57, "min_in_place_vel_theta": 0.5,
-              "acc_lim_x": 2.0, "acc_lim_theta": 3.0}  # fmt: skip
-    f = Fleet([(0.0, 0.029, 0.0)], [(0.8, -0.62, 0.0)], walls=walls, footprint=jackal,
-              padding=padding, **limits)  # fmt: skip
+    f = Fleet([(0.0, 0.029, 0.0)], [(0.8, -0.62, 0.0)], walls=walls, footprint=JACKAL,
+              padding=padding, **JACKAL_LIMITS)  # fmt: skip
     f.planners[0].set_plan(np.array([[x, 0.0 if x < 0.6 else -0.62 * (x - 0.6) / 0.2, 0.0]
                                      for x in np.linspace(0.0, 0.8, 17)]))  # fmt: skip
     assert drive_off_the_walls(f, 20.0, outline_points(body, 0.05)) is (padding > 0.0)
@@ -213,20 +210,23 @@ def test_a_fallback_command_holds_its_direction_while_it_serves():
     one, then the other, and stood for 40 s (the corridor of 4, seed 28). The way the last
     fallback command went is held unless the other way ends `REVERSE_MARGIN` nearer; where
     that way is blocked it is not taken (the robot stands, and its drive escapes)."""
-    cm = empty_map([(0.6, -1.0, 0.8, 1.0)])
     limits = (-0.5, 0.5, -1.5, 1.5, 2.0, 3.0)
-    args = ((0.5, 0.0), np.array([0.0, 0.3]), (0.0, 0.0, 0.0), (0.0, 0.0), grid_of(cm), OUTLINE)
-    v0, w0, replaced = footprint_safe_command(*args, limits, 1.0)
+
+    def args(wall):  # at the origin facing +x, standing; wanted: straight on; holo: left
+        grid = grid_of(empty_map([wall]))
+        return (0.5, 0.0), np.array([0.0, 0.3]), (0.0, 0.0, 0.0), (0.0, 0.0), grid, OUTLINE
+
+    ahead = args((0.6, -1.0, 0.8, 1.0))
+    v0, w0, replaced = footprint_safe_command(*ahead, limits, 1.0)
     assert replaced and v0 > 0.0 and w0 > 0.0  # ahead, turning left (nearest the wanted one)
-    assert footprint_safe_command(*args, limits, 1.0, 1.0)[:2] == (v0, w0)
-    vb, wb, _ = footprint_safe_command(*args, limits, 1.0, -1.0)
+    assert footprint_safe_command(*ahead, limits, 1.0, 1.0)[:2] == (v0, w0)
+    vb, wb, _ = footprint_safe_command(*ahead, limits, 1.0, -1.0)
     assert vb < 0.0 and wb < 0.0  # backing, turning right: its centre goes left all the same
     # a wall 1 cm from its nose: the direction held is blocked, so it is not taken (it
     # stands, where the backward turn is not REVERSE_MARGIN nearer; then it is wedged)
-    nose = empty_map([(0.21, -1.0, 0.4, 1.0)])
-    args = ((0.5, 0.0), np.array([0.0, 0.3]), (0.0, 0.0, 0.0), (0.0, 0.0), grid_of(nose), OUTLINE)
-    assert footprint_safe_command(*args, limits, 1.0)[0] < 0.0
-    assert footprint_safe_command(*args, limits, 1.0, 1.0)[:2] == (0.0, 0.0)
+    nose = args((0.21, -1.0, 0.4, 1.0))
+    assert footprint_safe_command(*nose, limits, 1.0)[0] < 0.0
+    assert footprint_safe_command(*nose, limits, 1.0, 1.0)[:2] == (0.0, 0.0)
 
 
 def test_the_drive_hands_the_last_fallbacks_direction_to_the_next_and_drops_it_on_a_new_goal(

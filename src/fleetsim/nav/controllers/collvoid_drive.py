@@ -34,8 +34,7 @@ import math
 import numpy as np
 
 from fleetsim.nav.controllers.base import VelocityCommand
-from fleetsim.nav.costmap.footprint import footprint_cost_at
-from fleetsim.nav.multirobot.footprint_check import footprint_safe_command
+from fleetsim.nav.multirobot.footprint_check import collides_at, footprint_safe_command
 from fleetsim.nav.multirobot.holonomic import (
     rotated,
     speed_along,
@@ -59,14 +58,6 @@ UNTRUNCATED = 1e3
 
 def _clamp(v: float, lo: float, hi: float) -> float:
     return max(lo, min(hi, v))
-
-
-def _touches(grid, outline: np.ndarray, pose) -> bool:
-    """Whether ``outline`` (M, 2) m at ``pose`` lies on a lethal or unknown cell of ``grid``
-    (costs, origin, resolution)."""
-    costs, origin, res = grid
-    x, y, yaw = (float(a) for a in pose)
-    return footprint_cost_at(costs, float(origin[0]), float(origin[1]), res, outline, x, y, yaw) < 0
 
 
 class CollvoidDrive:
@@ -161,7 +152,7 @@ class CollvoidDrive:
 
         outline = self.outline
         if self.peeling:  # off a wall within its padding: the body is checked until it is out
-            self.peeling = _touches(self.grid, outline, pose)
+            self.peeling = collides_at(self.grid, outline, pose)
             if self.peeling:
                 outline = self.body_outline
 

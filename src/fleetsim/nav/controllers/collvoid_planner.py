@@ -87,7 +87,6 @@ from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
 from fleetsim.nav.costmap.footprint import (
     footprint_radii,
     outline_points,
-    padded_footprint,
     polygon_cells,
 )
 from fleetsim.nav.multirobot.crossing import GiveWay
@@ -156,10 +155,9 @@ class CollvoidLocalPlanner(
         self.outline = outline_points(costmap_ros.footprint, self.costmap.resolution)
         # the body (the footprint without its padding): what a robot within its padding of a
         # wall is checked with, and how a robot flush on a wall peels off it (`CollvoidDrive`)
-        padding = float(getattr(costmap_ros, "footprint_padding", 0.0))
-        body = padded_footprint(costmap_ros.footprint, -padding)
-        res = self.costmap.resolution
-        self.body_outline = outline_points(body, res) if padding > 0.0 else None
+        body = getattr(costmap_ros, "unpadded_footprint", costmap_ros.footprint)
+        padded = not np.array_equal(body, costmap_ros.footprint)
+        self.body_outline = outline_points(body, self.costmap.resolution) if padded else None
         #: where the last escape began (a way out is taken when wedged there again)
         self.escaped_at: np.ndarray | None = None
         self.way_outs = 0  # how often it peeled off within its padding

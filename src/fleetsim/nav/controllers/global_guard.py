@@ -37,7 +37,7 @@ import numpy as np
 from numba import njit
 
 from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
-from fleetsim.nav.costmap.footprint import outline_points, padded_footprint
+from fleetsim.nav.costmap.footprint import outline_points
 
 
 class GlobalCostmapGuard:
@@ -78,13 +78,11 @@ class GlobalCostmapGuard:
         return self._transform or None
 
     def _body_outline(self, resolution: float) -> np.ndarray:
-        """The body's outline points, half a global cell apart (kept while the footprint, its
-        padding and the global resolution stay the same)."""
-        fp = self.local_costmap.footprint
-        padding = self.local_costmap.footprint_padding
-        key = (fp.tobytes(), padding, resolution)
+        """The body's outline points, half a global cell apart (kept while the body, the
+        local costmap's unpadded footprint, and the global resolution stay the same)."""
+        body = self.local_costmap.unpadded_footprint
+        key = (body.tobytes(), resolution)
         if key != self._body_key:
-            body = padded_footprint(fp, -padding)
             self._outline = np.ascontiguousarray(outline_points(body, 0.5 * resolution))
             self._body_key = key
         return self._outline

@@ -39,7 +39,7 @@ import numpy as np
 
 from fleetsim.errors import TransformError
 from fleetsim.msgs import geometry_msgs, nav_msgs, std_msgs
-from fleetsim.nav.costmap.footprint import footprint_at
+from fleetsim.nav.costmap.footprint import footprint_at, padded_footprint
 from fleetsim.nav.costmap.layer import Bounds, Layer
 from fleetsim.nav.costmap.layered_costmap import LayeredCostmap, occupancy_from_costs
 from fleetsim.nav.costmap.obstacle_layer import ObstacleLayer
@@ -130,10 +130,10 @@ class Costmap2DROS:
         return self.layered.footprint
 
     @property
-    def footprint_padding(self) -> float:
-        """m the footprint is padded by (``footprint_padding``): the padded footprint shrunk
-        by it is the robot's body (Costmap2DROS's unpadded footprint)."""
-        return float(self.layered.params.footprint_padding)
+    def unpadded_footprint(self) -> np.ndarray:
+        """The robot's body: the footprint without ``footprint_padding`` (Costmap2DROS's
+        getUnpaddedRobotFootprint), (K, 2) m in the robot frame."""
+        return padded_footprint(self.layered.footprint, -self.layered.params.footprint_padding)
 
     def _warn(self, key: str, text: str, period: float = 5.0) -> None:
         """Warn at most once every ``period`` s of sim time per key (ROS_WARN_THROTTLE)."""

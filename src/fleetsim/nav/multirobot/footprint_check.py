@@ -102,6 +102,14 @@ def first_collisions(
     return out
 
 
+def collides_at(grid, outline: np.ndarray, pose) -> bool:
+    """Whether ``outline`` (M, 2) m at ``pose`` (x, y, yaw) lies on a lethal or unknown cell
+    of ``grid`` (costs, origin, resolution)."""
+    costs, origin, res = grid
+    x, y, yaw = (float(a) for a in pose)
+    return footprint_cost_at(costs, float(origin[0]), float(origin[1]), res, outline, x, y, yaw) < 0
+
+
 def footprint_safe_command(
     wanted: tuple[float, float],
     holonomic: np.ndarray,
@@ -137,8 +145,7 @@ def footprint_safe_command(
     pose_a = np.asarray(pose, dtype=np.float64)
     vel = np.asarray(velocity, dtype=np.float64)
     acc = np.array([acc_v, acc_w])
-    x, y, th = pose
-    if footprint_cost_at(costs, origin_a[0], origin_a[1], res, outline, x, y, th) < 0:
+    if collides_at(grid, outline, pose):
         return wanted[0], wanted[1], False
     ends = np.empty((1, 2))
     first = first_collisions(

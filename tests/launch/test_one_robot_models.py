@@ -1,0 +1,134 @@
+"""``include/one_robot.launch`` (and ``robots.launch`` around it) with ``model:=``: the model
+alone picks the robot's description, parameters, laser topic and ground-truth topic, so a user's
+launch file gives a turtlebot3 or a jackal its whole stack without passing its description by
+hand. Explicit ``description`` / ``laser_topic`` / ``params`` still win."""
+
+from __future__ import annotations
+
+import logging
+from pathlib import Path
+
+import pytest
+import yaml
+
+import fleetsim
+from fleetsim.description.xacro import expand_xacro
+from fleetsim.launch.runner import LaunchSession, load_plan
+
+USER_LAUNCH = """<launch>
+  <arg name="model" default="lizi"/>
+  <arg name="localization" default="fake"/>
+  <param name="/use_sim_time" value="true"/>
+  <node pkg="map_server" type="map_server" name="map_server"
+        args="$(find fleetsim_maps)/open_room.yaml">
+    <param name="frame_id" value="/map"/>
+  </node>
+  <include file="$(find gazebo_ros)/launch/empty_world.launch">
+    <arg name="world_name" value="$(find fleetsim_maps)/open_room.yaml"/>
+    <arg name="gui" value="false"/>
+  </include>
+  <group ns="robot1">
+    <param name="tf_prefix" value="robot1"/>
+    <include file="$(find fleetsim_launch)/include/one_robot.launch">
+      <arg name="init_pose" value="-x 4.0 -y 7.0 -z 0"/>
+      <arg name="robot_name" value="robot1"/>
+      <arg name="model" value="$(arg model)"/>
+      <arg name="localization" value="$(arg localization)"/>
+    </include>
+  </group>
+  <node pkg="fleetsim" type="send_goals" name="send_goals">
+    <rosparam>
+      frame_id: map
+      start_delay: 1.0
+      goals:
+        robot1: [[6.0, 7.0, 0.0]]
+    </rosparam>
+  </node>
+</launch>
+"""
+
+# model -> (the description's package, the params directory, laser topic, ground truth topic)
+MODELS = {
+    "lizi": ("lizi", "lizi", "base_scan", "base_pose_ground_truth"),
+    "pioneer3at": ("pioneer3at", "pioneer3at", "scan", "base_pose_ground_truth"),
+    "burger": ("turtlebot3_burger", "burger", "scan", "odom"),
+    "turtlebot3_waffle": ("turtlebot3_waffle", "waffle", "scan", "odom"),
+    "jackal": ("jackal", "jackal", "front/scan", "ground_truth/state"),
+}
+
+
+def _user_launch(tmp_path: Path) -> Path:
+    path = tmp_path / "my_robot.launch"
+    path.write_text(USER_LAUNCH)
+    return path
+
+
+ASSETS = Path(fleetsim.__file__).parent / "assets"
+
+
+def _node(plan, name):
+    (node,) = [n for n in plan.nodes if n.name == name]
+    return node
+
+
+def _planner_params(plan) -> dict:
+    loads = [
+        p.value for p in plan.params if p.kind == "load" and p.name == "/robot1/move_base_node"
+    ]
+    return next(v["TrajectoryPlannerROS"] for v in loads if "TrajectoryPlannerROS" in v)
+
+
+@pytest.mark.parametrize("model", sorted(MODELS))
+def test_the_model_picks_description_params_laser_and_ground_truth(tmp_path, model):
+    package, params, scan, truth = MODELS[model]
+    plan = load_plan(_user_launch(tmp_path), {"model": model, "localization": "amcl"})
+    (description,) = [p for p in plan.params if p.name == "/robot1/robot_description"]
+    urdf, _ = expand_xacro(ASSETS / "robots" / package / "urdf" / f"{package}.urdf.xacro")
+    assert description.value == urdf
+    shipped = yaml.safe_load(
+        (ASSETS / "launch" / "params" / params / "base_local_planner_params.yaml").read_text()
+    )
+    assert _planner_params(plan) == shipped["TrajectoryPlannerROS"]
+    assert _node(plan, "amcl").remaps["scan"] == scan
+    plan = load_plan(_user_launch(tmp_path), {"model": model})
+    assert _node(plan, "fake_localization").remaps["base_pose_ground_truth"] == truth
+
+
+def test_an_explicit_description_still_wins(tmp_path):
+    text = (
+        _user_launch(tmp_path)
+        .read_text()
+        .replace(
+            '<arg name="model" value="$(arg model)"/>',
+            '<arg name="model" value="$(arg model)"/>\n'
+            '      <arg name="description" value="$(find pioneer3at)/urdf/pioneer3at.urdf.xacro"/>',
+        )
+    )
+    path = tmp_path / "explicit.launch"
+    path.write_text(text)
+    plan = load_plan(path, {"model": "lizi"})
+    (description,) = [p for p in plan.params if p.name == "/robot1/robot_description"]
+    urdf, _ = expand_xacro(ASSETS / "robots" / "pioneer3at" / "urdf" / "pioneer3at.urdf.xacro")
+    assert description.value == urdf
+    assert (
+        _planner_params(plan)["max_vel_x"]
+        == yaml.safe_load(
+            (ASSETS / "launch" / "params" / "lizi" / "base_local_planner_params.yaml").read_text()
+        )["TrajectoryPlannerROS"]["max_vel_x"]
+    )
+
+
+@pytest.mark.scenario
+def test_a_burger_from_one_robot_launch_reaches_its_goal_quietly(monkeypatch, tmp_path, caplog):
+    """The turtlebot3's `global_frame: map` is the shared /map, and fake_localization reads its
+    drive's world odometry: the goal 2 m ahead is reached, with no WARNING on the way."""
+    monkeypatch.chdir(tmp_path)  # where MuJoCo would write MUJOCO_LOG.TXT
+    plan = load_plan(_user_launch(tmp_path), {"model": "burger"})
+    with caplog.at_level(logging.WARNING), LaunchSession(plan, seed=1) as s:
+        s.run(duration=16.0)
+        engine = s.nodes["/gazebo"].engine
+        assert {i: w.number for i, w in enumerate(engine.data.warning) if w.number} == {}
+        (result,) = [r for r in s.monitor.results() if r.namespace.strip("/") == "robot1"]
+        assert (result.goals_reached, result.collisions) == (1, 0), result
+    assert [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING] == []
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()

@@ -426,6 +426,34 @@ def test_a_robot_passes_one_parked_off_the_middle_of_a_corridor():
     assert f.min_gap > 0.0 and np.all(np.abs(f.state[:, 1]) < 1.0 - BODY)
 
 
+def test_the_room_beside_a_standing_robot_is_judged_by_the_passage_not_orcas_leg():
+    """The lizis' corridor of 4 with amcl, seed 1: lizi4 parked on its goal in the 2 m
+    corridor's middle, lizi2 0.48 m above its line heading past it, its plan above it (0.8 m
+    of room there, 1.0 m below). ORCA's combined radius with both amcl spreads is the spread
+    across the leg the relative velocity passes: 0.71-0.81 m as the preferred velocity turned.
+    Judged by it the room above was shut one cycle (the way round went below it, and was kept)
+    and both sides the next, and lizi2 turned to and fro for 20 s. Judged by the passage's
+    width (the spreads across the line between the two) the side above is open, and taken."""
+    f = Fleet([(0.82, 0.48, math.pi)], [(-1.6, 0.48, math.pi)],
+              walls=[(-8, 0.96, 8, 1.2), (-8, -1.2, 8, -0.96)])  # fmt: skip
+    pl = f.planners[0]
+    pl.grid = (f.cm.costs, (f.cm.origin_x, f.cm.origin_y), f.cm.resolution)
+    xy, vel, pref = np.array([0.82, 0.48]), np.array([-0.4, 0.0]), np.array([-0.5, 0.0])
+    rel, standing = np.array([[-0.82, -0.48]]), np.zeros((1, 2))  # lizi4 at the origin
+
+    def way(radii, passage=None):
+        return pl._around_still(pref, xy, vel, rel, standing, np.array([radii]),
+                                np.array([True]), ["lizi4"], passage)  # fmt: skip
+
+    assert way(0.76)[1] < 0.0  # ORCA's radius, one leg: above shut, below open: it turns down
+    assert pl.detour_sides == {"lizi4": 1}
+    assert (way(0.80) == pref).all()  # the other leg: both shut, nothing to go round by
+    pl.detour_sides.clear()
+    assert way(0.76, np.array([0.62]))[1] > 0.0  # above, where its plan runs
+    assert pl.detour_sides == {"lizi4": 0}
+    assert way(0.80, np.array([0.62]))[1] > 0.0  # whichever leg ORCA pads by
+
+
 def test_a_goal_nudged_by_localization_is_the_same_goal_to_the_deadlock_rule():
     """move_base hands the plan over every cycle in odom, where each amcl correction moves the
     goal a few cm: the no-progress clock and the trail survive that, not a new goal."""

@@ -163,13 +163,16 @@ def test_a_robot_without_covariance_keeps_todays_radius_rule():
     assert r.covariance is None and r.body_radius == 0.4
     near = table.near(1.0, (0.0, 0.0), 10.0, 5)
     # fake localization here too: the radii as sent, the very array
-    orca, wide = CollvoidLocalPlanner.neighbour_radii(planner_stub(), 0.4, np.zeros(2), near)
-    assert orca is near.radii and wide is near.radii
+    orca, wide, room = CollvoidLocalPlanner.neighbour_radii(planner_stub(), 0.4, np.zeros(2), near)
+    assert orca is near.radii and wide is near.radii and room is near.radii
     # this robot uncertain, the other as sent plus this robot's spread (in contact: along x)
-    got, wide = CollvoidLocalPlanner.neighbour_radii(planner_stub(ALONG_X), 0.7, np.zeros(2), near)
+    got, wide, room = CollvoidLocalPlanner.neighbour_radii(
+        planner_stub(ALONG_X), 0.7, np.zeros(2), near
+    )
     assert got[0] == pytest.approx(0.4 + K * 0.15, abs=1e-3)
     # side by side (the line between them across x) only the spread across x counts, halved
     assert wide[0] == pytest.approx(0.4 + 0.5 * K * 0.005)
+    assert room[0] == wide[0]  # on its way, or sharing no spread: its disc
 
 
 def test_a_robot_sharing_a_covariance_is_its_body_padded_in_the_direction_that_matters():
@@ -191,8 +194,12 @@ def test_a_robot_sharing_a_covariance_is_its_body_padded_in_the_direction_that_m
     msg.holonomic_velocity.x = 0.0
     table.update(msg)
     near = table.near(1.0, (0.0, 0.0), 10.0, 5)
-    still = CollvoidLocalPlanner.neighbour_radii(planner_stub(), 0.35, np.zeros(2), near)[0][0]
-    assert 0.16 + 0.03 < still < 0.16 + 0.08 < got - 0.05
+    orca, wide, room = CollvoidLocalPlanner.neighbour_radii(planner_stub(), 0.35, np.zeros(2), near)
+    assert 0.16 + 0.03 < orca[0] < 0.16 + 0.08 < got - 0.05
+    # the room beside it (its way round: across the line between the two, here y) is its
+    # half width (0.16 m) plus half the spread across, where a passage takes its disc
+    assert room[0] == pytest.approx(0.16 + 0.5 * K * 0.005, abs=1e-6)
+    assert wide[0] == pytest.approx(body + 0.5 * K * 0.005, abs=1e-6)
 
 
 def test_a_body_in_the_pair_padding_shares_the_tangent_of_its_outline():

@@ -63,18 +63,20 @@ class CollvoidNeighbours:
 
     def neighbour_radii(
         self, own_r: float, map_xy: np.ndarray, near: Any, map_vel: Any = (0.0, 0.0)
-    ) -> tuple[np.ndarray, np.ndarray]:
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The others' radii (N,) m against this robot (``own_r`` m, at ``map_xy``, moving at
         ``map_vel`` m/s): for ORCA, each one's body grown by both robots' localization spreads
         across the leg of the pair's velocity obstacle the relative velocity passes
         (`pair_padding`); for the width of a passage, by half the
         spreads across the line between the two (`side_by_side_padding`: the spreads part the
-        two robots, not a robot from its walls, which it sees itself). The radius as sent for
-        a robot that shares no covariance; with no spread anywhere (fake_localization) the
-        radii as sent, exactly."""
+        two robots, not a robot from its walls, which it sees itself); for the room beside it
+        (the way round a robot standing in the way, `_around_still`), as the passage's but a
+        robot standing still that shares its spread by its body's extent across that line, not
+        its disc. The radius as sent for a robot that shares no covariance; with no spread
+        anywhere (fake_localization) the radii as sent, exactly, all three."""
         covs = near.covariances
         if self._covariance is None and not covs.any():
-            return near.radii, near.radii
+            return near.radii, near.radii, near.radii
         shared = covs.reshape(-1, 4).any(axis=1)
         body = np.where(shared, near.body_radii, near.radii)
         rel, cap, eps = near.positions - map_xy, 2.0 * self.body_radius, self.params.eps
@@ -88,6 +90,9 @@ class CollvoidNeighbours:
         # (the bisection's einsum), and with them the measured runs
         still = np.hypot(near.velocities[:, 0], near.velocities[:, 1]) < STILL_SPEED
         k = np.flatnonzero(shared & still)
+        across = side_by_side_padding(rel, self._covariance, cap, covs, 2.0 * body, eps)
+        wide = body + 0.5 * across
+        room = wide.copy()
         if k.size:
             shapes = [near.robots[i].body_in_map() for i in k]
             most = max(len(o) for o in shapes)  # other robots' footprints: repeat a corner
@@ -98,8 +103,13 @@ class CollvoidNeighbours:
                 rel[k], np.full(k.size, own_r), self._covariance, cap, covs[k],
                 2.0 * body[k], eps, vrel[k], bodies=outlines,
             )  # fmt: skip
-        across = side_by_side_padding(rel, self._covariance, cap, covs, 2.0 * body, eps)
-        return orca, body + 0.5 * across
+            # the room beside it: its body's extent across the line between the two (a lizi
+            # parked along a corridor is 0.16 m from its centre to its side, its disc 0.25 m)
+            d = np.maximum(np.hypot(rel[k, 0], rel[k, 1]), 1e-12)
+            perp = np.stack((-rel[k, 1] / d, rel[k, 0] / d), axis=1)
+            extent = np.abs(np.einsum("nkd,nd->nk", outlines, perp)).max(axis=1)
+            room[k] = extent + 0.5 * across[k]
+        return orca, wide, room
 
     def _map_to_local(self) -> tuple[float, float, float]:
         if self.frame == MAP_FRAME:
@@ -111,7 +121,8 @@ class CollvoidNeighbours:
         (own position in map (2,), ids, positions (N, 2), velocities (N, 2), radii (N,) against
         this robot of radius ``own_r`` moving at ``vel`` (`neighbour_radii`), ORCA
         responsibilities (N,): all of it for a robot not ``controlled`` or standing still, half
-        otherwise; controlled (N,) bool, yaws (N,), radii (N,) for the width of a passage).
+        otherwise; controlled (N,) bool, yaws (N,), radii (N,) for the width of a passage and
+        for the room beside each, `neighbour_radii`).
         None around without tf."""
         p, now = self.params, self.node.now()
         ids: list[str] = []
@@ -121,7 +132,7 @@ class CollvoidNeighbours:
             tx, ty, tyaw = self._map_to_local()
         except TransformError:
             self.near_robots = []
-            return xy, ids, pos, nvel, radii, resp, controlled, yaws, radii
+            return xy, ids, pos, nvel, radii, resp, controlled, yaws, radii, radii
         map_xy = rotated(xy - [tx, ty], -tyaw)
         near = self.share.table.near(
             now, (map_xy[0], map_xy[1]), p.neighbor_dist, p.max_neighbors, self.robot_id
@@ -133,6 +144,6 @@ class CollvoidNeighbours:
         still = np.hypot(nvel[:, 0], nvel[:, 1]) < STILL_SPEED
         resp = np.where(~near.controlled | still, 1.0, 0.5)
         yaws = np.array([r.yaw for r in near.robots]) + tyaw
-        radii, wide = self.neighbour_radii(own_r, map_xy, near, rotated(vel, -tyaw))
+        radii, wide, room = self.neighbour_radii(own_r, map_xy, near, rotated(vel, -tyaw))
         self.near_robots = near.robots  # their outlines when parked (`_near_outline`)
-        return map_xy, near.ids, pos, nvel, radii, resp, near.controlled, yaws, wide
+        return map_xy, near.ids, pos, nvel, radii, resp, near.controlled, yaws, wide, room

@@ -280,7 +280,7 @@ class CollvoidLocalPlanner(
             carrot, xy, remaining, p.max_vel_x, p.min_vel_x, DECELERATION * p.acc_lim_x
         )
         own_r = self.own_radius(float(np.hypot(*vel)))
-        map_xy, ids, pos, nvel, radii, resp, controlled, yaws, wide = self._neighbours(
+        map_xy, ids, pos, nvel, radii, resp, controlled, yaws, wide, room = self._neighbours(
             xy, own_r, vel
         )
         stuck = self._stuck_for(now, remaining)
@@ -290,8 +290,8 @@ class CollvoidLocalPlanner(
                 self._plan_through_parked(now, ids, pos, yaws, parked)
             keep = ~parked
             ids = [i for i, k in zip(ids, keep.tolist()) if k]
-            pos, nvel, radii, resp, controlled, yaws, wide = (
-                a[keep] for a in (pos, nvel, radii, resp, controlled, yaws, wide)
+            pos, nvel, radii, resp, controlled, yaws, wide, room = (
+                a[keep] for a in (pos, nvel, radii, resp, controlled, yaws, wide, room)
             )
         self.grid = self._walls(pos, nvel, wide, bodies)
         dist = np.hypot(pos[:, 0] - xy[0], pos[:, 1] - xy[1])
@@ -322,7 +322,11 @@ class CollvoidLocalPlanner(
             meeting = self._oncoming(pos - xy, nvel, vel, pref, dist, remaining)
             if not near_goal and meeting.any():
                 pref = rotated(pref, p.left_pref)
-            pref = self._around_still(pref, xy, vel, pos - xy, nvel, pair, controlled, ids)
+            # the way past a standing robot: the room beside it (`neighbour_radii`: the
+            # spreads across the line between the two, its body's extent across it), not
+            # ORCA's leg (the same with no spread)
+            passage = pair + (room - radii)
+            pref = self._around_still(pref, xy, vel, pos - xy, nvel, pair, controlled, ids, passage)
             pref = self._give_way(
                 pref, wanted, vel, pos - xy, nvel, pair, resp, controlled, ids, meeting
             )

@@ -13,6 +13,7 @@ import yaml
 
 import fleetsim
 from fleetsim.description.xacro import expand_xacro
+from fleetsim.errors import LaunchError
 from fleetsim.launch.runner import LaunchSession, load_plan
 
 USER_LAUNCH = """<launch>
@@ -54,6 +55,7 @@ MODELS = {
     "burger": ("turtlebot3_burger", "burger", "scan", "odom"),
     "turtlebot3_waffle": ("turtlebot3_waffle", "waffle", "scan", "odom"),
     "jackal": ("jackal", "jackal", "front/scan", "ground_truth/state"),
+    "hunter": ("hunter", "hunter", "/scan", "odom"),
 }
 
 
@@ -92,30 +94,69 @@ def test_the_model_picks_description_params_laser_and_ground_truth(tmp_path, mod
     assert _node(plan, "amcl").remaps["scan"] == scan
     plan = load_plan(_user_launch(tmp_path), {"model": model})
     assert _node(plan, "fake_localization").remaps["base_pose_ground_truth"] == truth
+    # the shared map frame, whatever the model's YAML says (turtlebot3_navigation's `map`)
+    frame = plan.param_tree().get("/robot1/move_base_node/global_costmap/global_frame")
+    assert frame == "/map"
 
 
-def test_an_explicit_description_still_wins(tmp_path):
+def _with_include_args(tmp_path, **args) -> Path:
+    extra = "".join(f'\n      <arg name="{k}" value="{v}"/>' for k, v in args.items())
     text = (
         _user_launch(tmp_path)
         .read_text()
         .replace(
             '<arg name="model" value="$(arg model)"/>',
-            '<arg name="model" value="$(arg model)"/>\n'
-            '      <arg name="description" value="$(find pioneer3at)/urdf/pioneer3at.urdf.xacro"/>',
+            '<arg name="model" value="$(arg model)"/>' + extra,
         )
     )
     path = tmp_path / "explicit.launch"
     path.write_text(text)
+    return path
+
+
+def test_a_model_of_the_users_own_takes_what_is_passed(tmp_path):
+    """A model fleetsim does not ship, with its description, parameters and laser topic given
+    (the pioneer's files here): nothing is looked up by the model's name."""
+    params = ASSETS / "launch" / "params" / "pioneer3at"
+    path = _with_include_args(
+        tmp_path,
+        description="$(find pioneer3at)/urdf/pioneer3at.urdf.xacro",
+        params=str(params),
+        laser_topic="my_scan",
+    )
+    plan = load_plan(path, {"model": "my_p3at", "localization": "amcl"})
+    (description,) = [p for p in plan.params if p.name == "/robot1/robot_description"]
+    urdf, _ = expand_xacro(ASSETS / "robots" / "pioneer3at" / "urdf" / "pioneer3at.urdf.xacro")
+    assert description.value == urdf
+    shipped = yaml.safe_load((params / "base_local_planner_params.yaml").read_text())
+    assert _planner_params(plan) == shipped["TrajectoryPlannerROS"]
+    assert _node(plan, "amcl").remaps["scan"] == "my_scan"
+
+
+def test_a_model_of_the_users_own_without_a_description_names_it(tmp_path):
+    with pytest.raises(LaunchError, match="my_p3at"):
+        load_plan(_user_launch(tmp_path), {"model": "my_p3at"})
+
+
+def test_an_explicit_description_still_wins(tmp_path):
+    path = _with_include_args(tmp_path, description="$(find pioneer3at)/urdf/pioneer3at.urdf.xacro")
     plan = load_plan(path, {"model": "lizi"})
     (description,) = [p for p in plan.params if p.name == "/robot1/robot_description"]
     urdf, _ = expand_xacro(ASSETS / "robots" / "pioneer3at" / "urdf" / "pioneer3at.urdf.xacro")
     assert description.value == urdf
-    assert (
-        _planner_params(plan)["max_vel_x"]
-        == yaml.safe_load(
-            (ASSETS / "launch" / "params" / "lizi" / "base_local_planner_params.yaml").read_text()
-        )["TrajectoryPlannerROS"]["max_vel_x"]
-    )
+    lizi = ASSETS / "launch" / "params" / "lizi" / "base_local_planner_params.yaml"
+    assert _planner_params(plan) == yaml.safe_load(lizi.read_text())["TrajectoryPlannerROS"]
+
+
+def test_robots_launch_hands_the_model_and_what_is_passed_to_each_robot():
+    """`navigation_multi`'s include of three robots: the model alone, or with its files."""
+    from fleetsim.cli.launch import resolve_launch_file
+
+    plan = load_plan(resolve_launch_file("pioneer_multi"), {"localization": "amcl"})
+    amcls = [n for n in plan.nodes if n.name == "amcl"]
+    assert [n.remaps["scan"] for n in amcls] == ["scan"] * 3
+    plan = load_plan(resolve_launch_file("navigation_multi"), {"localization": "amcl"})
+    assert [n.remaps["scan"] for n in plan.nodes if n.name == "amcl"] == ["base_scan"] * 3
 
 
 @pytest.mark.scenario

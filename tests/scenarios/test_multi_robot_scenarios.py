@@ -18,6 +18,7 @@ from fleetsim.cli.launch import resolve_launch_file
 from fleetsim.launch.runner import LaunchSession, load_plan
 from fleetsim.msgs import collvoid_msgs, geometry_msgs
 from fleetsim.nav.map_io import load_map
+from fleetsim.nav.navigator import INITIAL_COV_AA, INITIAL_COV_XX, INITIAL_COV_YY
 from fleetsim.runtime import Node
 
 pytestmark = pytest.mark.scenario
@@ -94,7 +95,8 @@ def test_swap_corridor_with_amcl_pads_by_the_spread_across_not_along(monkeypatch
     monkeypatch.chdir(tmp_path)
     plan = load_plan(resolve_launch_file("swap_corridor"),
                      {"robots": "2", "localization": "amcl", "gui": "false"})  # fmt: skip
-    defaults = {"initial_cov_xx": 0.25, "initial_cov_yy": 0.25, "initial_cov_aa": 0.068}
+    defaults = {"initial_cov_xx": INITIAL_COV_XX, "initial_cov_yy": INITIAL_COV_YY,
+                "initial_cov_aa": INITIAL_COV_AA}  # fmt: skip
     widened = [op for op in plan.params if op.name.rsplit("/", 1)[-1] in defaults]
     assert len(widened) == 6  # both robots' three
     for op in widened:

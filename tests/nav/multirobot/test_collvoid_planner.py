@@ -25,6 +25,8 @@ from fleetsim.nav.multirobot.holonomic import (
     tracking_command,
     without_robots,
 )
+from fleetsim.nav.multirobot.position_share import XY_COVARIANCE
+from fleetsim.nav.multirobot.uncertainty import widest_spread
 from fleetsim.runtime import Node, Runtime
 
 LIZI = np.array([[-0.19, -0.16], [-0.19, 0.16], [0.19, 0.16], [0.19, -0.16]])
@@ -44,8 +46,13 @@ def empty_map(walls=()):
 class Fleet:
     """N unicycles, each with its own node and planner, sharing positions every cycle."""
 
-    def __init__(self, starts, goals, walls=(), footprint=LIZI, padding=0.0, **params):
+    def __init__(
+        self, starts, goals, walls=(), footprint=LIZI, padding=0.0, covariances=None, **params
+    ):
         self.footprint = np.asarray(footprint, dtype=float)  # padded by ``padding`` m
+        # each robot's localization spread (2, 2) m^2, map frame, or None: its own, and shared
+        # with the footprint padded by its widest spread, as me_publisher does
+        self.covariances = covariances or [None] * len(starts)
         self.rt = Runtime()
         self.cm = empty_map(walls)
         self.pub = Node(self.rt, "sim", "/").create_publisher(
@@ -68,6 +75,7 @@ class Fleet:
             )
             line = np.linspace(s[:2], g[:2], 50)
             pl.set_plan(np.c_[line, np.full(50, g[2])])
+            pl._covariance = self.covariances[i]
             self.planners.append(pl)
         self.min_gap = math.inf
         self.min_wall = math.inf
@@ -85,9 +93,12 @@ class Fleet:
             )
             v = self.vel[i, 0]
             m.holonomic_velocity = geometry_msgs.Vector3(x=v * math.cos(yaw), y=v * math.sin(yaw))
-            m.footprint.polygon.points = [
-                geometry_msgs.Point32(x=a, y=b) for a, b in self.footprint
-            ]
+            footprint, cov = self.footprint, self.covariances[i]
+            if cov is not None:
+                m.pose.covariance[XY_COVARIANCE] = np.asarray(cov, dtype=float).reshape(-1)
+                footprint = padded_footprint(footprint, widest_spread(cov, 0.1, 2 * radius))
+                m.radius = float(np.hypot(*footprint.T).max())
+            m.footprint.polygon.points = [geometry_msgs.Point32(x=a, y=b) for a, b in footprint]
             self.pub.publish(m)
 
     def see(self):
@@ -452,6 +463,35 @@ def test_the_room_beside_a_standing_robot_is_judged_by_the_passage_not_orcas_leg
     assert way(0.76, np.array([0.62]))[1] > 0.0  # above, where its plan runs
     assert pl.detour_sides == {"lizi4": 0}
     assert way(0.80, np.array([0.62]))[1] > 0.0  # whichever leg ORCA pads by
+
+
+def test_the_planner_hands_the_room_beside_a_standing_robot_to_the_way_round(monkeypatch):
+    """The wiring of the test above: with amcl's spreads the way round a robot standing in the
+    way gets the combined radius for the room beside it (`neighbour_radii`'s third array,
+    through `pair_radii`), narrower than ORCA's for a lizi parked along the corridor; without
+    any spread it gets ORCA's, the same array's values."""
+    seen = []
+    plain = CollvoidLocalPlanner._around_still
+
+    def spy(self, pref, xy, vel, rel, nvel, radii, controlled, ids, passage=None):
+        seen.append((radii.copy(), None if passage is None else passage.copy()))
+        return plain(self, pref, xy, vel, rel, nvel, radii, controlled, ids, passage)
+
+    monkeypatch.setattr(CollvoidLocalPlanner, "_around_still", spy)
+    walls = [(-8, 0.96, 8, 1.2), (-8, -1.2, 8, -0.96)]
+    parked = (0.0, 0.0, math.pi)
+    along = np.diag([0.0144, 0.0016])  # amcl's in a corridor: 0.12 m along it, 0.04 m across
+    for covs in ([along, along], None):
+        seen.clear()
+        f = Fleet([(1.5, 0.48, math.pi), parked], [(-1.6, 0.48, math.pi), parked],
+                  walls=walls, covariances=covs)  # fmt: skip
+        f.run(0.5)
+        radii, passage = seen[-1]
+        assert passage is not None and passage.shape == radii.shape == (1,)
+        if covs is None:
+            assert passage.tolist() == radii.tolist()
+        else:
+            assert passage[0] < radii[0] - 0.03, (passage, radii)
 
 
 def test_a_goal_nudged_by_localization_is_the_same_goal_to_the_deadlock_rule():

@@ -172,7 +172,7 @@ def test_a_robot_without_covariance_keeps_todays_radius_rule():
     assert got[0] == pytest.approx(0.4 + K * 0.15, abs=1e-3)
     # side by side (the line between them across x) only the spread across x counts, halved
     assert wide[0] == pytest.approx(0.4 + 0.5 * K * 0.005)
-    assert room[0] == wide[0]  # on its way, or sharing no spread: its disc
+    assert room[0] == wide[0]  # sharing no spread: its disc
 
 
 def test_a_robot_sharing_a_covariance_is_its_body_padded_in_the_direction_that_matters():
@@ -200,6 +200,14 @@ def test_a_robot_sharing_a_covariance_is_its_body_padded_in_the_direction_that_m
     # half width (0.16 m) plus half the spread across, where a passage takes its disc
     assert room[0] == pytest.approx(0.16 + 0.5 * K * 0.005, abs=1e-6)
     assert wide[0] == pytest.approx(body + 0.5 * K * 0.005, abs=1e-6)
+    # turned a quarter: its half length (0.19 m) across the line between the two
+    msg.pose.pose.orientation = geometry_msgs.Quaternion(
+        z=math.sin(math.pi / 4), w=math.cos(math.pi / 4)
+    )
+    table.update(msg)
+    near = table.near(1.0, (0.0, 0.0), 10.0, 5)
+    room = CollvoidLocalPlanner.neighbour_radii(planner_stub(), 0.35, np.zeros(2), near)[2]
+    assert room[0] == pytest.approx(0.19 + 0.5 * K * 0.005, abs=1e-6)
 
 
 def test_a_body_in_the_pair_padding_shares_the_tangent_of_its_outline():

@@ -325,7 +325,7 @@ class CollvoidLocalPlanner(
             # the way past a standing robot: the room beside it (`neighbour_radii`: the
             # spreads across the line between the two, its body's extent across it), not
             # ORCA's leg (the same with no spread)
-            passage = pair + (room - radii)
+            passage = self.pair_radii(own_r, room, dist)
             pref = self._around_still(pref, xy, vel, pos - xy, nvel, pair, controlled, ids, passage)
             pref = self._give_way(
                 pref, wanted, vel, pos - xy, nvel, pair, resp, controlled, ids, meeting

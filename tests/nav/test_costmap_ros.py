@@ -231,3 +231,34 @@ def test_readings_are_read_at_the_update_unless_they_persist(persistence):
     box = cm.costmap.world_to_map(2.01, 1.0)  # the face the laser sees
     assert cm.costmap.costs[box[1], box[0]] == LETHAL_OBSTACLE
     assert cm.is_current()
+
+
+@pytest.mark.parametrize("shift", [(0.0, 0.0), (0.3, 0.0), (-0.2, 0.25)])
+def test_a_rolling_window_places_the_map_by_tf(shift, caplog):
+    """A local costmap in odom with a static layer, the map in `map`: odom starts at the robot's
+    start (3, 1), and map -> odom is off by ``shift`` (amcl's correction). The map's wall at
+    x = 4 lies at 1 - shift[0] in odom, as costmap_2d's StaticLayer transforms each cell of a
+    rolling window by tf. fleetsim used the map as if it were in odom (the wall then fell at
+    x = 4, outside the 3 m window) and warned so at start."""
+    from fleetsim.tf.static_transform_publisher import StaticTransformPublisher
+
+    sx, sy = shift
+    rt = Runtime()
+    rt.params.set("/lizi1/tf_prefix", "lizi1")
+    MapPub(rt)
+    KinematicRobot(rt, start=(3.0, 1.0, 0.0))
+    StaticTransformPublisher(rt, args=f"{3.0 + sx} {1.0 + sy} 0 0 0 0 map lizi1/odom 100")
+    extra = {
+        "plugins": [{"name": "static_layer", "type": "costmap_2d::StaticLayer"}],
+        "static_layer": {"map_topic": "/map"},
+    }
+    node, cm = host(rt, "local_costmap", extra)
+    rt.run(duration=1.05)
+    assert cm.initialized
+    m = cm.costmap
+    col = int((1.0 - sx - m.origin_x) / m.resolution)  # the wall's cell in odom
+    row = int((-sy - m.origin_y) / m.resolution)  # map y = 1.0
+    assert m.costs[row, col] == LETHAL_OBSTACLE
+    assert m.costs[row, col - 3] != LETHAL_OBSTACLE  # 0.15 m before it: free
+    assert m.costs[row, col + 3] != LETHAL_OBSTACLE  # and after it
+    assert not [r for r in caplog.records if "as if it were in the global frame" in r.message]

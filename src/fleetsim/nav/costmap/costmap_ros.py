@@ -98,6 +98,7 @@ class Costmap2DROS:
         self.sources = ObservationSources(self)
         self._subs: list[Any] = []
         self._map_subs: dict[str, Any] = {}
+        self._map_frames: dict[str, str] = {}  # each static layer's map frame
         _ = node.tf_buffer  # listen to /tf from now on
         self.costmap_pub = node.create_publisher(
             nav_msgs.OccupancyGrid, f"~{name}/costmap", queue_size=1, latch=True
@@ -162,12 +163,14 @@ class Costmap2DROS:
                 self.node.get_logger().error(f"ignoring map: {err}")
                 return
             frame = normalize_frame(msg.header.frame_id) if msg.header.frame_id else ""
-            if frame and frame != self.global_frame:
+            if frame and frame != self.global_frame and not self.layered.rolling_window:
                 self._warn(
                     "map_frame",
                     f"the map on {where} is in frame '{frame}' but the costmap's global_frame is "
                     f"'{self.global_frame}'; the map is used as if it were in the global frame",
                 )
+            # a rolling window looks its cells up in the map through tf at each update
+            self._map_frames[layer.name] = frame
             layer.set_map(occupancy)
 
         old = self._map_subs.get(layer.name)
@@ -247,6 +250,7 @@ class Costmap2DROS:
         if pose is None:
             return False
         self.sources.read_unread()
+        self._place_maps()
         missing = [la.name for la in self._static_layers() if la.map_grid is None]
         if missing:
             self._warn("map", f"waiting for the map on {', '.join(self._map_topics())}")
@@ -256,6 +260,32 @@ class Costmap2DROS:
         self.initialized = self.initialized or not missing
         self._publish_footprint(pose)
         return True
+
+    def _place_maps(self) -> None:
+        """Where each static layer's map lies in a rolling window's frame, from the newest tf
+        (`StaticLayer.window_in_map`). Where tf does not have it the layer adds nothing this
+        update, as costmap_2d's StaticLayer skips a rolling update it cannot transform (warned
+        once it stays missing)."""
+        if not self.layered.rolling_window:
+            return
+        for layer in self._static_layers():
+            frame = self._map_frames.get(layer.name, "")
+            layer.window_in_map, layer.window_placed = None, True
+            if not frame or frame == self.global_frame:
+                continue
+            key = f"map_tf:{layer.name}"
+            try:
+                place = self.node.tf_buffer.lookup_pose2d(frame, self.global_frame, 0.0)
+            except TransformError as err:
+                layer.window_placed = False
+                if self._patience.missing_too_long(key, self.node.now()):
+                    self._warn(key, f"cannot place the map of {layer.name} in the window: {err}")
+                continue
+            self._patience.found(key)
+            # fake_localization's map -> odom is the identity up to float noise (1e-16): the
+            # map is then read as it is, cell for cell
+            if max(abs(v) for v in place) > 1e-9:
+                layer.window_in_map = place
 
     def _map_topics(self) -> list[str]:
         return [self.node.resolve_name(la.params.map_topic) for la in self._static_layers()]

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -123,6 +124,11 @@ class StaticLayer(CostmapLayer):
         self._has_updated_data = False
         #: the map's cells (x0, y0, xn, yn) that the last map changed, or None: all of them
         self._changed: tuple[int, int, int, int] | None = None
+        #: the rolling window's frame in the map's frame, (x, y, yaw) m, rad, for this update, or
+        #: None where they are the same frame (Costmap2DROS sets it from tf before each update)
+        self.window_in_map: tuple[float, float, float] | None = None
+        #: False while tf cannot place the map in the rolling window: the layer adds nothing
+        self.window_placed = True
 
     def set_map(self, occupancy: OccupancyMap) -> bool:
         """Take a new map (the ``map`` topic callback). Returns False if it was ignored."""
@@ -188,12 +194,16 @@ class StaticLayer(CostmapLayer):
         if xn <= x0 or yn <= y0:  # the same map again
             return
         res = g.resolution
-        bounds.include(
-            g.origin_x + x0 * res,
-            g.origin_y + y0 * res,
-            g.origin_x + xn * res,
-            g.origin_y + yn * res,
-        )
+        ax, ay = g.origin_x + x0 * res, g.origin_y + y0 * res
+        bx, by = g.origin_x + xn * res, g.origin_y + yn * res
+        if rolling and self.window_in_map is not None:  # the map's corners in the window
+            tx, ty, yaw = self.window_in_map
+            c, s = math.cos(yaw), math.sin(yaw)
+            corners = [(x - tx, y - ty) for x in (ax, bx) for y in (ay, by)]
+            xs = [c * dx + s * dy for dx, dy in corners]
+            ys = [-s * dx + c * dy for dx, dy in corners]
+            ax, ay, bx, by = min(xs), min(ys), max(xs), max(ys)
+        bounds.include(ax, ay, bx, by)
 
     def update_costs(self, master: Costmap2D, x0: int, y0: int, xn: int, yn: int) -> None:
         if not self.enabled or self.map_grid is None or xn <= x0 or yn <= y0:
@@ -204,15 +214,20 @@ class StaticLayer(CostmapLayer):
             else:
                 self.update_with_true_overwrite(master, x0, y0, xn, yn)
             return
-        # Rolling window: look each master cell's centre up in the map.
+        if not self.window_placed:
+            return
+        # Rolling window: look each master cell's centre up in the map, through the transform
+        # between the window's frame and the map's (costmap_2d's StaticLayer transforms each
+        # cell by tf's map <- global transform: a local costmap in odom holds the map's walls
+        # where amcl's map -> odom puts them)
         mx, my = np.meshgrid(np.arange(x0, xn), np.arange(y0, yn))
-        centres = np.stack(
-            (
-                master.origin_x + (mx + 0.5) * master.resolution,
-                master.origin_y + (my + 0.5) * master.resolution,
-            ),
-            axis=-1,
-        )
+        cx = master.origin_x + (mx + 0.5) * master.resolution
+        cy = master.origin_y + (my + 0.5) * master.resolution
+        if self.window_in_map is not None:
+            tx, ty, yaw = self.window_in_map
+            c, s = math.cos(yaw), math.sin(yaw)
+            cx, cy = tx + c * cx - s * cy, ty + s * cx + c * cy
+        centres = np.stack((cx, cy), axis=-1)
         cells, inside = self.map_grid.cells_of(centres)
         window = master.costs[y0:yn, x0:xn]
         values = np.full(window.shape, NO_INFORMATION, dtype=np.uint8)

@@ -262,3 +262,29 @@ def test_a_rolling_window_places_the_map_by_tf(shift, caplog):
     assert m.costs[row, col - 3] != LETHAL_OBSTACLE  # 0.15 m before it: free
     assert m.costs[row, col + 3] != LETHAL_OBSTACLE  # and after it
     assert not [r for r in caplog.records if "as if it were in the global frame" in r.message]
+
+
+@pytest.mark.parametrize("yaw", [math.pi / 2, -math.pi / 2])
+def test_a_rolling_window_turned_from_the_map_places_it_by_tf(yaw):
+    """odom turned a quarter from the map at (3, 1): the map's wall at x = 4 runs across the
+    window at odom y = -1 (yaw +90 degrees) or +1 (-90), and not on the other side."""
+    from fleetsim.tf.static_transform_publisher import StaticTransformPublisher
+
+    rt = Runtime()
+    rt.params.set("/lizi1/tf_prefix", "lizi1")
+    MapPub(rt)
+    KinematicRobot(rt, start=(3.0, 1.0, 0.0))
+    StaticTransformPublisher(rt, args=f"3.0 1.0 0 {yaw} 0 0 map lizi1/odom 100")
+    extra = {
+        "plugins": [{"name": "static_layer", "type": "costmap_2d::StaticLayer"}],
+        "static_layer": {"map_topic": "/map"},
+    }
+    node, cm = host(rt, "local_costmap", extra)
+    rt.run(duration=1.05)
+    m = cm.costmap
+    side = -1.0 if yaw > 0 else 1.0
+    col = int((0.0 - m.origin_x) / m.resolution)
+    wall = int((side - m.origin_y) / m.resolution)
+    mirror = int((-side - m.origin_y) / m.resolution)
+    assert LETHAL_OBSTACLE in m.costs[wall - 1 : wall + 2, col]
+    assert LETHAL_OBSTACLE not in m.costs[mirror - 2 : mirror + 3, col]

@@ -170,8 +170,8 @@ class Costmap2DROS:
                     f"'{self.global_frame}'; the map is used as if it were in the global frame",
                 )
             # a rolling window looks its cells up in the map through tf at each update
-            self._map_frames[layer.name] = frame
-            layer.set_map(occupancy)
+            if layer.set_map(occupancy):
+                self._map_frames[layer.name] = frame
 
         old = self._map_subs.get(layer.name)
         if old is not None:

@@ -233,6 +233,26 @@ def test_readings_are_read_at_the_update_unless_they_persist(persistence):
     assert cm.is_current()
 
 
+def _window_over_map(odom_in_map: str) -> Costmap2DROS:
+    """A 3 m local costmap in lizi1/odom whose only layer is the map's (`room_map`), after a
+    second; odom is at ``odom_in_map`` ("x y z yaw pitch roll") in the map, the robot at
+    odom's origin."""
+    from fleetsim.tf.static_transform_publisher import StaticTransformPublisher
+
+    rt = Runtime()
+    rt.params.set("/lizi1/tf_prefix", "lizi1")
+    MapPub(rt)
+    KinematicRobot(rt, start=(3.0, 1.0, 0.0))
+    StaticTransformPublisher(rt, args=f"{odom_in_map} map lizi1/odom 100")
+    extra = {
+        "plugins": [{"name": "static_layer", "type": "costmap_2d::StaticLayer"}],
+        "static_layer": {"map_topic": "/map"},
+    }
+    _, cm = host(rt, "local_costmap", extra)
+    rt.run(duration=1.05)
+    return cm
+
+
 @pytest.mark.parametrize("shift", [(0.0, 0.0), (0.3, 0.0), (-0.2, 0.25)])
 def test_a_rolling_window_places_the_map_by_tf(shift, caplog):
     """A local costmap in odom with a static layer, the map in `map`: odom starts at the robot's
@@ -240,20 +260,8 @@ def test_a_rolling_window_places_the_map_by_tf(shift, caplog):
     x = 4 lies at 1 - shift[0] in odom, as costmap_2d's StaticLayer transforms each cell of a
     rolling window by tf. fleetsim used the map as if it were in odom (the wall then fell at
     x = 4, outside the 3 m window) and warned so at start."""
-    from fleetsim.tf.static_transform_publisher import StaticTransformPublisher
-
     sx, sy = shift
-    rt = Runtime()
-    rt.params.set("/lizi1/tf_prefix", "lizi1")
-    MapPub(rt)
-    KinematicRobot(rt, start=(3.0, 1.0, 0.0))
-    StaticTransformPublisher(rt, args=f"{3.0 + sx} {1.0 + sy} 0 0 0 0 map lizi1/odom 100")
-    extra = {
-        "plugins": [{"name": "static_layer", "type": "costmap_2d::StaticLayer"}],
-        "static_layer": {"map_topic": "/map"},
-    }
-    node, cm = host(rt, "local_costmap", extra)
-    rt.run(duration=1.05)
+    cm = _window_over_map(f"{3.0 + sx} {1.0 + sy} 0 0 0 0")
     assert cm.initialized
     m = cm.costmap
     col = int((1.0 - sx - m.origin_x) / m.resolution)  # the wall's cell in odom
@@ -268,19 +276,7 @@ def test_a_rolling_window_places_the_map_by_tf(shift, caplog):
 def test_a_rolling_window_turned_from_the_map_places_it_by_tf(yaw):
     """odom turned a quarter from the map at (3, 1): the map's wall at x = 4 runs across the
     window at odom y = -1 (yaw +90 degrees) or +1 (-90), and not on the other side."""
-    from fleetsim.tf.static_transform_publisher import StaticTransformPublisher
-
-    rt = Runtime()
-    rt.params.set("/lizi1/tf_prefix", "lizi1")
-    MapPub(rt)
-    KinematicRobot(rt, start=(3.0, 1.0, 0.0))
-    StaticTransformPublisher(rt, args=f"3.0 1.0 0 {yaw} 0 0 map lizi1/odom 100")
-    extra = {
-        "plugins": [{"name": "static_layer", "type": "costmap_2d::StaticLayer"}],
-        "static_layer": {"map_topic": "/map"},
-    }
-    node, cm = host(rt, "local_costmap", extra)
-    rt.run(duration=1.05)
+    cm = _window_over_map(f"3.0 1.0 0 {yaw} 0 0")
     m = cm.costmap
     side = -1.0 if yaw > 0 else 1.0
     col = int((0.0 - m.origin_x) / m.resolution)

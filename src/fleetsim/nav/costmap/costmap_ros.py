@@ -98,7 +98,6 @@ class Costmap2DROS:
         self.sources = ObservationSources(self)
         self._subs: list[Any] = []
         self._map_subs: dict[str, Any] = {}
-        self._map_frames: dict[str, str] = {}  # each static layer's map frame
         _ = node.tf_buffer  # listen to /tf from now on
         self.costmap_pub = node.create_publisher(
             nav_msgs.OccupancyGrid, f"~{name}/costmap", queue_size=1, latch=True
@@ -171,7 +170,7 @@ class Costmap2DROS:
                 )
             # a rolling window looks its cells up in the map through tf at each update
             if layer.set_map(occupancy):
-                self._map_frames[layer.name] = frame
+                layer.map_frame = frame
 
         old = self._map_subs.get(layer.name)
         if old is not None:
@@ -269,7 +268,7 @@ class Costmap2DROS:
         if not self.layered.rolling_window:
             return
         for layer in self._static_layers():
-            frame = self._map_frames.get(layer.name, "")
+            frame = layer.map_frame
             layer.window_in_map, layer.window_placed = None, True
             if not frame or frame == self.global_frame:
                 continue

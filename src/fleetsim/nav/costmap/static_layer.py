@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import functools
-import math
 from dataclasses import dataclass
 
 import numpy as np
@@ -15,6 +14,7 @@ from fleetsim.nav.costmap.costmap_2d import (
     Costmap2D,
     lookup_bytes,
 )
+from fleetsim.nav.costmap.footprint import footprint_at
 from fleetsim.nav.costmap.layer import Bounds, CostmapLayer, combined_max
 from fleetsim.nav.map_io import OccupancyMap
 from fleetsim.runtime import param
@@ -129,6 +129,8 @@ class StaticLayer(CostmapLayer):
         self.window_in_map: tuple[float, float, float] | None = None
         #: False while tf cannot place the map in the rolling window: the layer adds nothing
         self.window_placed = True
+        #: the frame of the map last taken ("": none given), set by Costmap2DROS
+        self.map_frame = ""
 
     def set_map(self, occupancy: OccupancyMap) -> bool:
         """Take a new map (the ``map`` topic callback). Returns False if it was ignored."""
@@ -198,11 +200,9 @@ class StaticLayer(CostmapLayer):
         bx, by = g.origin_x + xn * res, g.origin_y + yn * res
         if rolling and self.window_in_map is not None:  # the map's corners in the window
             tx, ty, yaw = self.window_in_map
-            c, s = math.cos(yaw), math.sin(yaw)
-            corners = [(x - tx, y - ty) for x in (ax, bx) for y in (ay, by)]
-            xs = [c * dx + s * dy for dx, dy in corners]
-            ys = [-s * dx + c * dy for dx, dy in corners]
-            ax, ay, bx, by = min(xs), min(ys), max(xs), max(ys)
+            corners = np.array([(x - tx, y - ty) for x in (ax, bx) for y in (ay, by)])
+            inside = footprint_at(corners, 0.0, 0.0, -yaw)
+            (ax, ay), (bx, by) = inside.min(axis=0), inside.max(axis=0)
         bounds.include(ax, ay, bx, by)
 
     def update_costs(self, master: Costmap2D, x0: int, y0: int, xn: int, yn: int) -> None:
@@ -221,13 +221,17 @@ class StaticLayer(CostmapLayer):
         # cell by tf's map <- global transform: a local costmap in odom holds the map's walls
         # where amcl's map -> odom puts them)
         mx, my = np.meshgrid(np.arange(x0, xn), np.arange(y0, yn))
-        cx = master.origin_x + (mx + 0.5) * master.resolution
-        cy = master.origin_y + (my + 0.5) * master.resolution
+        centres = np.stack(
+            (
+                master.origin_x + (mx + 0.5) * master.resolution,
+                master.origin_y + (my + 0.5) * master.resolution,
+            ),
+            axis=-1,
+        )
         if self.window_in_map is not None:
-            tx, ty, yaw = self.window_in_map
-            c, s = math.cos(yaw), math.sin(yaw)
-            cx, cy = tx + c * cx - s * cy, ty + s * cx + c * cy
-        centres = np.stack((cx, cy), axis=-1)
+            centres = footprint_at(centres.reshape(-1, 2), *self.window_in_map).reshape(
+                centres.shape
+            )
         cells, inside = self.map_grid.cells_of(centres)
         window = master.costs[y0:yn, x0:xn]
         values = np.full(window.shape, NO_INFORMATION, dtype=np.uint8)

@@ -192,25 +192,25 @@ def test_pioneers_that_see_each_other_cross_the_circle(monkeypatch, tmp_path):
 
 
 def test_two_jackals_with_amcl_swap_the_corridor_off_the_walls(monkeypatch, tmp_path):
-    """model:=jackal localization:=amcl: the jackal's local costmap works in odom, as
-    jackal_navigation's (its skid-steer drive reports the true pose on odom), not in /map,
-    where it moved with amcl's map -> odom corrections. Benchmark seeds 1-5 in /map: 8/10
-    goals and 4 robot-wall contacts; in odom 10/10 and none. These are seed 2's starts (the
-    benchmark's 2 cm jitter), where in /map jackal2, backing out to let jackal1 by (two
-    jackals 0.82 m across judge the 2 m corridor too narrow for two once amcl's spread pads
-    them), ran into the corridor's end wall and neither arrived in 60 s."""
+    """model:=jackal localization:=amcl: the jackal's local costmap works in odom (its
+    skid-steer drive reports the true pose on odom), not in /map, where the robot's pose
+    jumped against the walls marked before each amcl correction. Benchmark seeds 1-5 in /map:
+    8/10 goals and 4 robot-wall contacts; in odom 10/10 and none. These are seed 2's starts
+    (the benchmark's 2 cm jitter), where in /map jackal2, backing out to let jackal1 by (each
+    jackal's padded footprint has a 0.41 m circumscribed radius, and once amcl's spread pads
+    them the pair needs 2.05 m of the corridor's 1.875 m of free width), ran into the
+    corridor's end wall and neither arrived in 60 s."""
     monkeypatch.chdir(tmp_path)
-    args = {"robots": "2", "model": "jackal", "localization": "amcl", "gui": "false"}
-    plan = load_plan(resolve_launch_file("swap_corridor"), args)
+    launch_args = {"robots": "2", "model": "jackal", "localization": "amcl", "gui": "false"}
+    plan = load_plan(resolve_launch_file("swap_corridor"), launch_args)
     starts = {
         "/jackal1": ("1.9905", "1.9919", "0.0126"),
         "/jackal2": ("11.9837", "2.0040", "3.1507"),
     }
     for spec in plan.nodes:
         if spec.type == "spawn_model":
-            args = spec.args
             for flag, value in zip(("-x", "-y", "-Y"), starts[spec.namespace]):
-                args[args.index(flag) + 1] = value
+                spec.args[spec.args.index(flag) + 1] = value
     with LaunchSession(plan, seed=2) as s:
         frames = {s.nodes[f"/jackal{k}/move_base"].local_costmap.global_frame for k in (1, 2)}
         s.run(duration=60.0, until_goals=True)

@@ -84,21 +84,11 @@ class Run:
 
 
 def jittered_plan(path: Path, args: dict[str, str], seed: int, jitter: float):
-    """The launch plan, each spawn pose moved by up to ``jitter`` m (and rad / 100 * 2)."""
+    """The launch plan, each spawn pose moved by up to ``jitter`` m (and rad) (seed 0: the
+    exact starts; `LaunchPlan.jitter_spawns`)."""
     plan = load_plan(path, args)
-    if seed == 0 or jitter == 0:
-        return plan
-    rng = np.random.default_rng(seed)
-    for spec in plan.nodes:
-        if (spec.pkg, spec.type) != ("gazebo_ros", "spawn_model"):
-            continue
-        out, it = [], iter(spec.args)
-        for a in it:
-            out.append(a)
-            if a in ("-x", "-y", "-Y"):
-                v = float(next(it)) + rng.uniform(-jitter, jitter)
-                out.append(f"{v:.4f}")
-        spec.args[:] = out
+    if seed != 0 and jitter != 0:
+        plan.jitter_spawns(seed, jitter)
     return plan
 
 

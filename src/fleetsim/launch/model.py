@@ -16,6 +16,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+import numpy as np
 import yaml
 
 from fleetsim.errors import LaunchError
@@ -105,6 +106,20 @@ class LaunchPlan:
         tree = ParamTree()
         self.apply_params(tree)
         return tree
+
+    def jitter_spawns(self, seed: int, jitter: float) -> None:
+        """Move every ``gazebo_ros/spawn_model``'s ``-x``, ``-y`` (m) and ``-Y`` (rad) by a
+        uniform draw within +-``jitter``, in node and argument order, from NumPy's
+        ``default_rng(seed)``: the start noise of a seeded experiment (written to 4 decimals,
+        as a launch file would carry them)."""
+        rng = np.random.default_rng(seed)
+        for spec in self.find_nodes("gazebo_ros", "spawn_model"):
+            out, it = [], iter(spec.args)
+            for a in it:
+                out.append(a)
+                if a in ("-x", "-y", "-Y"):
+                    out.append(f"{float(next(it)) + rng.uniform(-jitter, jitter):.4f}")
+            spec.args[:] = out
 
     def find_nodes(self, pkg: str | None = None, type: str | None = None) -> list[NodeSpec]:
         return [

@@ -57,7 +57,12 @@ class CollvoidParked:
     def _parked_in_view(
         self, ids, pos, nvel, yaws, blocked=False
     ) -> tuple[np.ndarray, list[np.ndarray]]:
-        """(N,) bool, and their shared footprints at their poses (polygons, costmap frame):
+        """(N,) bool, and their bodies at their poses (polygons, costmap frame; a robot our
+        sensors see by its body alone, one we do not by its body grown by its localization
+        spread, `_near_outline`: where the laser shows a robot, where it probably is adds
+        nothing. With amcl, a jackal parked on its goal in the middle of the 2 m corridor,
+        drawn grown by its spread, left a jackal coming past it no room between it and the
+        wall, and the jackals' corridor of 4 jammed):
         the neighbours ``ids`` that have stood still for ``PARKED_TIME`` where
         this robot's own sensors see them (``SEEN_CELLS`` lethal cells or more under the
         footprint they share, grown by a cell, at ``pos`` (N, 2) m and ``yaws`` (N,) rad).
@@ -100,7 +105,9 @@ class CollvoidParked:
             seen = np.count_nonzero(cm.costs[rows, cols] == LETHAL_OBSTACLE) >= SEEN_CELLS
             out[k] = seen or ids[k] in as_bodies
             if out[k]:
-                bodies.append(footprint_at(self._near_outline(k), *pos[k], yaws[k]))
+                # seen: our laser shows where it is, so its body; else where it probably is
+                shape = self.near_robots[k].body if seen else self._near_outline(k)
+                bodies.append(footprint_at(shape, *pos[k], yaws[k]))
         return out, bodies
 
     def _near_outline(self, k: int, pad: float = 0.0) -> np.ndarray:

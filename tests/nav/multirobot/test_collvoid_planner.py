@@ -186,6 +186,34 @@ def test_a_standing_robot_in_view_is_an_obstacle_of_its_shared_shape():
             assert costs is pl.costmap.costs and robots == 1 and n_obst == 0
 
 
+@pytest.mark.parametrize("seen", [True, False])
+def test_a_parked_robot_our_laser_marks_enters_the_costmap_by_its_body_not_its_spread(seen):
+    """robot2 parked at the origin with amcl's spread (std 0.12 m across, 0.3 m along). Where
+    robot1's laser marks it, its body, not its body grown by the spread, enters robot1's
+    costmap: the laser shows where it is (the jackals' corridor of 4 with amcl jammed when a
+    jackal parked in the corridor's middle was drawn grown, leaving no room beside it). One no
+    sensor of ours marks, counted once robot1 is blocked, is drawn grown by its spread."""
+    cov = np.diag([0.3**2, 0.12**2])
+    f = Fleet([(-1.5, 0.0, 0.0), (0.0, 0.0, 0.0)], [(3.0, 0.0, 0.0), (0.0, 0.0, 0.0)],
+              covariances=[None, cov], deadlock_time=0.5)  # fmt: skip
+    pl = f.planners[0]
+    pl.costmap = empty_map()
+    if seen:
+        pl.costmap.costs[199:201, 195:197] = LETHAL_OBSTACLE  # its west face, (-0.2, 0.0)
+    for _ in range(12):  # parked once it has stood still for 1 s (and robot1 blocked)
+        f.share()
+        f.rt.run(duration=0.1)
+        pl.compute_velocity_commands(tuple(f.state[0]), (0.0, 0.0, 0.0))
+    costs = pl.grid[0]
+    body = polygon_cells(pl.costmap, footprint_at(LIZI, 0.0, 0.0, 0.0))
+    assert np.all(costs[body] == LETHAL_OBSTACLE)
+    grown = pl.near_robots[0].outline(pl.params.eps)
+    assert grown[:, 1].max() > 0.16 + 0.2  # the spread grows it well past the body's side
+    strip = np.array([[-0.1, 0.25], [0.1, 0.25], [0.1, 0.3], [-0.1, 0.3]])  # 9-14 cm beside
+    beside = costs[polygon_cells(pl.costmap, strip)]
+    assert np.all(beside < LETHAL_OBSTACLE) if seen else np.all(beside == LETHAL_OBSTACLE)
+
+
 def test_without_robots_clears_lethal_cells_in_the_discs_only():
     cm = empty_map([(1.0, -5, 1.05, 5)])  # a wall at x = 1
     cm.costs[200:204, 180:184] = LETHAL_OBSTACLE  # a robot's image around (-0.9, 0.05)

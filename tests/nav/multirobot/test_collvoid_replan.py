@@ -11,13 +11,13 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from test_collvoid_planner import LIMITS, LIZI, Fleet, SeeingFleet, empty_map
+from test_collvoid_planner import LIMITS, LIZI, Fleet, SeeingFleet
 
 from fleetsim.nav.controllers.base import NoValidTrajectory
 from fleetsim.nav.controllers.collvoid_parked import BLOCKED_TIME, REPLAN_AGAIN
 from fleetsim.nav.controllers.collvoid_planner import CollvoidLocalPlanner
-from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE, Costmap2D
-from fleetsim.nav.costmap.footprint import footprint_at, inside_polygon, polygon_cells
+from fleetsim.nav.costmap.costmap_2d import Costmap2D
+from fleetsim.nav.costmap.footprint import inside_polygon
 from fleetsim.runtime import Node, Runtime
 
 
@@ -155,29 +155,3 @@ def test_move_base_plans_again_from_where_a_robot_pushed_off_its_plan_stands():
     first = w.watch.plans[-1].poses[0].pose.position
     assert math.dist((first.x, first.y), (2.0, 3.5)) < 0.3
     assert w.bot.min_clearance > 0.0
-
-
-def test_a_parked_robot_our_sensors_see_enters_the_costmap_by_its_body_not_its_spread():
-    """robot2 parked at the origin with amcl's spread (0.12 m across, 0.3 m along), where
-    robot1's sensors see it: its body, not its body grown by the spread, enters robot1's
-    costmap (the laser shows where it is). The jackals' corridor of 4 with amcl jammed when a
-    jackal parked on its goal in the corridor's middle was drawn grown by its spread, leaving
-    no room beside it."""
-    cov = np.diag([0.3**2, 0.12**2])
-    f = Fleet([(-1.5, 0.0, 0.0), (0.0, 0.0, 0.0)], [(3.0, 0.0, 0.0), (0.0, 0.0, 0.0)],
-              covariances=[None, cov])  # fmt: skip
-    pl = f.planners[0]
-    pl.costmap = empty_map()
-    pl.costmap.costs[199:201, 195:197] = LETHAL_OBSTACLE  # its west face, (-0.2, 0.0), seen
-    for _ in range(12):  # parked once it has stood still for 1 s
-        f.share()
-        f.rt.run(duration=0.1)
-        pl.compute_velocity_commands(tuple(f.state[0]), (0.0, 0.0, 0.0))
-    costs = pl.grid[0]
-    body = polygon_cells(pl.costmap, footprint_at(LIZI, 0.0, 0.0, 0.0))
-    grown = footprint_at(pl.near_robots[0].outline(0.1), 0.0, 0.0, 0.0)
-    assert grown[:, 1].max() > 0.16 + 0.2  # the spread grows it well past the body's side
-    assert np.all(costs[body] == LETHAL_OBSTACLE)
-    strip = np.array([[-0.1, 0.25], [0.1, 0.25], [0.1, 0.3], [-0.1, 0.3]])  # 9-14 cm beside
-    beside = polygon_cells(pl.costmap, strip)
-    assert np.all(costs[beside] < LETHAL_OBSTACLE)  # inside the grown outline, outside the body

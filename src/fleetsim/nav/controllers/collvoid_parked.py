@@ -22,6 +22,7 @@ from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
 from fleetsim.nav.costmap.footprint import (
     footprint_at,
     inside_polygon,
+    padded_footprint,
     polygon_cells,
 )
 
@@ -37,8 +38,11 @@ REPLAN_AGAIN = 5.0
 #: planned again (a robot that gets round it on its own keeps its plan: in the pioneers'
 #: corridor of 4, seed 0, a new plan round pioneer3 led pioneer1 into the corridor's corner)
 BLOCKED_TIME = 3.0
-#: s a parked robot no sensor of ours sees counts with its footprint once we are stuck
+#: s a parked robot no sensor of ours sees counts with its outline once we are stuck
 BODIES_TIME = 10.0
+#: m round a parked robot's body at its shared pose within which our laser's marks show it
+#: (`_parked_shape`): two cells, about amcl's error on the jackals in a corridor (7-11 cm)
+SEEN_BODY_MARGIN = 0.1
 
 
 class CollvoidParked:
@@ -57,15 +61,11 @@ class CollvoidParked:
     def _parked_in_view(
         self, ids, pos, nvel, yaws, blocked=False
     ) -> tuple[np.ndarray, list[np.ndarray]]:
-        """(N,) bool, and their bodies at their poses (polygons, costmap frame; a robot our
-        sensors see by its body alone, one we do not by its body grown by its localization
-        spread, `_near_outline`: where the laser shows a robot, where it probably is adds
-        nothing. With amcl, a jackal parked on its goal in the middle of the 2 m corridor,
-        drawn grown by its spread, left a jackal coming past it no room between it and the
-        wall, and the jackals' corridor of 4 jammed):
-        the neighbours ``ids`` that have stood still for ``PARKED_TIME`` where
-        this robot's own sensors see them (``SEEN_CELLS`` lethal cells or more under the
-        footprint they share, grown by a cell, at ``pos`` (N, 2) m and ``yaws`` (N,) rad).
+        """(N,) bool, and the shapes they enter the costmap with (polygons, costmap frame,
+        `_parked_shape`): the neighbours ``ids`` that have stood still for ``PARKED_TIME``
+        where this robot's own sensors see them (``SEEN_CELLS`` lethal cells or more under
+        `_near_outline` grown by a cell, at ``pos`` (N, 2) m and ``yaws`` (N,) rad; wall
+        cells under it count too).
         They are left out of ORCA and stay in the
         local costmap: the wall half-planes and the footprint check then take them with their
         true shape, as collvoid puts standing robots into the costmap (its
@@ -74,7 +74,7 @@ class CollvoidParked:
         middle of a 2 m corridor, with 0.75 m free on either side. A robot no sensor of ours
         sees (a lizi's laser sweeps above the others) stays in ORCA, unless this robot is
         ``blocked`` (no progress for ``deadlock_time`` s, the deadlock rule's patience): then
-        every robot parked within ``neighbor_dist`` counts with its shared footprint for
+        every robot parked within ``neighbor_dist`` counts with its `_near_outline` for
         `BODIES_TIME` s (mixed circle of 16, seed 10: pioneer10 went to and fro for 80 s
         before a gap between two parked lizis that their discs closed and their bodies left
         0.85 m wide). Not sooner: in the lizis' corridor of 4, parked lizis taken by their
@@ -105,13 +105,35 @@ class CollvoidParked:
             seen = np.count_nonzero(cm.costs[rows, cols] == LETHAL_OBSTACLE) >= SEEN_CELLS
             out[k] = seen or ids[k] in as_bodies
             if out[k]:
-                # seen: our laser shows where it is, so its body; else where it probably is
-                shape = self.near_robots[k].body if seen else self._near_outline(k)
-                bodies.append(footprint_at(shape, *pos[k], yaws[k]))
+                bodies.append(
+                    footprint_at(self._parked_shape(k, pos[k], yaws[k]), *pos[k], yaws[k])
+                )
         return out, bodies
 
+    def _parked_shape(self, k: int, xy: np.ndarray, yaw: float) -> np.ndarray:
+        """The shape (robot frame) parked neighbour ``k``, at ``xy`` (2,) m and ``yaw`` rad,
+        enters the local costmap with: its body where our laser marks it (``SEEN_CELLS`` lethal
+        cells or more within `SEEN_BODY_MARGIN` of its body at its shared pose), else its body
+        grown by its localization spread (`_near_outline`, where it probably is). Its laser
+        image stays in the costmap either way (parked robots are not cleared, `_walls`), so
+        the spread is needed only where nothing shows the robot. With amcl, a jackal parked on
+        its goal in the middle of the 2 m corridor, drawn grown by its spread, left the jackal
+        bound past it no room between it and the wall, and the jackals' corridor of 4 jammed
+        (seed 1). `_plan_through_parked` still judges a plan by the grown outline. Without a
+        covariance the two shapes are the same."""
+        shape = self._near_outline(k)
+        body = self.near_robots[k].body
+        if shape is body:
+            return shape
+        cm = self.costmap
+        near = footprint_at(padded_footprint(body, SEEN_BODY_MARGIN), xy[0], xy[1], yaw)
+        rows, cols = polygon_cells(cm, near)
+        if np.count_nonzero(cm.costs[rows, cols] == LETHAL_OBSTACLE) >= SEEN_CELLS:
+            return body
+        return shape
+
     def _near_outline(self, k: int, pad: float = 0.0) -> np.ndarray:
-        """Neighbour ``k``'s body as it enters the costmap, padded by ``pad`` m (robot frame):
+        """Neighbour ``k``'s body where it probably is, padded by ``pad`` m (robot frame):
         its footprint as shared, or, when it shares a covariance, its body grown by its spread
         by direction (`Neighbour.outline`; its shared footprint is padded by its widest spread
         all round: a lizi parked with amcl closed a 2 m corridor)."""

@@ -336,10 +336,10 @@ class CollvoidLocalPlanner(
         """The local costmap as (costs, origin, resolution) without the other robots' images
         (`without_robots`): each neighbour at ``pos`` (N, 2) m moving at ``nvel`` (N, 2) m/s,
         its body ``wide`` (N,) m grown by how far it moves in ``SEEN_LAG`` (at most
-        ``SEEN_LAG_MAX``) and two cells; with the standing robots' shared footprints
-        ``bodies`` (polygons, costmap frame) drawn in as LETHAL (a laser sees a robot's body
-        and not always its wheels). What this cycle's wall half-planes, footprint check,
-        passage widths and refuge read."""
+        ``SEEN_LAG_MAX``) and two cells; with the parked robots' shapes ``bodies`` (polygons,
+        costmap frame, `CollvoidParked._parked_shape`) drawn in as LETHAL (a laser sees a
+        robot's body and not always its wheels). What this cycle's wall half-planes,
+        footprint check, passage widths and refuge read."""
         cm = self.costmap
         origin, res = (cm.origin_x, cm.origin_y), cm.resolution
         costs = cm.costs

@@ -98,21 +98,17 @@ class CollvoidParked:
         if blocked:
             for k in np.flatnonzero(out):
                 as_bodies[ids[k]] = now + BODIES_TIME
-        cm, bodies = self.costmap, []
+        cell, bodies = self.costmap.resolution, []
         for k in np.flatnonzero(out):
-            grown = self._near_outline(k, cm.resolution)
-            rows, cols = polygon_cells(cm, footprint_at(grown, *pos[k], yaws[k]))
-            seen = np.count_nonzero(cm.costs[rows, cols] == LETHAL_OBSTACLE) >= SEEN_CELLS
+            seen = self._marked(footprint_at(self._near_outline(k, cell), *pos[k], yaws[k]))
             out[k] = seen or ids[k] in as_bodies
             if out[k]:
-                bodies.append(
-                    footprint_at(self._parked_shape(k, pos[k], yaws[k]), *pos[k], yaws[k])
-                )
+                bodies.append(self._parked_shape(k, pos[k], yaws[k]))
         return out, bodies
 
     def _parked_shape(self, k: int, xy: np.ndarray, yaw: float) -> np.ndarray:
-        """The shape (robot frame) parked neighbour ``k``, at ``xy`` (2,) m and ``yaw`` rad,
-        enters the local costmap with: its body where our laser marks it (``SEEN_CELLS`` lethal
+        """The polygon (costmap frame) parked neighbour ``k``, at ``xy`` (2,) m and ``yaw``
+        rad, enters the local costmap as: its body where our laser marks it (``SEEN_CELLS`` lethal
         cells or more within `SEEN_BODY_MARGIN` of its body at its shared pose), else its body
         grown by its localization spread (`_near_outline`, where it probably is). Its laser
         image stays in the costmap either way (parked robots are not cleared, `_walls`), so
@@ -123,14 +119,17 @@ class CollvoidParked:
         covariance the two shapes are the same."""
         shape = self._near_outline(k)
         body = self.near_robots[k].body
-        if shape is body:
-            return shape
-        cm = self.costmap
-        near = footprint_at(padded_footprint(body, SEEN_BODY_MARGIN), xy[0], xy[1], yaw)
-        rows, cols = polygon_cells(cm, near)
-        if np.count_nonzero(cm.costs[rows, cols] == LETHAL_OBSTACLE) >= SEEN_CELLS:
-            return body
-        return shape
+        if shape is not body:
+            near = footprint_at(padded_footprint(body, SEEN_BODY_MARGIN), xy[0], xy[1], yaw)
+            if self._marked(near):
+                shape = body
+        return footprint_at(shape, xy[0], xy[1], yaw)
+
+    def _marked(self, polygon: np.ndarray) -> bool:
+        """``SEEN_CELLS`` lethal cells or more of the local costmap lie under ``polygon``
+        (costmap frame): our sensors mark something there."""
+        rows, cols = polygon_cells(self.costmap, polygon)
+        return np.count_nonzero(self.costmap.costs[rows, cols] == LETHAL_OBSTACLE) >= SEEN_CELLS
 
     def _near_outline(self, k: int, pad: float = 0.0) -> np.ndarray:
         """Neighbour ``k``'s body where it probably is, padded by ``pad`` m (robot frame):

@@ -74,6 +74,25 @@ def test_corrected_models_use_sqrt_of_variance():
     assert sd_corr == pytest.approx(0.2, rel=0.03)
 
 
+def test_a_turn_that_moves_the_base_sideways_over_1_cm_spreads_the_cloud_by_its_bearing():
+    """amcl's diff model (and Nav2's) takes ``delta_rot1`` as the bearing of the move once it
+    is 1 cm or more; a skid steer turning on the spot about a point off its base (the jackal's
+    and the pioneer3at's, ~3 cm) moves it sideways, ``delta_rot1`` comes out near 90 deg, and
+    ``alpha1 * rot1^2`` and ``alpha4 * (rot1^2 + rot2^2)`` become ~0.5 rad and ~0.9 m of noise
+    in one update (README, "Stop 48"). The same turn moving the base less stays tight."""
+    rng = np.random.default_rng(5)
+    p = np.zeros((4000, 3))
+    alphas = (0.2, 0.2, 0.2, 0.2, 0.1)  # jackal_navigation's amcl
+    spreads = {}
+    for side in (0.0085, 0.011):
+        out = particles_after_odometry(
+            p, np.zeros(3), np.array([0.0, side, 0.2]), "diff", alphas, rng
+        )
+        spreads[side] = (np.hypot(out[:, 0], out[:, 1]).std(), out[:, 2].std())
+    assert spreads[0.0085][0] < 0.01 and spreads[0.0085][1] < 0.01  # a4 * rot2^2 = 8 mm, 0.008 rad
+    assert spreads[0.011][0] > 0.4 and spreads[0.011][1] > 0.5
+
+
 def test_backward_motion_moves_backwards():
     out = particles_after_odometry(
         np.array([[1.0, 1.0, np.pi / 2]]),

@@ -212,6 +212,23 @@ def test_two_jackals_with_amcl_swap_the_corridor_off_the_walls(monkeypatch, tmp_
     assert frames == {"jackal1/odom", "jackal2/odom"}
 
 
+def test_three_jackals_in_willow_keep_off_the_walls_their_laser_has_not_seen(monkeypatch, tmp_path):
+    """model:=jackal in willow_swap (the starts chosen for lizis): jackal1 starts where it
+    cannot turn on the spot, and its front laser (270 degrees) has never seen the wall behind
+    it. With only the laser in its collvoid local costmap it backed and turned into that wall
+    (seed 3: 2 robot-wall contacts, with amcl and without; seeds 0-9: 2 contacts, 6 robots 20 s
+    without progress, up to 40.7 s). With the map's static layer in that costmap, as the
+    pioneer3at's has, 0 contacts and 21.9-22.3 s on seeds 0-9."""
+    monkeypatch.chdir(tmp_path)
+    launch_args = {"robots": "3", "model": "jackal", "gui": "false"}
+    plan = load_plan(resolve_launch_file("willow_swap"), launch_args)
+    plan.jitter_spawns(3, 0.02)  # benchmarks/multi_robot.py's starts for seed 3
+    with LaunchSession(plan, seed=3) as s:
+        s.run(duration=60.0, until_goals=True)
+        assert_clean_success(s, tmp_path)
+        assert {r.namespace for r in s.monitor.results()} == {f"/jackal{k}" for k in (1, 2, 3)}
+
+
 def test_turtlebot3_burgers_cross_the_circle_without_a_ring_of_wakes(monkeypatch, tmp_path):
     """model:=turtlebot3_burger, with turtlebot3_navigation's limits and collvoid's defaults:
     a burger's 360-degree laser sees the others, and every cell it saw a moving robot in stayed

@@ -588,3 +588,17 @@ def test_a_standoff_yields_to_the_robot_met_head_on_only():
     assert top.update(4.9, 4.6, near, facing=["pioneer4"]) is None
     assert top.update(5.1, 4.6, near, facing=["pioneer4"]) is None
     assert top.update(12.1, 4.6, near, facing=["pioneer4"]) == "pioneer1"
+
+
+def test_a_yield_ends_once_the_robot_yielded_to_is_out_of_our_way():
+    """A robot we yield to that has gone off to the side, beyond deadlock_radius and clear of
+    our plan ahead, is out of our way though not behind us: the yield ends there
+    (`_out_of_our_way`). Pioneers' circle of 16, seed 1: pioneer7 waited 27 s for pioneer5,
+    3 m to its side, turning onto its goal."""
+    f = Fleet([(-3.0, 0.0, 0.0)], [(3.0, 0.0, 0.0)], deadlock_radius=2.0)
+    pl, me = f.planners[0], np.array([-3.0, 0.0])
+    radii = 2 * BODY
+    assert pl._out_of_our_way(me, np.array([0.0, 0.3]), radii) is False  # on our way ahead
+    assert pl._out_of_our_way(me, np.array([0.0, 2.5]), radii) is True  # 2.5 m to the side
+    assert pl._out_of_our_way(me, np.array([-2.0, 1.5]), radii) is False  # within 2 m of us
+    assert pl._out_of_our_way(me, np.array([0.0, 0.8]), radii) is False  # beside the way

@@ -43,14 +43,24 @@ class CollvoidPreference:
     def _yield_velocity(self, xy, to_goal, other, own_r, other_r, remaining, pref):
         """Yielding (`fleetsim.nav.multirobot.yielding`): to the refuge back along the plan,
         then wait there; the yield ends (``pref`` again) as soon as the other robot is level
-        with us (beside us in the refuge, out of the passage; ORCA keeps us apart from there)."""
+        with us (beside us in the refuge, out of the passage; ORCA keeps us apart from there)
+        or out of our way (`_out_of_our_way`)."""
         p, now = self.params, self.node.now()
-        if has_passed(other - xy, to_goal, 0.0):
+        if has_passed(other - xy, to_goal, 0.0) or self._out_of_our_way(xy, other, own_r + other_r):
             self.deadlock.release(now, remaining)
             self.yielding_to = None
             return pref
         decel = DECELERATION * p.acc_lim_x
         return self.retreat.velocity(self.grid, xy, own_r, other_r, p.max_vel_x, decel)
+
+    def _out_of_our_way(self, xy, other, radii) -> bool:
+        """The robot we yield to (at ``other``, m) is farther than ``deadlock_radius`` from us
+        and more than twice the pair's combined radius ``radii`` (m) from every point of our
+        plan still ahead: it no longer stands in our way, though it is not behind us."""
+        if float(np.hypot(*(other - xy))) <= self.params.deadlock_radius:
+            return False
+        ahead = self.plan[self.plan_index :, :2]
+        return float(np.min(np.hypot(*(ahead - other).T))) > 2.0 * radii
 
     def _around_still(
         self, pref, xy, vel, rel, nvel, radii, controlled, ids, passage=None

@@ -22,8 +22,8 @@ measurement with RVO2: exact head-on pairs and 0.6 m corridors never finish). Ea
    the same ids, so all reach the same verdict without talking. If one of them has priority
    over it, it *yields* to the nearest such robot: it takes full responsibility for avoiding
    it (the priority robot keeps its half and drives on), retreats along its own plan to a place
-   wide enough for both and waits there, aside, until that robot has gone by
-   (`fleetsim.nav.multirobot.yielding`; the planner calls `release`), or at most
+   wide enough for both and waits there, aside, until that robot has gone by or is out of
+   its way (`fleetsim.nav.multirobot.yielding`; the planner calls `release`), or at most
    ``yield_time`` s;
 3. after yielding, the progress clock restarts, so a robot that is still stuck yields again.
 

@@ -302,7 +302,7 @@ def main() -> None:
         return
     header = (
         f"{'scenario':<16} {'planner':<11}{'runs':>5}{'rob-rob':>8}{'rob-wall':>9}{'deadl':>6}"
-        f"{'reached':>9}{'makespan s':>12}{'x alone':>11}{'>1.5x':>6}{'extra path':>11}"
+        f"{'reached':>9}{'makespan s':>12}{'x alone':>11}{f'>{TARGET_RATIO}x':>6}{'extra path':>11}"
         f"{'wall s':>8}"
     )
     seeds = range(a.first_seed, a.first_seed + a.seeds)

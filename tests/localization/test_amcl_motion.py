@@ -79,7 +79,8 @@ def test_a_turn_that_moves_the_base_sideways_over_1_cm_spreads_the_cloud_by_its_
     is 1 cm or more; a skid steer turning on the spot about a point off its base (the jackal's
     and the pioneer3at's, ~3 cm) moves it sideways, ``delta_rot1`` comes out near 90 deg, and
     ``alpha1 * rot1^2`` and ``alpha4 * (rot1^2 + rot2^2)`` become ~0.5 rad and ~0.9 m of noise
-    in one update (README, "Stop 48"). The same turn moving the base less stays tight."""
+    in one update (docs/multi_robot.md, "Stop 48"). The same turn moving the base less stays
+    tight."""
     rng = np.random.default_rng(5)
     p = np.zeros((4000, 3))
     alphas = (0.2, 0.2, 0.2, 0.2, 0.1)  # jackal_navigation's amcl
@@ -89,7 +90,8 @@ def test_a_turn_that_moves_the_base_sideways_over_1_cm_spreads_the_cloud_by_its_
             p, np.zeros(3), np.array([0.0, side, 0.2]), "diff", alphas, rng
         )
         spreads[side] = (np.hypot(out[:, 0], out[:, 1]).std(), out[:, 2].std())
-    assert spreads[0.0085][0] < 0.01 and spreads[0.0085][1] < 0.01  # a4 * rot2^2 = 8 mm, 0.008 rad
+    # a4 * rot^2 = 8 mm and a1 * rot^2 = 0.008 rad, both as standard deviations
+    assert spreads[0.0085][0] < 0.01 and spreads[0.0085][1] < 0.01
     assert spreads[0.011][0] > 0.4 and spreads[0.011][1] > 0.5
 
 

@@ -235,7 +235,8 @@ class CollvoidDrive:
         fleetsim's TrajectoryPlannerROS backs on such a curve too (`escape`)."""
         holo = self.last_holo
         # the wrap as measured (math.remainder differs in the last bits, and the jackals'
-        # corridor of 4, seed 3, then ends flush on the wall instead: see the README, stop 43)
+        # corridor of 4, seed 3, then ends flush on the wall instead: see docs/multi_robot.md,
+        # stop 43)
         err = (math.atan2(holo[1], holo[0]) - yaw + math.pi) % (2.0 * math.pi) - math.pi
         p = self.params
         fastest = ESCAPE_TURN * max(0.0, min(p.max_vel_theta, -p.min_vel_theta))

@@ -131,5 +131,6 @@ class CollvoidParams:
         30.0,
         unit="s",
         range=(0.0, None),
-        help="longest a yield lasts (it ends when the robot yielded to has gone by)",
+        help="longest a yield lasts (it ends when the robot yielded to has gone by or is out of "
+        "the way)",
     )

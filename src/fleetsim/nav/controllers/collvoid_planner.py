@@ -19,7 +19,8 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
 3. the `DeadlockRule` may make the robot yield (at once when a robot faces it across a
    passage too narrow for two): it backs out along the way it came (``max_vel_x_backwards``)
    to a place wide enough, aside to the right, taking full responsibility for avoiding the
-   robot with priority, and waits there without turning until that robot is level with it;
+   robot with priority, and waits there without turning until that robot is level with it
+   or out of its way (`CollvoidPreference._out_of_our_way`);
 4. ORCA half-planes (`fleetsim.nav.multirobot.orca`): one per robot on ``/position_share``
    within ``neighbor_dist`` (at most ``max_neighbors``, horizon ``time_horizon``, half the
    responsibility, all of it for a robot that is not ``controlled``, stands still or is yielded

@@ -4,8 +4,8 @@ giving way at a crossing (`_give_way`, `fleetsim.nav.multirobot.crossing`) and t
 of a robot that yields (`_yield_velocity`).
 
 `CollvoidPreference` is mixed into the planner, which owns the state it reads (``params``,
-``node``, ``plan``, ``costmap``, ``body_radius``, ``deadlock``, ``retreat``, ``yielding_to``,
-``detour_sides``, ``give_way``, ``turning_to``).
+``node``, ``plan``, ``plan_index``, ``costmap``, ``body_radius``, ``deadlock``, ``retreat``,
+``yielding_to``, ``detour_sides``, ``give_way``, ``turning_to``).
 """
 
 from __future__ import annotations

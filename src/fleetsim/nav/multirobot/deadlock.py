@@ -88,7 +88,8 @@ class DeadlockRule:
         self.narrow_since: float | None = None
 
     def release(self, now: float, remaining: float) -> None:
-        """The robot yielded to has gone by: the yield ends, the progress clock restarts."""
+        """The robot yielded to has gone by or is out of the way: the yield ends, the progress
+        clock restarts."""
         self.yield_to = None
         self.yield_until = -float("inf")
         self.best, self.best_time = remaining, now

@@ -21,7 +21,7 @@ from fleetsim.nav.multirobot.crossing import (
     room_to_turn,
 )
 from fleetsim.nav.multirobot.holonomic import detour_velocity, gaps_closed
-from fleetsim.nav.multirobot.yielding import has_passed
+from fleetsim.nav.multirobot.yielding import has_passed, out_of_way
 
 #: m/s: a neighbour slower than this is treated as standing still (full responsibility)
 STILL_SPEED = 0.02
@@ -55,12 +55,10 @@ class CollvoidPreference:
 
     def _out_of_our_way(self, xy, other, radii) -> bool:
         """The robot we yield to (at ``other``, m) is farther than ``deadlock_radius`` from us
-        and more than twice the pair's combined radius ``radii`` (m) from every point of our
-        plan still ahead: it no longer stands in our way, though it is not behind us."""
-        if float(np.hypot(*(other - xy))) <= self.params.deadlock_radius:
-            return False
+        and more than twice the pair's combined radius ``radii`` (m) from our plan still
+        ahead (`out_of_way`)."""
         ahead = self.plan[self.plan_index :, :2]
-        return float(np.min(np.hypot(*(ahead - other).T))) > 2.0 * radii
+        return out_of_way(other - xy, ahead, other, self.params.deadlock_radius, 2.0 * radii)
 
     def _around_still(
         self, pref, xy, vel, rel, nvel, radii, controlled, ids, passage=None

@@ -22,7 +22,7 @@ robot has gone by:
   robot keeps retreating and finds the wide place when it comes into view, or ends at the far
   end of its trail when there is none;
 * `has_passed`: the robot yielded to is behind the yielding one along its way to the goal, clear
-  of it;
+  of it; `out_of_way`: it is far off to the side of the yielding one's plan ahead;
 * `Retreat`: one robot's trail (the way it came, which a replanned path does not keep: it
   starts where the robot stands; kept across goals) and its refuge while it yields.
 """
@@ -254,6 +254,17 @@ def has_passed(rel_other: np.ndarray, to_goal: np.ndarray, clearance: float) -> 
     if n < 1e-9:
         return True
     return float(rel_other @ to_goal) / n < -clearance
+
+
+def out_of_way(
+    rel_other: np.ndarray, ahead: np.ndarray, other: np.ndarray, near: float, clearance: float
+) -> bool:
+    """The other robot (at ``rel_other``, m, relative to us; at ``other`` in the frame of
+    ``ahead``) is farther than ``near`` m from us and more than ``clearance`` m from every
+    point of ``ahead`` (K, 2), our plan still to drive: out of our way, though not behind us."""
+    if float(np.hypot(*rel_other)) <= near:
+        return False
+    return float(np.min(np.hypot(*(ahead - other).T))) > clearance
 
 
 def retreat_velocity(

@@ -12,6 +12,7 @@ from fleetsim.msgs import collvoid_msgs, geometry_msgs
 from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.nav.costmap.costmap_2d import INSCRIBED_INFLATED_OBSTACLE, LETHAL_OBSTACLE
 from fleetsim.nav.costmap.layered_costmap import LayeredCostmap
+from fleetsim.nav.errors import GoalOccupied
 from fleetsim.nav.multirobot.uncertainty import widest_spread
 from fleetsim.runtime import Node, Runtime
 
@@ -180,7 +181,11 @@ def _seen_costmap(order, **robots):
     robots layer, in ``order``; returns it and a /position_share publisher."""
     rt = Runtime()
     node = Node(rt, "move_base", "/lizi1")
-    kinds = {"obstacle_layer": "costmap_2d::ObstacleLayer", "voxel_layer": "costmap_2d::VoxelLayer"}
+    kinds = {
+        "obstacle_layer": "costmap_2d::ObstacleLayer",
+        "voxel_layer": "costmap_2d::VoxelLayer",
+        "inflation_layer": "costmap_2d::InflationLayer",
+    }
     params = {
         "global_frame": "/map",
         "width": 10.0,
@@ -190,7 +195,7 @@ def _seen_costmap(order, **robots):
         "plugins": [{"name": n, "type": kinds.get(n, "fleetsim::RobotsLayer")} for n in order],
         "robots_layer": robots,
     }
-    for n in set(kinds) & set(order):
+    for n in set(kinds) & set(order) - {"inflation_layer"}:
         params[n] = {
             "observation_sources": "scan",
             "scan": {"data_type": "LaserScan", "marking": True, "clearing": False},
@@ -287,3 +292,27 @@ def test_a_robot_standing_still_keeps_its_image():
     rt.run(duration=0.05)
     cm.update_map(5.0, 5.0, 0.0)
     assert all(cost_at(cm, x, y) == 0 for x, y in _body(2.0))
+
+
+def test_clear_still_robots_erases_a_parked_robots_image_so_navfn_takes_its_goal():
+    """In a global costmap (clear_still_robots) a parked robot's laser image goes and only the
+    layer's mark (252, below navfn's obstacle) stays: a goal where another robot stands gets a
+    plan (three jackals in Willow, each sent to another's start, had none for 11-16 s)."""
+    from fleetsim.nav.planners import NavFn, NavfnParams
+
+    order = ("obstacle_layer", "robots_layer", "inflation_layer")
+    for clear_still, expected in ((False, LETHAL_OBSTACLE), (True, 252)):
+        rt, cm, pub = _seen_costmap(order, clear_still_robots=clear_still)
+        pub.publish(shared("lizi2", 2.0, 3.0, 0.0))
+        rt.run(duration=0.05)
+        _hits(cm, "obstacle_layer", _body(2.0) + WALL)
+        cm.update_map(5.0, 5.0, 0.0)
+        assert cost_at(cm, 1.8, 3.0) == expected, clear_still
+        assert cost_at(cm, 2.0, 2.55) == LETHAL_OBSTACLE  # the wall's hit beside it is kept
+        planner = NavFn(cm.costmap, NavfnParams(), "map")
+        if clear_still:
+            path = planner.create_plan((5.0, 5.0, 0.0), (2.0, 3.0, 0.0)).poses
+            assert np.hypot(*(path[-1, :2] - [2.0, 3.0])) < 0.1
+        else:
+            with pytest.raises(GoalOccupied):
+                planner.create_plan((5.0, 5.0, 0.0), (2.0, 3.0, 0.0))

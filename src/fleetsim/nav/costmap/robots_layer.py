@@ -33,7 +33,11 @@ the obstacle layers of its costmap the cells under every other robot on the move
 moves in ``SEEN_LAG`` (the age of a scan and of a shared pose), at every update: a moving
 robot's image never outlives the update it was marked in. A robot standing still keeps its
 image, which is where it is (the local planner tells parked robots it sees from those it does
-not by it), and gets this layer's marks. A wall under the padding is marked again by the next
+not by it), and gets this layer's marks; with ``clear_still_robots`` (for a global costmap) its
+image is erased too and only this layer's marks stay. Three jackals in the Willow map, whose
+lasers see each other, had no global plan for 11 to 16 s: each goal is another jackal's start,
+and its lethal, inflated image made navfn refuse the goal until the aggressive reset cleared
+the obstacle layer. A wall under the padding is marked again by the next
 scan that sees it (the static layer's walls are not touched). Layers before this one in
 ``plugins`` are cleared after their marking (``update_bounds``), layers after it before their
 costs reach the master grid (``update_costs``).
@@ -83,6 +87,13 @@ class RobotsLayerParams:
         True,
         help="erase the moving robots' bodies, as the sensors saw them, from this costmap's "
         "obstacle layers (fleetsim)",
+    )
+    clear_still_robots: bool = param(
+        False,
+        help="with clear_robots, erase the robots standing still too, which this layer marks "
+        "(at cost): in a global costmap, where a robot's laser image, lethal and inflated, "
+        "closes a passage or the goal it stands on to navfn; not in a local costmap whose "
+        "collvoid planner tells parked robots its sensors see by their image (fleetsim)",
     )
     seen_padding: float = param(
         0.1,
@@ -166,11 +177,12 @@ class RobotsLayer(Layer):
             if np.hypot(centre[0] - robot_x, centre[1] - robot_y) > p.max_distance:
                 continue
             speed = float(np.hypot(r.vx, r.vy))
-            if speed < p.still_speed:
+            still = speed < p.still_speed
+            if still:
                 # its body and spread by direction (its shared footprint is padded by its
                 # widest spread all round: a lizi parked with amcl closed a 2 m corridor)
                 marked.append(placed(r, r.outline(p.eps, p.static_scale, self._grow)))
-            elif p.clear_robots:
+            if p.clear_robots and (not still or p.clear_still_robots):
                 pad = p.seen_padding + SEEN_LAG * speed
                 seen.append(placed(r, padded_footprint(r.footprint, pad)))
         return marked, seen

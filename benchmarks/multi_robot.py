@@ -128,7 +128,14 @@ def scenario_item(item: str) -> tuple[str, int, dict[str, str]]:
             f"--scenarios: {item!r} is not NAME:ROBOTS[:arg=value...] "
             "(e.g. circle:16, willow_swap:3, swap_corridor:2:localization=amcl)"
         )
-    return name, int(count), dict(kv.split("=", 1) for kv in args)
+    launch_args = dict(kv.split("=", 1) for kv in args)
+    models = [*_generator().NAME_PREFIXES, "mixed"]
+    if launch_args.get("model", "lizi") not in models:
+        raise SystemExit(
+            f"--scenarios: {item!r}: model {launch_args['model']!r} is not one of the "
+            f"scenarios' models ({', '.join(models)})"
+        )
+    return name, int(count), launch_args
 
 
 def run_once(name: str, robots: int, planner: str, seed: int, limit: float, jitter: float,

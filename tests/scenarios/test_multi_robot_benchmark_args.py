@@ -18,10 +18,14 @@ def test_items_give_name_robots_and_launch_args():
         2,
         {"localization": "amcl", "width": "1.0"},
     )
+    assert multi_robot.scenario_item("circle:8:model=turtlebot3_burger")[2] == {
+        "model": "turtlebot3_burger"
+    }
 
 
 @pytest.mark.parametrize(
-    "item", ["willow_swap", "circle:", "circle:x", "circle:0", "circle:16:foo"]
+    "item",
+    ["willow_swap", "circle:", "circle:x", "circle:0", "circle:16:foo", "circle:8:model=burger"],
 )
 def test_a_bad_item_is_named(item):
     with pytest.raises(SystemExit, match=re.escape(repr(item))):

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import atexit
 import gc
 import logging
 import zlib
@@ -16,6 +17,7 @@ from fleetsim.runtime.params import ParamTree
 from fleetsim.runtime.scheduler import NS, Scheduler, Timer, to_ns
 
 _log = logging.getLogger("fleetsim.runtime")
+_UNFREEZE_AT_EXIT = False
 
 
 class Runtime:
@@ -85,9 +87,17 @@ class Runtime:
         objects for ten robots) out of Python's full garbage collections (``gc.freeze``), which
         otherwise walk all of it every few seconds (~0.2 s each, 3-4 % of a fleet's run) to
         free the few short-lived cycles a run makes; those are still collected. Undone at
-        `shutdown`, so that a finished run's own cycles can be freed."""
+        `shutdown`, so that a finished run's own cycles can be freed; and at interpreter exit,
+        for a Runtime never shut down."""
+        global _UNFREEZE_AT_EXIT
         self._heap_frozen = True
         gc.freeze()
+        if not _UNFREEZE_AT_EXIT:
+            # the collections at interpreter exit skip frozen objects too: without this, what a
+            # Runtime left unshut froze (such as extension types, freed only as cycles: OMPL's,
+            # which nanobind then reports as leaked) would never be freed nor finalised
+            atexit.register(gc.unfreeze)
+            _UNFREEZE_AT_EXIT = True
 
     def spin_once(self) -> int:
         """Deliver pending messages without advancing time; returns how many were delivered."""

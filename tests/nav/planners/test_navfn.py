@@ -349,3 +349,26 @@ def test_known_bounds_match_numpy_on_whole_maps_windows_and_odd_widths():
     edge = np.full((16, 16), 255, np.uint8)
     edge[15, 15] = 0  # the last byte of the last word
     assert known_bounds(edge) == (15, 15, 16, 16)
+
+
+def test_a_descent_caught_on_a_plateaus_edge_still_finds_its_way():
+    """A jackal's global costmap on the circle of 16 (seed 2, 76 s): parked robots as the robots
+    layer's 252 cells, no walls. navfn's descent turned back and forth inside one cell on a
+    plateau's edge, never repeating a point exactly, until its steps ran out; the goal was
+    aborted. A descent that stays in one cell for STUCK_STEPS steps now moves to the lowest
+    neighbour, as on navfn's own oscillation."""
+    from pathlib import Path
+
+    data = np.load(Path(__file__).with_name("navfn_plateau_edge.npz"))
+    costs = data["costs"]
+    cm = Costmap2D(costs.shape[1], costs.shape[0], float(data["resolution"]), *data["origin"])
+    cm.costs[:] = costs
+    path = NavFn(cm, NavfnParams(), "map").create_plan(tuple(data["start"]), tuple(data["goal"]))
+    poses = path.poses
+    assert np.hypot(*(poses[0, :2] - data["start"][:2])) < 0.05
+    assert np.hypot(*(poses[-1, :2] - data["goal"][:2])) < 0.05
+    cells = ((poses[:, :2] - data["origin"]) / data["resolution"]).astype(int)
+    assert costs[cells[:, 1], cells[:, 0]].max() < 252  # round the parked robots
+    steps = np.hypot(*np.diff(poses[:, :2], axis=0).T)
+    assert steps.max() < 2.5 * float(data["resolution"])  # a connected path
+    assert steps.sum() < 1.6 * np.hypot(*(data["goal"][:2] - data["start"][:2]))

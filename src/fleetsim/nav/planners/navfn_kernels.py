@@ -267,12 +267,22 @@ def _grad_cell(pot, gradx, grady, nx, ns, n):
         grady[n] = dy / norm
 
 
+#: steps of the gradient descent in one cell taken as an oscillation (`navfn_path`): a 0.5-cell
+#: step along a steady gradient leaves a cell within 6 steps (4 straight, 6 diagonally)
+STUCK_STEPS = 8
+
+
 @njit(cache=True)
 def navfn_path(pot, nx, start_x, start_y, goal_x, goal_y, max_steps, step):
     """Descend the potential from (start_x, start_y) to the zero-potential goal (calcPath).
 
     Follows the bilinearly interpolated normalised gradient in steps of ``step`` cells; near
-    unreached cells or on oscillation it moves to the lowest 8-neighbour instead.
+    unreached cells or on oscillation it moves to the lowest 8-neighbour instead. Oscillation
+    is navfn's (a point repeated two steps later, exactly) or, a fleetsim addition, a descent
+    that stays in one cell for `STUCK_STEPS` steps: on the edge of a plateau (a parked robot's
+    252 cells from the robots layer, no inflation round them) the interpolated gradient turns
+    back and forth inside one cell, never exactly repeating a point, until ``max_steps`` runs
+    out and the plan fails (a jackal on the circle of 16 had its goal aborted so).
 
     Returns
     -------
@@ -287,6 +297,8 @@ def navfn_path(pot, nx, start_x, start_y, goal_x, goal_y, max_steps, step):
     stc = start_y * nx + start_x
     dx = 0.0
     dy = 0.0
+    cell = stc
+    stay = 0  # steps in this cell
     for _ in range(max_steps):
         near = stc + round(dx) + nx * round(dy)
         near = max(0, min(ns - 1, near))
@@ -299,7 +311,12 @@ def navfn_path(pot, nx, start_x, start_y, goal_x, goal_y, max_steps, step):
         path[npath, 0] = stc % nx + dx
         path[npath, 1] = stc // nx + dy
         npath += 1  # noqa: SIM113
-        oscillation = (
+        if stc == cell:
+            stay += 1
+        else:
+            cell = stc
+            stay = 0
+        oscillation = stay >= STUCK_STEPS or (
             npath > 2
             and path[npath - 1, 0] == path[npath - 3, 0]
             and path[npath - 1, 1] == path[npath - 3, 1]

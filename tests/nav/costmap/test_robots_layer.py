@@ -316,3 +316,19 @@ def test_clear_still_robots_erases_a_parked_robots_image_so_navfn_takes_its_goal
         else:
             with pytest.raises(GoalOccupied):
                 planner.create_plan((5.0, 5.0, 0.0), (2.0, 3.0, 0.0))
+
+
+@pytest.mark.parametrize(
+    "order", [("obstacle_layer", "robots_layer"), ("robots_layer", "obstacle_layer")]
+)
+def test_clear_still_robots_erases_only_under_the_mark(order):
+    """Only the cells the layer marks (the body scaled by static_scale, here unpadded) lose
+    their hits: a hit 5 cm outside the mark stays lethal, one inside becomes the mark's cost."""
+    rt, cm, pub = _seen_costmap(order, clear_still_robots=True, padding=0.0)
+    pub.publish(shared("lizi2", 2.0, 3.0, 0.0))
+    rt.run(duration=0.05)
+    inside, outside = (2.0, 2.85), (2.0, 2.76)  # the mark reaches 2.81 (0.95 x 0.2 m)
+    _hits(cm, order[0] if order[0] != "robots_layer" else order[1], [inside, outside])
+    cm.update_map(5.0, 5.0, 0.0)
+    assert cost_at(cm, *inside) == 252
+    assert cost_at(cm, *outside) == LETHAL_OBSTACLE

@@ -31,14 +31,17 @@ in 5 seeds). With ``clear_robots`` (a fleetsim addition, on by default) the laye
 the obstacle layers of its costmap the cells under every other robot on the move (at
 ``still_speed`` or faster), its shared footprint padded by ``seen_padding`` and by how far it
 moves in ``SEEN_LAG`` (the age of a scan and of a shared pose), at every update: a moving
-robot's image never outlives the update it was marked in. A robot standing still keeps its
-image, which is where it is (the local planner tells parked robots it sees from those it does
-not by it), and gets this layer's marks; with ``clear_still_robots`` (for a global costmap) its
-image is erased too and only this layer's marks stay. Three jackals in the Willow map, whose
-lasers see each other, had no global plan for 11 to 16 s: each goal is another jackal's start,
-and its lethal, inflated image made navfn refuse the goal until the aggressive reset cleared
-the obstacle layer. A wall under the padding is marked again by the next
-scan that sees it (the static layer's walls are not touched). Layers before this one in
+robot's image never outlives the update it was marked in. A wall under the padding is marked
+again by the next scan that sees it (the static layer's walls are not touched). By default a
+robot standing still keeps its image, which is where it is (the local planner tells parked
+robots it sees from those it does not by it), and gets this layer's marks. With
+``clear_still_robots`` (for a global costmap) the obstacle layers' cells under those marks are
+erased, so that only the marks (``cost``, not lethal, not inflated) stay there while it stands:
+three jackals in the Willow map, whose lasers see each other, had no global plan for 10-15 s
+after their goals went out, since each goal is another jackal's start and its lethal, inflated
+image made navfn refuse the goal until the aggressive reset cleared the obstacle layer. A
+parked robot then has no inflation round it in the global costmap, as the robots that lasers
+do not see (the lizis) never had. Layers before this one in
 ``plugins`` are cleared after their marking (``update_bounds``), layers after it before their
 costs reach the master grid (``update_costs``).
 
@@ -90,10 +93,10 @@ class RobotsLayerParams:
     )
     clear_still_robots: bool = param(
         False,
-        help="with clear_robots, erase the robots standing still too, which this layer marks "
-        "(at cost): in a global costmap, where a robot's laser image, lethal and inflated, "
-        "closes a passage or the goal it stands on to navfn; not in a local costmap whose "
-        "collvoid planner tells parked robots its sensors see by their image (fleetsim)",
+        help="erase from the obstacle layers the cells this layer marks (at cost) under the "
+        "robots standing still: in a global costmap, where a robot's laser image, lethal and "
+        "inflated, closes a passage or the goal it stands on to navfn; not in a local costmap "
+        "whose collvoid planner tells parked robots its sensors see by their image (fleetsim)",
     )
     seen_padding: float = param(
         0.1,
@@ -177,12 +180,14 @@ class RobotsLayer(Layer):
             if np.hypot(centre[0] - robot_x, centre[1] - robot_y) > p.max_distance:
                 continue
             speed = float(np.hypot(r.vx, r.vy))
-            still = speed < p.still_speed
-            if still:
+            if speed < p.still_speed:
                 # its body and spread by direction (its shared footprint is padded by its
                 # widest spread all round: a lizi parked with amcl closed a 2 m corridor)
-                marked.append(placed(r, r.outline(p.eps, p.static_scale, self._grow)))
-            if p.clear_robots and (not still or p.clear_still_robots):
+                mark = placed(r, r.outline(p.eps, p.static_scale, self._grow))
+                marked.append(mark)
+                if p.clear_still_robots:  # under its mark only: nothing erased goes unmarked
+                    seen.append(mark)
+            elif p.clear_robots:
                 pad = p.seen_padding + SEEN_LAG * speed
                 seen.append(placed(r, padded_footprint(r.footprint, pad)))
         return marked, seen

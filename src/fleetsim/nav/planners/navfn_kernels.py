@@ -267,8 +267,9 @@ def _grad_cell(pot, gradx, grady, nx, ns, n):
         grady[n] = dy / norm
 
 
-#: steps of the gradient descent in one cell taken as an oscillation (`navfn_path`): a 0.5-cell
-#: step along a steady gradient leaves a cell within 6 steps (4 straight, 6 diagonally)
+#: steps of the gradient descent in one base cell taken as an oscillation (`navfn_path`): along
+#: a steady gradient 0.5-cell steps cross the cell's offset window (+-1) within 5 steps
+#: straight and 6 diagonally
 STUCK_STEPS = 8
 
 
@@ -297,8 +298,8 @@ def navfn_path(pot, nx, start_x, start_y, goal_x, goal_y, max_steps, step):
     stc = start_y * nx + start_x
     dx = 0.0
     dy = 0.0
-    cell = stc
-    stay = 0  # steps in this cell
+    cell = -1
+    stay = 0  # points of the path in this cell after the first
     for _ in range(max_steps):
         near = stc + round(dx) + nx * round(dy)
         near = max(0, min(ns - 1, near))

@@ -41,9 +41,9 @@ three jackals in the Willow map, whose lasers see each other, had no global plan
 after their goals went out, since each goal is another jackal's start and its lethal, inflated
 image made navfn refuse the goal until the aggressive reset cleared the obstacle layer. A
 parked robot then has no inflation round it in the global costmap, as the robots that lasers
-do not see (the lizis) never had. Layers before this one in
-``plugins`` are cleared after their marking (``update_bounds``), layers after it before their
-costs reach the master grid (``update_costs``).
+do not see (the lizis) never had. Layers before this one in ``plugins`` are cleared after
+their marking (``update_bounds``), layers after it before their costs reach the master grid
+(``update_costs``).
 
 The layer keeps no grid of its own: each update it clears where robots were last marked (by
 widening the bounds, so the layers below rewrite those cells) and marks where they are now. The

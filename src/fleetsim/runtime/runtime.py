@@ -17,7 +17,11 @@ from fleetsim.runtime.params import ParamTree
 from fleetsim.runtime.scheduler import NS, Scheduler, Timer, to_ns
 
 _log = logging.getLogger("fleetsim.runtime")
-_UNFREEZE_AT_EXIT = False
+# the collections at interpreter exit skip frozen objects too: without this, what a Runtime left
+# unshut froze (`Runtime._freeze_heap`; such as extension types, freed only as cycles: OMPL's,
+# which nanobind then reports as leaked) would never be freed nor finalised. A no-op when
+# nothing is frozen.
+atexit.register(gc.unfreeze)
 
 
 class Runtime:
@@ -89,15 +93,8 @@ class Runtime:
         free the few short-lived cycles a run makes; those are still collected. Undone at
         `shutdown`, so that a finished run's own cycles can be freed; and at interpreter exit,
         for a Runtime never shut down."""
-        global _UNFREEZE_AT_EXIT
         self._heap_frozen = True
         gc.freeze()
-        if not _UNFREEZE_AT_EXIT:
-            # the collections at interpreter exit skip frozen objects too: without this, what a
-            # Runtime left unshut froze (such as extension types, freed only as cycles: OMPL's,
-            # which nanobind then reports as leaked) would never be freed nor finalised
-            atexit.register(gc.unfreeze)
-            _UNFREEZE_AT_EXIT = True
 
     def spin_once(self) -> int:
         """Deliver pending messages without advancing time; returns how many were delivered."""

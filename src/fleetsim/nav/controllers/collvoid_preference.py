@@ -58,7 +58,7 @@ class CollvoidPreference:
         and more than twice the pair's combined radius ``radii`` (m) from our plan still
         ahead (`out_of_way`)."""
         ahead = self.plan[self.plan_index :, :2]
-        return out_of_way(other - xy, ahead, other, self.params.deadlock_radius, 2.0 * radii)
+        return out_of_way(xy, other, ahead, self.params.deadlock_radius, 2.0 * radii)
 
     def _around_still(
         self, pref, xy, vel, rel, nvel, radii, controlled, ids, passage=None

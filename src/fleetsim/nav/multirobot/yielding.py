@@ -257,12 +257,12 @@ def has_passed(rel_other: np.ndarray, to_goal: np.ndarray, clearance: float) -> 
 
 
 def out_of_way(
-    rel_other: np.ndarray, ahead: np.ndarray, other: np.ndarray, near: float, clearance: float
+    xy: np.ndarray, other: np.ndarray, ahead: np.ndarray, near: float, clearance: float
 ) -> bool:
-    """The other robot (at ``rel_other``, m, relative to us; at ``other`` in the frame of
-    ``ahead``) is farther than ``near`` m from us and more than ``clearance`` m from every
-    point of ``ahead`` (K, 2), our plan still to drive: out of our way, though not behind us."""
-    if float(np.hypot(*rel_other)) <= near:
+    """The other robot (at ``other``, m, in the frame of our position ``xy`` and of ``ahead``)
+    is farther than ``near`` m from us and more than ``clearance`` m from every point of
+    ``ahead`` (K, 2), our plan still to drive: out of our way, though not behind us."""
+    if float(np.hypot(*(other - xy))) <= near:
         return False
     return float(np.min(np.hypot(*(ahead - other).T))) > clearance
 

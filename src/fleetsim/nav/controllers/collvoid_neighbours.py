@@ -75,6 +75,7 @@ class CollvoidNeighbours:
         its disc. The radius as sent for a robot that shares no covariance; with no spread
         anywhere (fake_localization) the radii as sent, exactly, all three."""
         covs = near.covariances
+        self.near_spreads = {}  # robot id -> the pair's spread padding (`pair_padding`), m
         if self._covariance is None and not covs.any():
             return near.radii, near.radii, near.radii
         shared = covs.reshape(-1, 4).any(axis=1)
@@ -82,6 +83,7 @@ class CollvoidNeighbours:
         rel, cap, eps = near.positions - map_xy, 2.0 * self.body_radius, self.params.eps
         vrel = np.asarray(map_vel, dtype=np.float64) - near.velocities
         pad = pair_padding(rel, own_r + body, self._covariance, cap, covs, 2.0 * body, eps, vrel)
+        self.near_spreads = dict(zip(near.ids, pad.tolist(), strict=True))
         orca = body + pad
         # a robot standing still that shares its spread: by its body's outline, not its disc
         # (the lizis' corridor of 4 with amcl, seeds 1-8: 2 robots 20 s without progress, 7
@@ -132,6 +134,7 @@ class CollvoidNeighbours:
             tx, ty, tyaw = self._map_to_local()
         except TransformError:
             self.near_robots = []
+            self.near_by_id = {}
             return xy, ids, pos, nvel, radii, resp, controlled, yaws, radii, radii
         map_xy = rotated(xy - [tx, ty], -tyaw)
         near = self.share.table.near(
@@ -146,4 +149,5 @@ class CollvoidNeighbours:
         yaws = np.array([r.yaw for r in near.robots]) + tyaw
         radii, wide, room = self.neighbour_radii(own_r, map_xy, near, rotated(vel, -tyaw))
         self.near_robots = near.robots  # their outlines when parked (`_near_outline`)
+        self.near_by_id = dict(zip(near.ids, near.robots, strict=True))
         return map_xy, near.ids, pos, nvel, radii, resp, near.controlled, yaws, wide, room

@@ -79,6 +79,11 @@ class CollvoidParams:
     eps: float = param(
         0.1, range=(0.0, 0.999), help="amcl particle weight allowed outside the own safety radius"
     )
+    use_polygon_footprint: bool = param(
+        False,
+        help="robots' velocity obstacles from their footprints' Minkowski sum, not their "
+        "circumscribed discs (collvoid's polygon mode)",
+    )
     # fleetsim additions
     safety_margin: float = param(
         0.05, unit="m", range=(0.0, None), help="added to the robot radius against neighbours"

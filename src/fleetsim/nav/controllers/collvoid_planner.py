@@ -99,7 +99,8 @@ from fleetsim.nav.multirobot.holonomic import (
     rotated,
     without_robots,
 )
-from fleetsim.nav.multirobot.orca import contact_halfplanes, orca_halfplanes, orca_velocity
+from fleetsim.nav.multirobot.orca import contact_halfplanes_along, orca_halfplanes, orca_velocity
+from fleetsim.nav.multirobot.polygon_vo import pair_shapes, polygon_orca_halfplanes, shape_gaps
 from fleetsim.nav.multirobot.position_share import PositionShare
 from fleetsim.nav.multirobot.uncertainty import cloud_covariance
 from fleetsim.nav.multirobot.yielding import Retreat, head_on, narrow_between
@@ -297,6 +298,9 @@ class CollvoidLocalPlanner(
         self.grid = self._walls(pos, nvel, wide, bodies)
         dist = np.hypot(pos[:, 0] - xy[0], pos[:, 1] - xy[1])
         pair = self.pair_radii(own_r, radii, dist)
+        # how wide two robots are side by side (a passage, a refuge, out of the way): their
+        # discs, or with ``use_polygon_footprint`` their bodies' half widths across their axes
+        own_side, side = self._sides(own_r, ids, wide)
         active = {k: d for k, d, c in zip(ids, dist.tolist(), controlled) if c}
         narrow: list[str] = []
         facing: list[str] = []
@@ -304,14 +308,14 @@ class CollvoidLocalPlanner(
             met = head_on(carrot - xy, pos - xy, nvel, yaws, controlled)
             facing = [ids[k] for k in met]
             narrow = [
-                ids[k] for k in met if narrow_between(*self.grid, xy, pos[k], own_r, float(wide[k]))
+                ids[k] for k in met if narrow_between(*self.grid, xy, pos[k], own_side, side[k])
             ]
         self.yielding_to = self.deadlock.update(now, remaining, active, narrow, facing)
         self.waiting = False
         if self.yielding_to is not None:
             k = ids.index(self.yielding_to)
             along = carrot - self.plan[self.plan_index, :2]  # the plan's way here
-            pref = self._yield_velocity(xy, along, pos[k], own_r, wide[k], remaining, pref)
+            pref = self._yield_velocity(xy, along, pos[k], own_side, side[k], remaining, pref)
             if self.yielding_to is not None:
                 resp[k] = 1.0
                 self.waiting = not pref.any()
@@ -331,7 +335,63 @@ class CollvoidLocalPlanner(
             pref = self._give_way(
                 pref, wanted, vel, pos - xy, nvel, pair, resp, controlled, ids, meeting
             )
-        return self._orca(xy, vel, pref, pos - xy, nvel, pair, resp, self.bodies_radii(radii))
+        hard = self.bodies_radii(radii)
+        shapes = self._pair_polygons(yaw, pos - xy, ids, yaws, pair, hard) if ids else None
+        return self._orca(xy, vel, pref, pos - xy, nvel, pair, resp, hard, shapes)
+
+    def _sides(self, own_r: float, ids: list[str], wide: np.ndarray) -> tuple[float, list[float]]:
+        """Our half width and each neighbour's, m, for passing side by side: ``own_r`` and
+        ``wide`` (N,) m as they are (discs), or with ``use_polygon_footprint`` each less its
+        circumscribed radius and plus its body's half width across its axis (what it keeps
+        of margins, allowance and spread): two jackals (0.54 m wide padded, discs of 0.41 m)
+        fit a 1.6 m corridor side by side, their discs do not."""
+        if not self.params.use_polygon_footprint:
+            return own_r, [float(w) for w in wide]
+        fp = np.asarray(self.costmap_ros.footprint, dtype=np.float64)
+        own = own_r - self.body_radius + float(np.abs(fp[:, 1]).max())
+        if self.params.footprint_radius > 0.0:
+            own = own_r
+        side = []
+        for rid, w in zip(ids, wide.tolist(), strict=True):
+            body = self.near_by_id[rid].body
+            side.append(
+                w - float(np.hypot(body[:, 0], body[:, 1]).max()) + float(np.abs(body[:, 1]).max())
+            )
+        return own, side
+
+    def _pair_polygons(self, yaw, rel, ids, yaws, pair, hard) -> tuple | None:
+        """With ``use_polygon_footprint``: each pair's shapes for ORCA and for contact
+        (`fleetsim.nav.multirobot.polygon_vo.pair_shapes`, local costmap frame): our footprint
+        at our ``yaw`` and each neighbour's at its heading (its body: its footprint as sent
+        when it shares no covariance, padded by its spread), grown by what the pair's
+        disc radii (``pair``, ``hard`` (N,) m) hold beyond the two circumscribed discs: the
+        safety margin, the tracking allowance and the localization spreads. Else None."""
+        p = self.params
+        if not p.use_polygon_footprint:
+            return None
+        own = self._own_polygon(yaw)
+        others, pads, hard_pads = [], [], []
+        for k, rid in enumerate(ids):
+            c, s = math.cos(float(yaws[k])), math.sin(float(yaws[k]))
+            others.append(self.near_by_id[rid].body @ np.array([[c, s], [-s, c]]))
+            spread = self.near_spreads.get(rid, 0.0)
+            hard_pads.append(p.safety_margin + spread)
+            pads.append(p.safety_margin + spread + float(pair[k] - hard[k]))
+        return pair_shapes(rel, own, others, np.array(pads)), pair_shapes(
+            rel, own, others, np.array(hard_pads)
+        )
+
+    def _own_polygon(self, yaw: float) -> np.ndarray:
+        """Our footprint at ``yaw`` about our centre, (K, 2) m (a disc of ``footprint_radius``
+        as a 16-gon holding it, when that is set)."""
+        if self.params.footprint_radius > 0.0:
+            a = np.arange(16) * (math.pi / 8.0)
+            r = self.params.footprint_radius / math.cos(math.pi / 16.0)
+            return np.stack((r * np.cos(a), r * np.sin(a)), axis=1)
+        c, s = math.cos(yaw), math.sin(yaw)
+        return np.asarray(self.costmap_ros.footprint, dtype=np.float64) @ np.array(
+            [[c, s], [-s, c]]
+        )
 
     def _walls(self, pos, nvel, wide, bodies=()) -> tuple[np.ndarray, tuple[float, float], float]:
         """The local costmap as (costs, origin, resolution) without the other robots' images
@@ -354,12 +414,13 @@ class CollvoidLocalPlanner(
             costs[rows, cols] = LETHAL_OBSTACLE
         return costs, origin, res
 
-    def _orca(self, xy, vel, pref, rel, nvel, radii, resp, hard) -> np.ndarray:
+    def _orca(self, xy, vel, pref, rel, nvel, radii, resp, hard, shapes=None) -> np.ndarray:
         """The velocity nearest ``pref`` (2,) m/s that the half-planes of the local costmap's
         walls and of the robots (``rel`` (N, 2) m, ``nvel`` (N, 2) m/s, combined ``radii`` (N,)
         m, responsibilities ``resp`` (N,); ``hard`` (N,) m the combined radii of the bodies'
         discs, which robots whose ``radii`` overlap close in on no faster than in
-        ``overlap_time``) admit; the half-planes are kept in ``lines``."""
+        ``overlap_time``) admit; the half-planes are kept in ``lines``. ``shapes``: the pairs'
+        polygons (`_pair_polygons`) standing for ``radii`` and ``hard``, or None."""
         p = self.params
         lines_p, lines_d = [], []
         self.contact_lines = (np.zeros((0, 2)), np.zeros((0, 2)))
@@ -374,20 +435,31 @@ class CollvoidLocalPlanner(
             lines_p.append(lp)
             lines_d.append(ld)
         if rel.shape[0]:
-            lp, ld = orca_halfplanes(
-                rel, vel - nvel, radii, vel, self.horizon, self.overlap_t, resp
-            )
+            if shapes is None:
+                lp, ld = orca_halfplanes(
+                    rel, vel - nvel, radii, vel, self.horizon, self.overlap_t, resp
+                )
+                touch = np.einsum("ij,ij->i", rel, rel) <= radii * radii
+                dist = np.sqrt(np.einsum("ij,ij->i", rel, rel))
+                normals = rel / np.maximum(dist, 1e-9)[:, None]
+                gaps = dist - hard
+            else:
+                (shape, size), (body, body_size) = shapes
+                lp, ld, touch = polygon_orca_halfplanes(
+                    shape, size, vel - nvel, vel, self.horizon, self.overlap_t, resp
+                )
+                normals, gaps = shape_gaps(body, body_size)
             lines_p.append(lp)
             lines_d.append(ld)
-            touch = np.einsum("ij,ij->i", rel, rel) <= radii * radii
             if touch.any():  # parted over overlap_t, never into each other (contact_halfplanes)
-                lp, ld = contact_halfplanes(
-                    rel[touch], (vel - nvel)[touch], hard[touch], vel, self.overlap_t, resp[touch]
-                )
+                lp, ld = contact_halfplanes_along(
+                    normals[touch], gaps[touch], (vel - nvel)[touch], vel, self.overlap_t,
+                    resp[touch],
+                )  # fmt: skip
                 lines_p.append(lp)
                 lines_d.append(ld)
-                # the drive's last resort: the bodies' discs already overlapping
-                deep = np.einsum("ij,ij->i", rel[touch], rel[touch]) < hard[touch] ** 2
+                # the drive's last resort: the bodies already overlapping
+                deep = gaps[touch] < 0.0
                 self.contact_lines = (lp[deep], ld[deep])
         self.lines = (
             np.concatenate(lines_p) if lines_p else np.zeros((0, 2)),

@@ -113,12 +113,30 @@ def contact_halfplanes(
     allowance). Returns (points (N, 2), directions (N, 2)).
     """
     rel_pos = np.asarray(rel_pos, dtype=np.float64).reshape(-1, 2)
-    rel_vel = np.asarray(rel_vel, dtype=np.float64).reshape(-1, 2)
     dist = np.sqrt(np.einsum("ij,ij->i", rel_pos, rel_pos))
     n = rel_pos / np.maximum(dist, 1e-9)[:, None]
-    allowed = (dist - np.asarray(hard, dtype=np.float64).reshape(-1)) / closing_time
+    gaps = dist - np.asarray(hard, dtype=np.float64).reshape(-1)
+    return contact_halfplanes_along(n, gaps, rel_vel, velocity, closing_time, responsibility)
+
+
+def contact_halfplanes_along(
+    normals: np.ndarray,
+    gaps: np.ndarray,
+    rel_vel: np.ndarray,
+    velocity: np.ndarray,
+    closing_time: float,
+    responsibility: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """`contact_halfplanes` for bodies of any shape: the approach speed along unit
+    ``normals`` (N, 2) (the way the two close their gap fastest) stays at most
+    ``gaps / closing_time`` (``gaps`` (N,) m, negative by the depth of an overlap). For discs
+    the normal is the line of centres and the gap the distance minus the radii; for polygons
+    `fleetsim.nav.multirobot.polygon_vo.shape_gaps`. Other arguments as `contact_halfplanes`'s."""
+    n = np.asarray(normals, dtype=np.float64).reshape(-1, 2)
+    rel_vel = np.asarray(rel_vel, dtype=np.float64).reshape(-1, 2)
+    allowed = np.asarray(gaps, dtype=np.float64).reshape(-1) / closing_time
     u = (allowed - np.einsum("ij,ij->i", rel_vel, n))[:, None] * n
-    resp = np.broadcast_to(np.asarray(responsibility, dtype=np.float64), dist.shape)
+    resp = np.broadcast_to(np.asarray(responsibility, dtype=np.float64), allowed.shape)
     points = np.asarray(velocity, dtype=np.float64)[None, :] + resp[:, None] * u
     return points, np.stack([-n[:, 1], n[:, 0]], axis=1)
 

@@ -1,0 +1,255 @@
+"""ORCA half-planes of robots as convex polygons (collvoid's ``use_polygon_footprint``).
+
+collvoid's polygon mode (COCALU, Claes et al.) gives each pair the Minkowski sum of the two
+footprints instead of the sum of their circumscribed discs: two robots longer than they are
+wide may then pass side by side closer than their discs allow (two jackals, 0.62 x 0.54 m
+padded, need 0.82 m between centres as discs and 0.54 m abreast as rectangles; two of them
+meeting in a 2 m corridor under amcl's spread did not pass as discs).
+
+The geometry, for this robot's footprint A (at its heading, about its centre) and a
+neighbour's B (at its heading) at ``rel`` (its centre minus ours): the two touch after t s
+at relative velocity v (ours minus theirs) when t v lies in P = rel + B (+) -A (Minkowski sum),
+grown here by the pair's padding (margins, tracking allowance, localization spreads) as a
+polygon around a disc. The velocity obstacle truncated at the horizon tau is
+P / tau (+) cone(P), the convex hull of P / tau and of P scaled far out; ORCA's u is the
+vector from v to the nearest point of its boundary, the half-plane's normal the boundary's
+outward normal there, exactly as RVO2 builds them for discs (RVO2 is the reference:
+`orca_halfplanes`; a many-sided polygon round a disc gives its half-planes). When the padded
+shapes already overlap (0 in P), the obstacle is P / time_step, as RVO2's collision branch.
+
+Why our own: no maintained Python library builds polygonal velocity obstacles (RVO2 and its
+bindings take discs). The kernels are numba, looped over the neighbours: a hull of at most a
+few hundred points each, sequential by nature.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+#: sides of the polygon standing for a disc of padding (circumscribed: its sides touch the
+#: disc, so the polygon holds it; 16 sides stand at most 2 % of the radius off it)
+PAD_SIDES = 16
+#: how far P is scaled out to stand for the cone's unbounded legs: its nearest vertex this far
+#: (m/s) from the origin, beyond any speed a robot commands
+FAR_SPEED = 1.0e3
+
+
+@numba.njit(cache=True)
+def _hull(pts: np.ndarray) -> np.ndarray:
+    """Convex hull of (n, 2) points, counter-clockwise, no repeated or collinear vertices
+    (Andrew's monotone chain)."""
+    n = pts.shape[0]
+    order_y = np.argsort(pts[:, 1], kind="mergesort")
+    order = order_y[np.argsort(pts[order_y, 0], kind="mergesort")]
+    p = pts[order]
+    out = np.empty((2 * n + 1, 2))
+    k = 0
+    for i in range(n):  # lower chain
+        while (
+            k >= 2
+            and (
+                (out[k - 1, 0] - out[k - 2, 0]) * (p[i, 1] - out[k - 2, 1])
+                - (out[k - 1, 1] - out[k - 2, 1]) * (p[i, 0] - out[k - 2, 0])
+            )
+            <= 0.0
+        ):
+            k -= 1
+        out[k] = p[i]
+        k += 1
+    low = k + 1
+    for i in range(n - 2, -1, -1):  # upper chain
+        while (
+            k >= low
+            and (
+                (out[k - 1, 0] - out[k - 2, 0]) * (p[i, 1] - out[k - 2, 1])
+                - (out[k - 1, 1] - out[k - 2, 1]) * (p[i, 0] - out[k - 2, 0])
+            )
+            <= 0.0
+        ):
+            k -= 1
+        out[k] = p[i]
+        k += 1
+    return out[: max(k - 1, 1)].copy()
+
+
+@numba.njit(cache=True)
+def _nearest(poly: np.ndarray, vx: float, vy: float):
+    """Nearest point (qx, qy) of the boundary of the convex counter-clockwise ``poly`` to v,
+    the boundary's outward unit normal there (nx, ny) and whether v lies inside."""
+    m = poly.shape[0]
+    best = np.inf
+    qx = qy = nx = ny = 0.0
+    inside = True
+    for i in range(m):
+        ax, ay = poly[i, 0], poly[i, 1]
+        bx, by = poly[(i + 1) % m, 0], poly[(i + 1) % m, 1]
+        ex, ey = bx - ax, by - ay
+        ee = ex * ex + ey * ey
+        if ex * (vy - ay) - ey * (vx - ax) < 0.0:
+            inside = False
+        t = 0.0 if ee <= 0.0 else min(1.0, max(0.0, ((vx - ax) * ex + (vy - ay) * ey) / ee))
+        px, py = ax + t * ex, ay + t * ey
+        d = (vx - px) ** 2 + (vy - py) ** 2
+        if d < best:
+            best = d
+            qx, qy = px, py
+            le = math.sqrt(ee) if ee > 0.0 else 1.0
+            nx, ny = ey / le, -ex / le  # the edge's outward normal (interior on the left)
+    if not inside:
+        dx, dy = vx - qx, vy - qy
+        dl = math.sqrt(dx * dx + dy * dy)
+        if dl > 1e-12:  # off a vertex the normal points at v, off an edge it is the edge's
+            nx, ny = dx / dl, dy / dl
+    return qx, qy, nx, ny, inside
+
+
+@numba.njit(cache=True)
+def _pair_shapes(rel, own, others, counts, pads, sides):
+    """rel + others[k] (+) -own (+) a ``sides``-gon round a disc of pads[k], as convex
+    counter-clockwise polygons packed in (N, M, 2) with their vertex counts (N,)."""
+    n = rel.shape[0]
+    ring = np.empty((sides, 2))
+    for j in range(sides):
+        a = 2.0 * math.pi * (j + 0.5) / sides
+        ring[j, 0] = math.cos(a) / math.cos(math.pi / sides)
+        ring[j, 1] = math.sin(a) / math.cos(math.pi / sides)
+    ka = own.shape[0]
+    width = others.shape[1] * ka + sides  # at most this many hull vertices per pair
+    shapes = np.zeros((n, width, 2))
+    sizes = np.zeros(n, dtype=np.int64)
+    for k in range(n):
+        kb = counts[k]
+        pts = np.empty((kb * ka, 2))
+        for i in range(kb):
+            for j in range(ka):
+                pts[i * ka + j, 0] = others[k, i, 0] - own[j, 0]
+                pts[i * ka + j, 1] = others[k, i, 1] - own[j, 1]
+        core = _hull(pts)
+        if pads[k] > 0.0:
+            grown = np.empty((core.shape[0] * sides, 2))
+            for i in range(core.shape[0]):
+                for j in range(sides):
+                    grown[i * sides + j, 0] = core[i, 0] + pads[k] * ring[j, 0]
+                    grown[i * sides + j, 1] = core[i, 1] + pads[k] * ring[j, 1]
+            core = _hull(grown)
+        m = core.shape[0]
+        shapes[k, :m, 0] = core[:, 0] + rel[k, 0]
+        shapes[k, :m, 1] = core[:, 1] + rel[k, 1]
+        sizes[k] = m
+    return shapes, sizes
+
+
+def pair_shapes(
+    rel: np.ndarray,
+    own: np.ndarray,
+    others: list[np.ndarray] | np.ndarray,
+    pads: np.ndarray,
+    sides: int = PAD_SIDES,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Each pair's collision shape in relative-velocity space: rel[k] + others[k] (+) -own,
+    grown by ``pads`` (N,) m (a ``sides``-gon holding the disc).
+
+    rel : (N, 2) the neighbours' centres minus ours, m; own : (K, 2) our footprint at our
+    heading about our centre, m; others : N arrays (K_k, 2), each neighbour's footprint at its
+    heading about its centre, m. Returns (shapes (N, M, 2) m, counter-clockwise, and their
+    vertex counts (N,)); the two touch now when 0 lies in shape k.
+    """
+    rel = np.ascontiguousarray(rel, dtype=np.float64).reshape(-1, 2)
+    n = rel.shape[0]
+    most = max((len(o) for o in others), default=1)
+    packed = np.zeros((n, most, 2))
+    counts = np.zeros(n, dtype=np.int64)
+    for k, o in enumerate(others):
+        o = np.asarray(o, dtype=np.float64).reshape(-1, 2)
+        packed[k, : len(o)] = o
+        counts[k] = len(o)
+    own = np.ascontiguousarray(own, dtype=np.float64).reshape(-1, 2)
+    pads = np.ascontiguousarray(np.broadcast_to(pads, (n,)), dtype=np.float64)
+    return _pair_shapes(rel, own, packed, counts, pads, int(sides))
+
+
+@numba.njit(cache=True)
+def _halfplanes(shapes, sizes, rel_vel, velocity, tau, dt, resp):
+    n = shapes.shape[0]
+    points = np.empty((n, 2))
+    directions = np.empty((n, 2))
+    touching = np.zeros(n, dtype=np.bool_)
+    for k in range(n):
+        poly = shapes[k, : sizes[k]]
+        _, _, _, _, inside0 = _nearest(poly, 0.0, 0.0)
+        touching[k] = inside0
+        if inside0:  # RVO2's collision branch: out of the shape within one step
+            vo = poly / dt
+        else:
+            near = np.inf
+            for i in range(poly.shape[0]):
+                near = min(near, math.hypot(poly[i, 0], poly[i, 1]))
+            pts = np.empty((2 * poly.shape[0], 2))
+            pts[: poly.shape[0]] = poly / tau
+            pts[poly.shape[0] :] = poly * (FAR_SPEED / max(near, 1e-9))
+            vo = _hull(pts)
+        vx, vy = rel_vel[k, 0], rel_vel[k, 1]
+        qx, qy, nx, ny, _ = _nearest(vo, vx, vy)
+        points[k, 0] = velocity[0] + resp[k] * (qx - vx)
+        points[k, 1] = velocity[1] + resp[k] * (qy - vy)
+        directions[k, 0] = ny  # permitted: left of the direction, the outward normal's side
+        directions[k, 1] = -nx
+    return points, directions, touching
+
+
+def polygon_orca_halfplanes(
+    shapes: np.ndarray,
+    sizes: np.ndarray,
+    rel_vel: np.ndarray,
+    velocity: np.ndarray,
+    time_horizon: float,
+    time_step: float,
+    responsibility: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """ORCA half-planes of one agent against N neighbours given as `pair_shapes`.
+
+    rel_vel : (N, 2) own velocity minus each neighbour's, m/s; velocity : (2,) own, m/s;
+    time_horizon, time_step : s, as `fleetsim.nav.multirobot.orca.orca_halfplanes`;
+    responsibility : (N,) or scalar share of the avoidance this agent takes.
+    Returns (points (N, 2), directions (N, 2): permitted velocities lie left of each line, as
+    `orca_halfplanes`'s, and touching (N,) bool: the padded shapes overlap now).
+    """
+    n = shapes.shape[0]
+    rv = np.ascontiguousarray(rel_vel, dtype=np.float64).reshape(-1, 2)
+    vel = np.ascontiguousarray(velocity, dtype=np.float64).reshape(2)
+    resp = np.ascontiguousarray(np.broadcast_to(responsibility, (n,)), dtype=np.float64)
+    return _halfplanes(
+        np.ascontiguousarray(shapes, dtype=np.float64),
+        np.asarray(sizes, dtype=np.int64),
+        rv,
+        vel,
+        float(time_horizon),
+        float(time_step),
+        resp,
+    )
+
+
+@numba.njit(cache=True)
+def _gaps(shapes, sizes):
+    n = shapes.shape[0]
+    normals = np.empty((n, 2))
+    gaps = np.empty(n)
+    for k in range(n):
+        qx, qy, nx, ny, inside = _nearest(shapes[k, : sizes[k]], 0.0, 0.0)
+        d = math.hypot(qx, qy)
+        gaps[k] = -d if inside else d
+        normals[k, 0] = -nx  # towards the other: into the shape
+        normals[k, 1] = -ny
+    return normals, gaps
+
+
+def shape_gaps(shapes: np.ndarray, sizes: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """How far each pair's bodies are apart along the way they would meet: (normals (N, 2),
+    unit, the direction of relative motion that closes the gap fastest; gaps (N,) m, the
+    distance from 0 to `pair_shapes`' shape, negative by the depth when they overlap). What
+    `fleetsim.nav.multirobot.orca.contact_halfplanes` takes as the line of centres and
+    distance minus radii, for polygons."""
+    return _gaps(np.ascontiguousarray(shapes, dtype=np.float64), np.asarray(sizes, np.int64))

@@ -234,10 +234,13 @@ def phase_line(run: Run, alone: dict[str, Run]) -> str:
     return f"seed {run.seed}: slowest {m} {run.arrival[m]:.1f} s, s per metre {here} (alone {solo})"
 
 
-def cycle_time(neighbours: int = 16, cycles: int = 400) -> tuple[float, float, float, float]:
-    """Median and 95th percentile (ms) of CollvoidLocalPlanner's cycle with ``neighbours``:
-    wall clock, then CPU time of this process (on a loaded machine the wall clock's tail is the
-    scheduler's time slices, not the planner)."""
+def cycle_time(
+    neighbours: int = 16, cycles: int = 400, polygon: bool = False
+) -> tuple[float, float, float, float]:
+    """Median and 95th percentile (ms) of CollvoidLocalPlanner's cycle with ``neighbours``
+    (``polygon``: with ``use_polygon_footprint``): wall clock, then CPU time of this process
+    (on a loaded machine the wall clock's tail is the scheduler's time slices, not the
+    planner)."""
     from types import SimpleNamespace
 
     from fleetsim.msgs import collvoid_msgs, geometry_msgs
@@ -254,7 +257,8 @@ def cycle_time(neighbours: int = 16, cycles: int = 400) -> tuple[float, float, f
     node = Node(rt, "move_base", "/me")
     planner = CollvoidLocalPlanner.from_namespace(
         node, SimpleNamespace(costmap=cm, footprint=fp, global_frame="map"),
-        {"max_neighbors": neighbours, "neighbor_dist": 5.0}, "bench",
+        {"max_neighbors": neighbours, "neighbor_dist": 5.0, "use_polygon_footprint": polygon},
+        "bench",
     )  # fmt: skip
     pub = Node(rt, "others", "/").create_publisher(
         collvoid_msgs.PoseTwistWithCovariance, "/position_share"
@@ -300,11 +304,13 @@ def main() -> None:
     a = ap.parse_args()
     items = [scenario_item(item) for item in a.scenarios.split(",")]  # bad ones before any run
     logging.basicConfig(level=logging.ERROR)
-    med, p95, cmed, cp95 = cycle_time()
-    print(
-        f"collvoid cycle with 16 neighbours: median {med:.2f} ms, p95 {p95:.2f} ms wall clock; "
-        f"CPU median {cmed:.2f} ms, p95 {cp95:.2f} ms"
-    )
+    for polygon in (False, True):
+        med, p95, cmed, cp95 = cycle_time(polygon=polygon)
+        print(
+            f"collvoid cycle with 16 neighbours{' (use_polygon_footprint)' if polygon else ''}: "
+            f"median {med:.2f} ms, p95 {p95:.2f} ms wall clock; "
+            f"CPU median {cmed:.2f} ms, p95 {cp95:.2f} ms"
+        )
     if a.cycle_only:
         return
     header = (

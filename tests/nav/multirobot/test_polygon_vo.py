@@ -118,7 +118,7 @@ def test_contact_half_planes_along_the_line_of_centres_are_the_disc_ones():
 
 
 def min_polygon_gap(f: Fleet) -> float:
-    polys = [Polygon(turned(f.footprint, yaw) + (x, y)) for x, y, yaw in f.state]
+    polys = [Polygon(turned(f.footprint, yaw) + np.array([x, y])) for x, y, yaw in f.state]
     return min(
         polys[i].distance(polys[j]) - (1.0 if polys[i].intersects(polys[j]) else 0.0)
         for i in range(len(polys))

@@ -38,40 +38,28 @@ FAR_SPEED = 1.0e3
 
 
 @numba.njit(cache=True)
+def _turns_left(out, k, px, py):
+    """out[k - 2] -> out[k - 1] -> (px, py) turns counter-clockwise."""
+    ax, ay = out[k - 2, 0], out[k - 2, 1]
+    return (out[k - 1, 0] - ax) * (py - ay) - (out[k - 1, 1] - ay) * (px - ax) > 0.0
+
+
+@numba.njit(cache=True)
 def _hull(pts: np.ndarray) -> np.ndarray:
     """Convex hull of (n, 2) points, counter-clockwise, no repeated or collinear vertices
-    (Andrew's monotone chain)."""
+    (Andrew's monotone chain: the lower chain left to right, then the upper one back)."""
     n = pts.shape[0]
     order_y = np.argsort(pts[:, 1], kind="mergesort")
-    order = order_y[np.argsort(pts[order_y, 0], kind="mergesort")]
-    p = pts[order]
+    p = pts[order_y[np.argsort(pts[order_y, 0], kind="mergesort")]]
     out = np.empty((2 * n + 1, 2))
     k = 0
-    for i in range(n):  # lower chain
-        while (
-            k >= 2
-            and (
-                (out[k - 1, 0] - out[k - 2, 0]) * (p[i, 1] - out[k - 2, 1])
-                - (out[k - 1, 1] - out[k - 2, 1]) * (p[i, 0] - out[k - 2, 0])
-            )
-            <= 0.0
-        ):
-            k -= 1
-        out[k] = p[i]
-        k += 1
-    low = k + 1
-    for i in range(n - 2, -1, -1):  # upper chain
-        while (
-            k >= low
-            and (
-                (out[k - 1, 0] - out[k - 2, 0]) * (p[i, 1] - out[k - 2, 1])
-                - (out[k - 1, 1] - out[k - 2, 1]) * (p[i, 0] - out[k - 2, 0])
-            )
-            <= 0.0
-        ):
-            k -= 1
-        out[k] = p[i]
-        k += 1
+    for chain in range(2):
+        low = k + 1 if chain else 2
+        for j in range(n) if chain == 0 else range(n - 2, -1, -1):
+            while k >= low and not _turns_left(out, k, p[j, 0], p[j, 1]):
+                k -= 1
+            out[k] = p[j]
+            k += 1
     return out[: max(k - 1, 1)].copy()
 
 

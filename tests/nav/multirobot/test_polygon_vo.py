@@ -4,23 +4,27 @@ pass where their discs would not, overlaps and gaps are measured on the true sha
 collvoid's planner drives two jackals side by side in polygon mode without contact."""
 
 import math
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
-from shapely.geometry import Polygon
+from shapely.geometry import MultiPoint, Polygon
 from test_collvoid_planner import Fleet
 
+from fleetsim.nav.controllers.collvoid_planner import CollvoidLocalPlanner
+from fleetsim.nav.costmap.costmap_2d import Costmap2D
 from fleetsim.nav.multirobot.orca import (
-    contact_halfplanes,
     contact_halfplanes_along,
     orca_halfplanes,
     orca_velocity,
 )
 from fleetsim.nav.multirobot.polygon_vo import (
+    _hull,
     pair_shapes,
     polygon_orca_halfplanes,
     shape_gaps,
 )
+from fleetsim.runtime import Node, Runtime
 
 #: a jackal's padded footprint (the shipped costmap_common_params.yaml, 0.05 m padding)
 JACKAL = np.array([[-0.31, -0.27], [-0.31, 0.27], [0.31, 0.27], [0.31, -0.27]])
@@ -83,13 +87,19 @@ def test_two_rectangles_abreast_keep_their_way_where_their_discs_would_part_them
     assert touching[0]
 
 
+#: footprints that no half turn maps onto themselves, their centres off their middles (a
+#: Minkowski sum taken the wrong way round, or a footprint turned the wrong way, shows)
+WEDGE = np.array([[0.35, 0.02], [-0.1, 0.22], [-0.18, -0.25]])
+KITE = np.array([[0.3, -0.05], [0.1, 0.2], [-0.25, 0.1], [-0.05, -0.3]])
+
+
 def test_the_shapes_overlap_exactly_when_the_footprints_do_and_the_gap_is_their_distance():
     rng = np.random.default_rng(4)
-    for _ in range(300):
-        rel = rng.uniform(-1.2, 1.2, 2)
+    for _ in range(400):
+        rel = rng.uniform(-1.0, 1.0, 2)
         ya, yb = rng.uniform(-math.pi, math.pi, 2)
         pad = float(rng.choice([0.0, 0.07]))
-        a, b = turned(JACKAL, ya), turned(JACKAL * [1.3, 0.7], yb)
+        a, b = turned(WEDGE, ya), turned(KITE, yb)
         shape, size = pair_shapes(rel[None], a, [b], pad)
         normals, gaps = shape_gaps(shape, size)
         pa, pb = Polygon(a), Polygon(b + rel)
@@ -107,14 +117,34 @@ def test_the_shapes_overlap_exactly_when_the_footprints_do_and_the_gap_is_their_
             assert moved.distance(pb) < 1e-6 and moved.intersection(pb).area < 1e-6
 
 
-def test_contact_half_planes_along_the_line_of_centres_are_the_disc_ones():
-    rng = np.random.default_rng(5)
-    rel, rv = rng.uniform(-1.0, 1.0, (20, 2)), rng.uniform(-0.5, 0.5, (20, 2))
-    hard, resp = rng.uniform(0.3, 0.9, 20), rng.choice([0.5, 1.0], 20)
-    p, d = contact_halfplanes(rel, rv, hard, [0.2, 0.1], 1.0, resp)
-    dist = np.hypot(rel[:, 0], rel[:, 1])
-    p2, d2 = contact_halfplanes_along(rel / dist[:, None], dist - hard, rv, [0.2, 0.1], 1.0, resp)
-    assert np.allclose(p, p2, rtol=0.0, atol=1e-12) and np.allclose(d, d2, rtol=0.0, atol=1e-12)
+def test_the_hull_drops_repeated_and_collinear_points():
+    square = np.array([[0, 0], [1, 0], [1, 1], [0, 1], [0.5, 0], [1, 1], [0, 0], [0.5, 0.5]])
+    h = _hull(square.astype(float))
+    assert len(h) == 4 and Polygon(h).exterior.is_ccw and Polygon(h).area == pytest.approx(1.0)
+    assert _hull(np.ones((5, 2))).tolist() == [[1.0, 1.0]]
+    line = np.array([[0.0, 0.0], [1.0, 1.0], [0.5, 0.5], [2.0, 2.0]])
+    assert sorted(map(tuple, _hull(line))) == [(0.0, 0.0), (2.0, 2.0)]
+    rng = np.random.default_rng(6)
+    for _ in range(200):
+        pts = np.round(rng.uniform(-1.0, 1.0, (rng.integers(3, 30), 2)), 1)
+        ref = MultiPoint(pts).convex_hull
+        if ref.geom_type == "Polygon":
+            h = Polygon(_hull(pts))
+            assert h.exterior.is_ccw and h.area == pytest.approx(ref.area, abs=1e-12)
+
+
+def test_a_follower_closes_on_a_robot_ahead_no_faster_than_the_gap_allows():
+    """Nose to tail, 0.1 m between the bodies, the one ahead standing: the contact half-plane
+    along the shapes' gap holds our approach to 0.1 m/s (``closing_time`` 1 s), and a sideways
+    velocity stays free."""
+    shape, size = pair_shapes(np.array([[0.72, 0.0]]), JACKAL, [JACKAL], 0.0)
+    normals, gaps = shape_gaps(shape, size)
+    assert normals[0] == pytest.approx([1.0, 0.0]) and gaps[0] == pytest.approx(0.1)
+    p, d = contact_halfplanes_along(normals, gaps, [[0.5, 0.0]], [0.5, 0.0], 1.0, [1.0])
+    v, ok = orca_velocity(p, d, 0.5, np.array([0.5, 0.0]))
+    assert ok and v == pytest.approx([0.1, 0.0])
+    v, _ = orca_velocity(p, d, 0.5, np.array([0.0, 0.5]))
+    assert v == pytest.approx([0.0, 0.5])
 
 
 def min_polygon_gap(f: Fleet) -> float:
@@ -170,3 +200,38 @@ def test_head_on_jackals_in_a_corridor_pass_in_polygon_mode_without_contact():
     assert f.run(25.0)
     assert f.min_body_gap > 0.0
     assert np.all(f.backed == 0.0)
+
+
+def test_the_planners_pair_shapes_turn_both_footprints_and_carry_margin_allowance_and_spread():
+    """`_pair_polygons` against shapely: our WEDGE at our heading and a neighbour's KITE at its
+    own, both turned the right way (no half turn maps them onto themselves), the ORCA shape
+    grown by margin + spread + tracking allowance and the contact shape by margin + spread."""
+    node = Node(Runtime(), "move_base", "/robot1")
+    costmap_ros = SimpleNamespace(
+        costmap=Costmap2D(80, 80, 0.05, -2.0, -2.0), footprint=WEDGE, global_frame="map"
+    )
+    params = {"use_polygon_footprint": True, "safety_margin": 0.03}
+    pl = CollvoidLocalPlanner.from_namespace(node, costmap_ros, params, "robot1")
+    pl.near_by_id = {"robot2": SimpleNamespace(body=KITE)}
+    rng = np.random.default_rng(7)
+    for _ in range(100):
+        rel = rng.uniform(-1.5, 1.5, (1, 2))
+        yaw, their_yaw = rng.uniform(-math.pi, math.pi, 2)
+        spread, allowance = rng.uniform(0.0, 0.08, 2)
+        pl.near_spreads = {"robot2": spread}
+        hard = np.array([1.0])
+        (orca, orca_n), (body, body_n) = pl._pair_polygons(
+            yaw, rel, ["robot2"], np.array([their_yaw]), hard + allowance, hard
+        )
+        ours = Polygon(turned(WEDGE, yaw))
+        theirs = Polygon(turned(KITE, their_yaw) + rel[0])
+        if ours.intersects(theirs):
+            assert shape_gaps(body, body_n)[1][0] < 0.0
+            continue
+        true = ours.distance(theirs)
+        for shape, n, pad in (
+            (orca, orca_n, 0.03 + spread + allowance),
+            (body, body_n, 0.03 + spread),
+        ):
+            gap = shape_gaps(shape, n)[1][0]
+            assert gap == pytest.approx(true - pad, abs=0.02 * pad + 1e-9)

@@ -86,6 +86,7 @@ from fleetsim.nav.controllers.collvoid_preference import (
 )
 from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
 from fleetsim.nav.costmap.footprint import (
+    footprint_at,
     footprint_radii,
     outline_points,
     polygon_cells,
@@ -100,7 +101,12 @@ from fleetsim.nav.multirobot.holonomic import (
     without_robots,
 )
 from fleetsim.nav.multirobot.orca import contact_halfplanes_along, orca_halfplanes, orca_velocity
-from fleetsim.nav.multirobot.polygon_vo import pair_shapes, polygon_orca_halfplanes, shape_gaps
+from fleetsim.nav.multirobot.polygon_vo import (
+    disc_polygon,
+    pair_shapes,
+    polygon_orca_halfplanes,
+    shape_gaps,
+)
 from fleetsim.nav.multirobot.position_share import PositionShare
 from fleetsim.nav.multirobot.uncertainty import cloud_covariance
 from fleetsim.nav.multirobot.yielding import Retreat, head_on, narrow_between
@@ -300,7 +306,7 @@ class CollvoidLocalPlanner(
         pair = self.pair_radii(own_r, radii, dist)
         # how wide two robots are side by side (a passage, a refuge, out of the way): their
         # discs, or with ``use_polygon_footprint`` their bodies' half widths across their axes
-        own_side, side = self._sides(own_r, ids, wide)
+        own_side, side = self._sides(own_r, yaw, pos - xy, ids, yaws, wide)
         active = {k: d for k, d, c in zip(ids, dist.tolist(), controlled) if c}
         narrow: list[str] = []
         facing: list[str] = []
@@ -308,14 +314,14 @@ class CollvoidLocalPlanner(
             met = head_on(carrot - xy, pos - xy, nvel, yaws, controlled)
             facing = [ids[k] for k in met]
             narrow = [
-                ids[k] for k in met if narrow_between(*self.grid, xy, pos[k], own_side, side[k])
+                ids[k] for k in met if narrow_between(*self.grid, xy, pos[k], own_side[k], side[k])
             ]
         self.yielding_to = self.deadlock.update(now, remaining, active, narrow, facing)
         self.waiting = False
         if self.yielding_to is not None:
             k = ids.index(self.yielding_to)
             along = carrot - self.plan[self.plan_index, :2]  # the plan's way here
-            pref = self._yield_velocity(xy, along, pos[k], own_side, side[k], remaining, pref)
+            pref = self._yield_velocity(xy, along, pos[k], own_side[k], side[k], remaining, pref)
             if self.yielding_to is not None:
                 resp[k] = 1.0
                 self.waiting = not pref.any()
@@ -339,24 +345,26 @@ class CollvoidLocalPlanner(
         shapes = self._pair_polygons(yaw, pos - xy, ids, yaws, pair, hard) if ids else None
         return self._orca(xy, vel, pref, pos - xy, nvel, pair, resp, hard, shapes)
 
-    def _sides(self, own_r: float, ids: list[str], wide: np.ndarray) -> tuple[float, list[float]]:
-        """Our half width and each neighbour's, m, for passing side by side: ``own_r`` and
-        ``wide`` (N,) m as they are (discs), or with ``use_polygon_footprint`` each less its
-        circumscribed radius and plus its body's half width across its axis (what it keeps
-        of margins, allowance and spread): two jackals (0.54 m wide padded, discs of 0.41 m)
-        fit a 1.6 m corridor side by side, their discs do not."""
+    def _sides(self, own_r, yaw, rel, ids, yaws, wide) -> tuple[np.ndarray, np.ndarray]:
+        """Our half width and each neighbour's, m, for passing side by side ((N,) each: ours
+        against each neighbour at ``rel`` (N, 2) m): ``own_r`` and ``wide`` (N,) m as they are
+        (discs), or with ``use_polygon_footprint`` each less its circumscribed radius and plus
+        its body's extent across the line between the two (what it keeps of margins, allowance
+        and spread; our footprint at our ``yaw``, theirs at ``yaws``): two jackals meeting
+        head-on (0.54 m wide padded, discs of 0.41 m) fit a 1.6 m corridor side by side, their
+        discs do not."""
+        n = len(ids)
         if not self.params.use_polygon_footprint:
-            return own_r, [float(w) for w in wide]
-        fp = np.asarray(self.costmap_ros.footprint, dtype=np.float64)
-        own = own_r - self.body_radius + float(np.abs(fp[:, 1]).max())
-        if self.params.footprint_radius > 0.0:
-            own = own_r
-        side = []
-        for rid, w in zip(ids, wide.tolist(), strict=True):
+            return np.full(n, float(own_r)), np.asarray(wide, dtype=np.float64)
+        d = np.maximum(np.hypot(rel[:, 0], rel[:, 1]), 1e-12)
+        across = np.stack((-rel[:, 1] / d, rel[:, 0] / d), axis=1)
+        own_fp = self._own_polygon(yaw)
+        own = own_r - self.body_radius + np.abs(own_fp @ across.T).max(axis=0)
+        side = np.empty(n)
+        for k, rid in enumerate(ids):
             body = self.near_by_id[rid].body
-            side.append(
-                w - float(np.hypot(body[:, 0], body[:, 1]).max()) + float(np.abs(body[:, 1]).max())
-            )
+            extent = np.abs(footprint_at(body, 0.0, 0.0, float(yaws[k])) @ across[k]).max()
+            side[k] = wide[k] - float(np.hypot(body[:, 0], body[:, 1]).max()) + extent
         return own, side
 
     def _pair_polygons(self, yaw, rel, ids, yaws, pair, hard) -> tuple | None:
@@ -365,33 +373,30 @@ class CollvoidLocalPlanner(
         at our ``yaw`` and each neighbour's at its heading (its body: its footprint as sent
         when it shares no covariance, padded by its spread), grown by what the pair's
         disc radii (``pair``, ``hard`` (N,) m) hold beyond the two circumscribed discs: the
-        safety margin, the tracking allowance and the localization spreads. Else None."""
+        safety margin, the tracking allowance and the localization spreads. Else None.
+
+        The spread is the pair's padding for discs (`pair_padding` without the bodies: both
+        spreads across the leg of the discs' velocity obstacle), grown round the polygon
+        alike, also for a robot standing still whose disc radius came from its outline."""
         p = self.params
         if not p.use_polygon_footprint:
             return None
         own = self._own_polygon(yaw)
-        others, pads, hard_pads = [], [], []
-        for k, rid in enumerate(ids):
-            c, s = math.cos(float(yaws[k])), math.sin(float(yaws[k]))
-            others.append(self.near_by_id[rid].body @ np.array([[c, s], [-s, c]]))
-            spread = self.near_spreads.get(rid, 0.0)
-            hard_pads.append(p.safety_margin + spread)
-            pads.append(p.safety_margin + spread + float(pair[k] - hard[k]))
-        return pair_shapes(rel, own, others, np.array(pads)), pair_shapes(
-            rel, own, others, np.array(hard_pads)
-        )
+        others = [
+            footprint_at(self.near_by_id[r].body, 0.0, 0.0, float(y))
+            for r, y in zip(ids, yaws, strict=True)
+        ]
+        spreads = np.array([self.near_spreads.get(r, 0.0) for r in ids])
+        hard_pads = p.safety_margin + spreads
+        pads = hard_pads + (np.asarray(pair) - np.asarray(hard))
+        return pair_shapes(rel, own, others, pads), pair_shapes(rel, own, others, hard_pads)
 
     def _own_polygon(self, yaw: float) -> np.ndarray:
-        """Our footprint at ``yaw`` about our centre, (K, 2) m (a disc of ``footprint_radius``
-        as a 16-gon holding it, when that is set)."""
+        """Our footprint at ``yaw`` about our centre, (K, 2) m (with ``footprint_radius`` set,
+        a polygon holding that disc, `disc_polygon`)."""
         if self.params.footprint_radius > 0.0:
-            a = np.arange(16) * (math.pi / 8.0)
-            r = self.params.footprint_radius / math.cos(math.pi / 16.0)
-            return np.stack((r * np.cos(a), r * np.sin(a)), axis=1)
-        c, s = math.cos(yaw), math.sin(yaw)
-        return np.asarray(self.costmap_ros.footprint, dtype=np.float64) @ np.array(
-            [[c, s], [-s, c]]
-        )
+            return disc_polygon(self.params.footprint_radius)
+        return footprint_at(self.costmap_ros.footprint, 0.0, 0.0, yaw)
 
     def _walls(self, pos, nvel, wide, bodies=()) -> tuple[np.ndarray, tuple[float, float], float]:
         """The local costmap as (costs, origin, resolution) without the other robots' images

@@ -60,13 +60,17 @@ def _hull(pts: np.ndarray) -> np.ndarray:
                 k -= 1
             out[k] = p[j]
             k += 1
-    return out[: max(k - 1, 1)].copy()
+    m = max(k - 1, 1)
+    if m == 2 and out[0, 0] == out[1, 0] and out[0, 1] == out[1, 1]:
+        m = 1  # all the points the same
+    return out[:m].copy()
 
 
 @numba.njit(cache=True)
 def _nearest(poly: np.ndarray, vx: float, vy: float):
     """Nearest point (qx, qy) of the boundary of the convex counter-clockwise ``poly`` to v,
-    the boundary's outward unit normal there (nx, ny) and whether v lies inside."""
+    the boundary's outward unit normal there (nx, ny) and whether v lies inside (for a
+    ``poly`` without area, a point or a segment, only a v on it)."""
     m = poly.shape[0]
     best = np.inf
     qx = qy = nx = ny = 0.0
@@ -86,6 +90,8 @@ def _nearest(poly: np.ndarray, vx: float, vy: float):
             qx, qy = px, py
             le = math.sqrt(ee) if ee > 0.0 else 1.0
             nx, ny = ey / le, -ex / le  # the edge's outward normal (interior on the left)
+    if m < 3:
+        inside = best <= 1e-24
     if not inside:
         dx, dy = vx - qx, vy - qy
         dl = math.sqrt(dx * dx + dy * dy)
@@ -130,6 +136,14 @@ def _pair_shapes(rel, own, others, counts, pads, sides):
     return shapes, sizes
 
 
+def disc_polygon(radius: float, sides: int = PAD_SIDES) -> np.ndarray:
+    """A ``sides``-gon holding the disc of ``radius`` m about 0 (its sides touch the disc):
+    (sides, 2) m, counter-clockwise; what a disc stands as among polygons."""
+    a = 2.0 * math.pi * (np.arange(sides) + 0.5) / sides
+    r = radius / math.cos(math.pi / sides)
+    return np.stack((r * np.cos(a), r * np.sin(a)), axis=1)
+
+
 def pair_shapes(
     rel: np.ndarray,
     own: np.ndarray,
@@ -167,14 +181,12 @@ def _halfplanes(shapes, sizes, rel_vel, velocity, tau, dt, resp):
     touching = np.zeros(n, dtype=np.bool_)
     for k in range(n):
         poly = shapes[k, : sizes[k]]
-        _, _, _, _, inside0 = _nearest(poly, 0.0, 0.0)
+        q0x, q0y, _, _, inside0 = _nearest(poly, 0.0, 0.0)
         touching[k] = inside0
         if inside0:  # RVO2's collision branch: out of the shape within one step
             vo = poly / dt
         else:
-            near = np.inf
-            for i in range(poly.shape[0]):
-                near = min(near, math.hypot(poly[i, 0], poly[i, 1]))
+            near = math.hypot(q0x, q0y)  # scaled by FAR_SPEED / near, P's nearest point
             pts = np.empty((2 * poly.shape[0], 2))
             pts[: poly.shape[0]] = poly / tau
             pts[poly.shape[0] :] = poly * (FAR_SPEED / max(near, 1e-9))

@@ -67,7 +67,6 @@ def test_node_in_another_process_exchanges_messages(sim):
     # the window counts from before the interpreter starts: its start-up and imports took ~3 s
     # on a loaded machine (the node joined at 2.9 s of a 3 s window and echoed twice)
     until = sim.runtime.now() + 8.0
-    t0 = time.monotonic()
     r = subprocess.run(
         [sys.executable, "-c", code, str(until)],
         env=env,
@@ -77,7 +76,9 @@ def test_node_in_another_process_exchanges_messages(sim):
     )
     assert r.returncode == 0, r.stderr
     assert "/lizi1/echo joined the simulation at" in r.stdout
-    assert time.monotonic() - t0 < 20
+    # it ran until the sim time it was given (no wall-clock bound: the subprocess timeout
+    # catches a hang; a loaded machine only makes it slower)
+    assert sim.runtime.now() >= until, (sim.runtime.now(), until)
     back = [m.data for m in sim.talker.back]
     assert len(back) >= 5
     assert all(b.startswith("from-sim:t=") for b in back)  # the simulation's parameter

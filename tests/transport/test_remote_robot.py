@@ -8,7 +8,6 @@ The controller (``helper_nodes.GoToPoint``) runs in a subprocess started through
 import os
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -46,7 +45,6 @@ def test_controller_in_another_process_drives_the_robot_to_its_goal(endpoint):
     env = dict(os.environ, PYTHONPATH=f"{ROOT / 'src'}{os.pathsep}{ROOT / 'tests'}")
     with SimThread(rt, endpoint, rate=2.0):
         until = rt.now() + 12.0
-        t0 = time.monotonic()
         r = subprocess.run(
             [sys.executable, "-c", code, str(until)],
             env=env,
@@ -55,8 +53,10 @@ def test_controller_in_another_process_drives_the_robot_to_its_goal(endpoint):
             timeout=60,
         )
         assert r.returncode == 0, r.stderr
+        # it ran until the sim time it was given, and stopped there (no wall-clock bound: the
+        # subprocess timeout catches a hang; a loaded machine only makes it slower)
+        assert rt.now() >= until, (rt.now(), until)
         position, _ = sim.engine.model_pose("r")
-    assert time.monotonic() - t0 < 20
     assert arrived, "the remote controller never reported arrival"
     p = odom[-1].pose.pose.position
     assert np.hypot(p.x - 1.2, p.y - 0.6) < 0.1  # by its odometry, within its tolerance

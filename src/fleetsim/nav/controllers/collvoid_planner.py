@@ -31,7 +31,10 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    static obstacle point of the local costmap (the nearest lethal cell per bearing sector,
    horizon ``time_horizon_obst``, full responsibility, kept hard when the program is
    infeasible; the robot's circumscribed disc, or its inscribed one where the walls leave that
-   disc no way on);
+   disc no way on); with ``use_polygon_footprint`` (collvoid's polygon mode) each robot's
+   half-plane and contact line come from the two footprints' Minkowski sum instead of their
+   discs (`fleetsim.nav.multirobot.polygon_vo`, `_pair_polygons`), and a passage is judged by
+   the robots' half widths (`_sides`);
 5. the linear program gives the holonomic velocity nearest the preferred one; a differential
    drive tracks it (`tracking_command`, ``time_to_holo``) within ``acc_lim_x``/``acc_lim_theta``,
    its forward speed cut to what the same half-planes admit along its heading

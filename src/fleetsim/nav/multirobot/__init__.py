@@ -5,6 +5,8 @@
 - `me_publisher`: the node that shares a robot's pose, velocity and uncertainty-inflated
   footprint (`MePublisher`, ``collvoid/me_publisher`` in launch files);
 - `orca`: ORCA half-planes and linear programs (`orca_halfplanes`, `orca_velocity`);
+- `polygon_vo`: ORCA half-planes of robots as their footprints' Minkowski sum, collvoid's
+  ``use_polygon_footprint`` (`pair_shapes`, `polygon_orca_halfplanes`, `shape_gaps`);
 - `holonomic`: preferred velocity, static obstacle points, differential-drive tracking;
 - `footprint_check`: static obstacles against the real footprint on a command's rollout
   (`first_collisions`, `footprint_safe_command`);

@@ -13,6 +13,7 @@ from test_collvoid_planner import Fleet
 
 from fleetsim.nav.controllers.collvoid_planner import CollvoidLocalPlanner
 from fleetsim.nav.costmap.costmap_2d import Costmap2D
+from fleetsim.nav.costmap.footprint import footprint_at
 from fleetsim.nav.multirobot.orca import (
     contact_halfplanes_along,
     orca_halfplanes,
@@ -36,8 +37,7 @@ def ring(r: float, sides: int) -> np.ndarray:
 
 
 def turned(poly: np.ndarray, yaw: float) -> np.ndarray:
-    c, s = math.cos(yaw), math.sin(yaw)
-    return poly @ np.array([[c, s], [-s, c]])
+    return footprint_at(poly, 0.0, 0.0, yaw)
 
 
 def test_fine_polygons_round_two_discs_give_rvo2s_half_planes():
@@ -220,7 +220,7 @@ def test_the_planners_pair_shapes_turn_both_footprints_and_carry_margin_allowanc
         spread, allowance = rng.uniform(0.0, 0.08, 2)
         pl.near_spreads = {"robot2": spread}
         hard = np.array([1.0])
-        (orca, orca_n), (body, body_n) = pl._pair_polygons(
+        (orca, body), (orca_n, body_n) = pl._pair_polygons(
             yaw, rel, ["robot2"], np.array([their_yaw]), hard + allowance, hard
         )
         ours = Polygon(turned(WEDGE, yaw))

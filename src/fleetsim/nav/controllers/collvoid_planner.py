@@ -33,8 +33,8 @@ After collvoid (Claes, Hennes, Tuyls), each control cycle:
    infeasible; the robot's circumscribed disc, or its inscribed one where the walls leave that
    disc no way on); with ``use_polygon_footprint`` (collvoid's polygon mode) each robot's
    half-plane and contact line come from the two footprints' Minkowski sum instead of their
-   discs (`fleetsim.nav.multirobot.polygon_vo`, `_pair_polygons`), and a passage is judged by
-   the robots' half widths (`_sides`);
+   discs (`fleetsim.nav.multirobot.polygon_vo`, `CollvoidNeighbours._pair_polygons`), and a
+   passage is judged by the robots' half widths (`CollvoidNeighbours._sides`);
 5. the linear program gives the holonomic velocity nearest the preferred one; a differential
    drive tracks it (`tracking_command`, ``time_to_holo``) within ``acc_lim_x``/``acc_lim_theta``,
    its forward speed cut to what the same half-planes admit along its heading
@@ -89,7 +89,6 @@ from fleetsim.nav.controllers.collvoid_preference import (
 )
 from fleetsim.nav.costmap.costmap_2d import LETHAL_OBSTACLE
 from fleetsim.nav.costmap.footprint import (
-    footprint_at,
     footprint_radii,
     outline_points,
     polygon_cells,
@@ -103,13 +102,13 @@ from fleetsim.nav.multirobot.holonomic import (
     rotated,
     without_robots,
 )
-from fleetsim.nav.multirobot.orca import contact_halfplanes_along, orca_halfplanes, orca_velocity
-from fleetsim.nav.multirobot.polygon_vo import (
-    disc_polygon,
-    pair_shapes,
-    polygon_orca_halfplanes,
-    shape_gaps,
+from fleetsim.nav.multirobot.orca import (
+    contact_halfplanes_along,
+    disc_gaps,
+    orca_halfplanes,
+    orca_velocity,
 )
+from fleetsim.nav.multirobot.polygon_vo import polygon_orca_halfplanes, shape_gaps
 from fleetsim.nav.multirobot.position_share import PositionShare
 from fleetsim.nav.multirobot.uncertainty import cloud_covariance
 from fleetsim.nav.multirobot.yielding import Retreat, head_on, narrow_between
@@ -348,64 +347,6 @@ class CollvoidLocalPlanner(
         shapes = self._pair_polygons(yaw, pos - xy, ids, yaws, pair, hard) if ids else None
         return self._orca(xy, vel, pref, pos - xy, nvel, pair, resp, hard, shapes)
 
-    def _sides(self, own_r, ids, wide) -> tuple[np.ndarray, np.ndarray]:
-        """Our half width and each neighbour's, m, for passing side by side ((N,) each, ours
-        the same against every neighbour): ``own_r`` and ``wide`` (N,) m as they are (discs),
-        or with ``use_polygon_footprint`` each less its circumscribed radius and plus its
-        body's half width across its own axis (what it keeps of margins, allowance and
-        spread): two jackals meeting head-on (0.54 m wide padded, discs of 0.41 m) fit a 1.6 m
-        corridor side by side, their discs do not.
-
-        Across its own axis, as a differential drive passes another driving along it. Not
-        across the line between the two: two robots about to pass stand slanted to each
-        other, and a rectangle's extent across that line grows towards its disc (measured,
-        the jackals with amcl, seeds 1-5: corridor of 4 12/20 goals and 2 wall contacts
-        against 19/20 and 0; corridor of 2 27.6 s against 21.5 s)."""
-        n = len(ids)
-        if not self.params.use_polygon_footprint:
-            return np.full(n, float(own_r)), np.asarray(wide, dtype=np.float64)
-        own = own_r
-        if self.params.footprint_radius <= 0.0:
-            fp = np.asarray(self.costmap_ros.footprint, dtype=np.float64)
-            own = own_r - self.body_radius + float(np.abs(fp[:, 1]).max())
-        side = np.empty(n)
-        for k, rid in enumerate(ids):
-            body = self.near_by_id[rid].body
-            circumscribed = float(np.hypot(body[:, 0], body[:, 1]).max())
-            side[k] = wide[k] - circumscribed + float(np.abs(body[:, 1]).max())
-        return np.full(n, own), side
-
-    def _pair_polygons(self, yaw, rel, ids, yaws, pair, hard) -> tuple | None:
-        """With ``use_polygon_footprint``: each pair's shapes for ORCA and for contact
-        (`fleetsim.nav.multirobot.polygon_vo.pair_shapes`, local costmap frame): our footprint
-        at our ``yaw`` and each neighbour's at its heading (its body: its footprint as sent
-        when it shares no covariance, padded by its spread), grown by what the pair's
-        disc radii (``pair``, ``hard`` (N,) m) hold beyond the two circumscribed discs: the
-        safety margin, the tracking allowance and the localization spreads. Else None.
-
-        The spread is the pair's padding for discs (`pair_padding` without the bodies: both
-        spreads across the leg of the discs' velocity obstacle), grown round the polygon
-        alike, also for a robot standing still whose disc radius came from its outline."""
-        p = self.params
-        if not p.use_polygon_footprint:
-            return None
-        own = self._own_polygon(yaw)
-        others = [
-            footprint_at(self.near_by_id[r].body, 0.0, 0.0, float(y))
-            for r, y in zip(ids, yaws, strict=True)
-        ]
-        spreads = np.array([self.near_spreads.get(r, 0.0) for r in ids])
-        hard_pads = p.safety_margin + spreads
-        pads = hard_pads + (np.asarray(pair) - np.asarray(hard))
-        return pair_shapes(rel, own, others, pads), pair_shapes(rel, own, others, hard_pads)
-
-    def _own_polygon(self, yaw: float) -> np.ndarray:
-        """Our footprint at ``yaw`` about our centre, (K, 2) m (with ``footprint_radius`` set,
-        a polygon holding that disc, `disc_polygon`)."""
-        if self.params.footprint_radius > 0.0:
-            return disc_polygon(self.params.footprint_radius)
-        return footprint_at(self.costmap_ros.footprint, 0.0, 0.0, yaw)
-
     def _walls(self, pos, nvel, wide, bodies=()) -> tuple[np.ndarray, tuple[float, float], float]:
         """The local costmap as (costs, origin, resolution) without the other robots' images
         (`without_robots`): each neighbour at ``pos`` (N, 2) m moving at ``nvel`` (N, 2) m/s,
@@ -453,11 +394,9 @@ class CollvoidLocalPlanner(
                     rel, vel - nvel, radii, vel, self.horizon, self.overlap_t, resp
                 )
                 touch = np.einsum("ij,ij->i", rel, rel) <= radii * radii
-                dist = np.sqrt(np.einsum("ij,ij->i", rel, rel))
-                normals = rel / np.maximum(dist, 1e-9)[:, None]
-                gaps = dist - hard
+                normals, gaps = disc_gaps(rel, hard)
             else:
-                (shape, size), (body, body_size) = shapes
+                (shape, body), (size, body_size) = shapes
                 lp, ld, touch = polygon_orca_halfplanes(
                     shape, size, vel - nvel, vel, self.horizon, self.overlap_t, resp
                 )

@@ -112,11 +112,18 @@ def contact_halfplanes(
     the radii the bodies must not come inside (their circumscribed discs, without the tracking
     allowance). Returns (points (N, 2), directions (N, 2)).
     """
+    n, gaps = disc_gaps(rel_pos, hard)
+    return contact_halfplanes_along(n, gaps, rel_vel, velocity, closing_time, responsibility)
+
+
+def disc_gaps(rel_pos: np.ndarray, hard: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Discs' `fleetsim.nav.multirobot.polygon_vo.shape_gaps`: the unit line of centres
+    (N, 2) towards each other body at ``rel_pos`` (N, 2) m, and the distance minus the combined
+    radii ``hard`` (N,) m (negative by the depth of an overlap)."""
     rel_pos = np.asarray(rel_pos, dtype=np.float64).reshape(-1, 2)
     dist = np.sqrt(np.einsum("ij,ij->i", rel_pos, rel_pos))
-    n = rel_pos / np.maximum(dist, 1e-9)[:, None]
     gaps = dist - np.asarray(hard, dtype=np.float64).reshape(-1)
-    return contact_halfplanes_along(n, gaps, rel_vel, velocity, closing_time, responsibility)
+    return rel_pos / np.maximum(dist, 1e-9)[:, None], gaps
 
 
 def contact_halfplanes_along(

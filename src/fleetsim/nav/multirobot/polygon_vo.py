@@ -18,8 +18,9 @@ outward normal there, exactly as RVO2 builds them for discs (RVO2 is the referen
 shapes already overlap (0 in P), the obstacle is P / time_step, as RVO2's collision branch.
 
 Why our own: no maintained Python library builds polygonal velocity obstacles (RVO2 and its
-bindings take discs). The kernels are numba, looped over the neighbours: a hull of at most a
-few hundred points each, sequential by nature.
+bindings take discs), and scipy's Qhull (used for meshes in `fleetsim.sim.decompose`) cannot be
+called from the numba kernels, which build a hull per neighbour each cycle. The kernels loop
+over the neighbours: a hull of at most a few hundred points each, sequential by nature.
 """
 
 from __future__ import annotations
@@ -102,8 +103,9 @@ def _nearest(poly: np.ndarray, vx: float, vy: float):
 
 @numba.njit(cache=True)
 def _pair_shapes(rel, own, others, counts, pads, sides):
-    """rel + others[k] (+) -own (+) a ``sides``-gon round a disc of pads[k], as convex
-    counter-clockwise polygons packed in (N, M, 2) with their vertex counts (N,)."""
+    """rel + others[k] (+) -own (+) a ``sides``-gon round a disc of pads[j, k], as convex
+    counter-clockwise polygons packed in (J, N, M, 2) with their vertex counts (J, N): the
+    core sum is built once per pair for all J pads."""
     n = rel.shape[0]
     ring = np.empty((sides, 2))
     for j in range(sides):
@@ -112,8 +114,8 @@ def _pair_shapes(rel, own, others, counts, pads, sides):
         ring[j, 1] = math.sin(a) / math.cos(math.pi / sides)
     ka = own.shape[0]
     width = others.shape[1] * ka + sides  # at most this many hull vertices per pair
-    shapes = np.zeros((n, width, 2))
-    sizes = np.zeros(n, dtype=np.int64)
+    shapes = np.zeros((pads.shape[0], n, width, 2))
+    sizes = np.zeros((pads.shape[0], n), dtype=np.int64)
     for k in range(n):
         kb = counts[k]
         pts = np.empty((kb * ka, 2))
@@ -122,17 +124,19 @@ def _pair_shapes(rel, own, others, counts, pads, sides):
                 pts[i * ka + j, 0] = others[k, i, 0] - own[j, 0]
                 pts[i * ka + j, 1] = others[k, i, 1] - own[j, 1]
         core = _hull(pts)
-        if pads[k] > 0.0:
-            grown = np.empty((core.shape[0] * sides, 2))
-            for i in range(core.shape[0]):
-                for j in range(sides):
-                    grown[i * sides + j, 0] = core[i, 0] + pads[k] * ring[j, 0]
-                    grown[i * sides + j, 1] = core[i, 1] + pads[k] * ring[j, 1]
-            core = _hull(grown)
-        m = core.shape[0]
-        shapes[k, :m, 0] = core[:, 0] + rel[k, 0]
-        shapes[k, :m, 1] = core[:, 1] + rel[k, 1]
-        sizes[k] = m
+        for q in range(pads.shape[0]):
+            grown = core
+            if pads[q, k] > 0.0:
+                grown = np.empty((core.shape[0] * sides, 2))
+                for i in range(core.shape[0]):
+                    for j in range(sides):
+                        grown[i * sides + j, 0] = core[i, 0] + pads[q, k] * ring[j, 0]
+                        grown[i * sides + j, 1] = core[i, 1] + pads[q, k] * ring[j, 1]
+                grown = _hull(grown)
+            m = grown.shape[0]
+            shapes[q, k, :m, 0] = grown[:, 0] + rel[k, 0]
+            shapes[q, k, :m, 1] = grown[:, 1] + rel[k, 1]
+            sizes[q, k] = m
     return shapes, sizes
 
 
@@ -157,7 +161,8 @@ def pair_shapes(
     rel : (N, 2) the neighbours' centres minus ours, m; own : (K, 2) our footprint at our
     heading about our centre, m; others : N arrays (K_k, 2), each neighbour's footprint at its
     heading about its centre, m. Returns (shapes (N, M, 2) m, counter-clockwise, and their
-    vertex counts (N,)); the two touch now when 0 lies in shape k.
+    vertex counts (N,)); the two touch now when 0 lies in shape k. ``pads`` (J, N): J sets
+    of shapes, (J, N, M, 2) and (J, N), the sums built once.
     """
     rel = np.ascontiguousarray(rel, dtype=np.float64).reshape(-1, 2)
     n = rel.shape[0]
@@ -169,8 +174,10 @@ def pair_shapes(
         packed[k, : len(o)] = o
         counts[k] = len(o)
     own = np.ascontiguousarray(own, dtype=np.float64).reshape(-1, 2)
-    pads = np.ascontiguousarray(np.broadcast_to(pads, (n,)), dtype=np.float64)
-    return _pair_shapes(rel, own, packed, counts, pads, int(sides))
+    pads = np.asarray(pads, dtype=np.float64)
+    sets = pads.reshape(-1, n) if pads.ndim == 2 else np.broadcast_to(pads, (1, n))
+    shapes, sizes = _pair_shapes(rel, own, packed, counts, np.ascontiguousarray(sets), int(sides))
+    return (shapes, sizes) if pads.ndim == 2 else (shapes[0], sizes[0])
 
 
 @numba.njit(cache=True)

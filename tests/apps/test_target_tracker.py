@@ -7,7 +7,13 @@ import math
 import numpy as np
 import pytest
 
-from fleetsim.apps.target_tracker import TargetTracker, TrackerParams, ctrv_step, wrap
+from fleetsim.apps.target_tracker import (
+    TargetTracker,
+    TrackerParams,
+    ctrv_jacobian,
+    ctrv_step,
+    wrap,
+)
 from fleetsim.errors import ParameterError
 
 DT = 0.1  # s, the camera's 10 Hz
@@ -109,3 +115,23 @@ def test_bad_input_is_named():
         tracker.predicted_states(0.0, DT, 3)
     with pytest.raises(ParameterError, match="3 finite numbers"):
         tracker.update(0.0, np.array([1.0, math.nan, 0.0]))
+
+
+def test_one_state_step_and_batched_jacobian_equal_the_array_path_bit_for_bit():
+    """The scalar step of one state and the Jacobian's batched differences are speed paths:
+    they give what the (..., 5) array path and one difference per column give, to the bit."""
+    rng = np.random.default_rng(7)
+    states = rng.normal(size=(400, 5)) * [3.0, 3.0, 20.0, 0.5, 1.0]
+    states[::5, 4] *= 1e-4  # straight-line cases, under SMALL_YAW_RATE
+    steps = (1e-5, 1e-5, 1e-6, 1e-5, 1e-5)
+    for s, dt in zip(states, rng.choice([0.033, 0.05, 0.1, 0.2], size=len(states)), strict=True):
+        one = ctrv_step(s, dt)
+        assert np.array_equal(one, ctrv_step(s[None], dt)[0])
+        want = np.empty((5, 5))
+        for i, h in enumerate(steps):
+            d = np.zeros(5)
+            d[i] = h
+            diff = ctrv_step((s + d)[None], dt)[0] - ctrv_step((s - d)[None], dt)[0]
+            diff[2] = wrap(diff[2])
+            want[:, i] = diff / (2 * h)
+        assert np.array_equal(ctrv_jacobian(s, dt), want)

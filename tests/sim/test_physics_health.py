@@ -48,9 +48,20 @@ def tilt(e: Engine, name: str) -> float:
     return math.acos(max(-1.0, min(1.0, 1.0 - 2.0 * (x * x + y * y))))
 
 
+def unread(e: Engine) -> None:
+    """Mark every sensor unread, as a simulator node does for topics with no subscriber: these
+    tests check physics, and the hunter's arm camera rendered and noised each frame was ~80 % of
+    its tests' time."""
+    for entry in e.models.values():
+        for p in entry.plugins:
+            if hasattr(p, "wanted"):
+                p.wanted = lambda: False
+
+
 def run_clean(e: Engine, commands, seconds: float) -> float:
     """Drive for ``seconds``; no warning counter may trip and accelerations stay sane.
     Returns the largest tilt (rad) any driven robot reached."""
+    unread(e)
     most = 0.0
     for _ in range(round(seconds / 0.05)):
         for drive, vx, wz in commands:
@@ -201,6 +212,7 @@ def test_robot_tossed_spinning_with_its_drive_on_stays_sane(path):
     free = e.model.jnt_dofadr[e.model.body_jntadr[e.root_body("r")]]
     e.data.qvel[free : free + 6] = (0.0, 0.0, 5.0, 40.0, -35.0, -38.0)
     spin0 = float(np.linalg.norm(e.data.qvel[free + 3 : free + 6]))
+    unread(e)
     most = 0.0
     for _ in range(round(4.0 / 0.05)):
         drive.command(top_speed(entry, drive), 0.5, e.time)

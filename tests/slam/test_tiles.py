@@ -2,6 +2,7 @@
 
 import numpy as np
 
+from fleetsim.slam.render import cast_counts, occupancy_from_counts
 from fleetsim.slam.scan_match import add_hits, endpoint_cells
 from fleetsim.slam.tiles import COUNT_CELL, FAR, TILE, CowTiles
 
@@ -71,3 +72,23 @@ def test_count_tiles_are_uint16_pairs():
     maps = CowTiles(2, 0.0, 0.0, 1.0, 1.0, 0.05, COUNT_CELL)
     assert maps.pool.dtype == np.uint16 and maps.pool.shape[1:] == (TILE, TILE, 2)
     assert maps.dense(1).shape == (*maps.shape_cells, 2)
+
+
+def test_dense_of_is_fn_of_the_dense_cells():
+    """The map read tile by tile (`dense_of`) equals the function of every cell (`dense`)."""
+    maps = CowTiles(2, -6.0, -6.0, 6.0, 6.0, 0.05, COUNT_CELL)
+    a = np.linspace(-np.pi, np.pi, 360, endpoint=False)
+    poses = np.array([[0.0, 0.0, 0.0], [1.0, 0.5, 0.3]])
+    rng = np.random.default_rng(0)
+    for _ in range(3):
+        ranges = rng.uniform(0.5, 4.0, 360)
+        maps.write(cast_counts, poses, np.zeros(3), ranges, a, 5.0, maps.geom)
+
+    def occ(c):
+        return occupancy_from_counts(c[..., 0], c[..., 1], 0.25)
+
+    for p in range(2):
+        want = occ(maps.dense(p))
+        got = maps.dense_of(p, occ, np.int8)
+        assert got.dtype == np.int8 and np.array_equal(got, want)
+        assert (got == -1).any() and (got == 100).any() and (got == 0).any()

@@ -31,6 +31,8 @@ POSITION_GATE = 9.21
 #: this many fixes gated out in a row restart the filter at the newest (the target was lost
 #: long enough for the prediction to go wrong, or the filter diverged)
 REINIT_AFTER = 3
+#: below this turn rate (rad/s) the CTRV step is taken as a straight line
+SMALL_YAW_RATE = 1e-4
 
 
 @dataclass(frozen=True)
@@ -67,8 +69,11 @@ def wrap(a):
 
 def ctrv_step(state: np.ndarray, dt: float) -> np.ndarray:
     """The CTRV motion of ``state`` (..., 5) over ``dt`` seconds (no noise)."""
-    x, y, th, v, w = np.moveaxis(np.asarray(state, dtype=float), -1, 0)
-    small = np.abs(w) < 1e-4
+    state = np.asarray(state, dtype=float)
+    if state.ndim == 1:
+        return _ctrv_step_one(state, dt)
+    x, y, th, v, w = np.moveaxis(state, -1, 0)
+    small = np.abs(w) < SMALL_YAW_RATE
     ws = np.where(small, 1.0, w)
     th2 = th + w * dt
     x2 = np.where(small, x + v * dt * np.cos(th), x + v / ws * (np.sin(th2) - np.sin(th)))
@@ -76,16 +81,34 @@ def ctrv_step(state: np.ndarray, dt: float) -> np.ndarray:
     return np.stack([x2, y2, wrap(th2), v, w], axis=-1)
 
 
+def _ctrv_step_one(state: np.ndarray, dt: float) -> np.ndarray:
+    """`ctrv_step` of one (5,) state in scalar arithmetic: the same operations in the same order
+    (numpy's and the math module's sin and cos agree to the bit here, which the tests check),
+    ~13x faster than the array path for the predictive follower's per-cycle horizon."""
+    x, y, th, v, w = state.tolist()
+    th2 = th + w * dt
+    if abs(w) < SMALL_YAW_RATE:
+        x2 = x + v * dt * math.cos(th)
+        y2 = y + v * dt * math.sin(th)
+    else:
+        x2 = x + v / w * (math.sin(th2) - math.sin(th))
+        y2 = y + v / w * (math.cos(th) - math.cos(th2))
+    return np.array([x2, y2, (th2 + math.pi) % (2 * math.pi) - math.pi, v, w])
+
+
+#: central-difference steps of `ctrv_jacobian`, per state component
+_JACOBIAN_STEPS = np.array([1e-5, 1e-5, 1e-6, 1e-5, 1e-5])
+
+
 def ctrv_jacobian(state: np.ndarray, dt: float) -> np.ndarray:
-    """d ctrv_step / d state at ``state`` (5,), by central differences (5, 5)."""
-    jac = np.empty((5, 5))
-    for i, h in enumerate((1e-5, 1e-5, 1e-6, 1e-5, 1e-5)):
-        d = np.zeros(5)
-        d[i] = h
-        diff = ctrv_step(state + d, dt) - ctrv_step(state - d, dt)
-        diff[2] = wrap(diff[2])
-        jac[:, i] = diff / (2 * h)
-    return jac
+    """d ctrv_step / d state at ``state`` (5,), by central differences (5, 5): the ten
+    perturbed states stepped in one batch."""
+    shifts = np.diag(_JACOBIAN_STEPS)
+    state = np.asarray(state, dtype=float)
+    moved = ctrv_step(np.concatenate([state + shifts, state - shifts]), dt)
+    diff = moved[:5] - moved[5:]
+    diff[:, 2] = wrap(diff[:, 2])
+    return diff.T / (2 * _JACOBIAN_STEPS)
 
 
 def ctrv_process_noise(state: np.ndarray, dt: float, p: TrackerParams) -> np.ndarray:

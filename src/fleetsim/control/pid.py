@@ -5,6 +5,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+import numpy as np
+
 from fleetsim.errors import ControlError
 
 GAIN_KEYS = ("p", "i", "d", "i_clamp", "i_clamp_min", "i_clamp_max", "antiwindup")
@@ -48,4 +50,31 @@ class Pid:
         self.i_term += self.i * error * dt
         lim = abs(self.i_clamp)
         self.i_term = min(max(self.i_term, -lim), lim)
+        return self.p * error + self.i_term + self.d * error_dot
+
+
+class PidArray:
+    """Several `Pid` loops computed together, one per joint of a trajectory controller.
+
+    The same arithmetic as `Pid.compute` elementwise over (J,) arrays: a trajectory controller
+    runs at the physics rate (the hunter's arm at 250 Hz), where a Python call per joint a step
+    was ~6 % of a whole SLAM run's time."""
+
+    def __init__(self, pids: list[Pid]) -> None:
+        self.p = np.array([q.p for q in pids], dtype=float)
+        self.i = np.array([q.i for q in pids], dtype=float)
+        self.d = np.array([q.d for q in pids], dtype=float)
+        self.lim = np.abs(np.array([q.i_clamp for q in pids], dtype=float))
+        self.i_term = np.zeros(len(pids))
+
+    def __len__(self) -> int:
+        return self.p.size
+
+    def reset(self) -> None:
+        self.i_term[:] = 0.0
+
+    def compute(self, error: np.ndarray, error_dot: np.ndarray, dt: float) -> np.ndarray:
+        """(J,) commands from the (J,) errors (target - actual), their rates and the period."""
+        self.i_term += self.i * error * dt
+        np.clip(self.i_term, -self.lim, self.lim, out=self.i_term)
         return self.p * error + self.i_term + self.d * error_dot

@@ -186,6 +186,10 @@ class GmappingFilter:
 
         Read out of its counts: the cost is the map's size, not the length of the run.
         """
-        counts = self.counts.dense(self.best_index)
-        data = occupancy_from_counts(counts[..., 0], counts[..., 1], self.p.occ_thresh)
+        thresh = self.p.occ_thresh
+        data = self.counts.dense_of(
+            self.best_index,
+            lambda c: occupancy_from_counts(c[..., 0], c[..., 1], thresh),
+            np.int8,
+        )
         return data, self.counts.geom.copy()

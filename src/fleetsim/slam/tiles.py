@@ -149,6 +149,19 @@ class CowTiles:
     def tiles_in_use(self) -> int:
         return int(np.count_nonzero(self.refs))
 
+    def dense_of(self, p: int, fn, dtype) -> np.ndarray:
+        """(H, W) ``fn`` of particle p's cells: ``fn`` maps (K, TILE, TILE, ...) cells to (K,
+        TILE, TILE) ``dtype`` values, elementwise over cells; it runs on the tiles p holds and
+        once on a blank tile for the rest. A SLAM map is mostly tiles never written (the
+        hunter's 2000 x 2000 cells), so the map is read without expanding the counts of every
+        cell (`dense` then `fn`: 85 ms a map, ~6 % of a SLAM run)."""
+        ty, tx = self.table.shape[1:]
+        out = np.empty((ty, tx, TILE, TILE), dtype=dtype)
+        out[...] = fn(self.blank_tile[None])[0]
+        held = self.table[p] >= 0
+        out[held] = fn(self.pool[self.table[p][held]])
+        return np.swapaxes(out, 1, 2).reshape(ty * TILE, tx * TILE)
+
     def dense(self, p: int) -> np.ndarray:
         """(H, W, ...) particle p's cells, blank where it never wrote."""
         ty, tx = self.table.shape[1:]

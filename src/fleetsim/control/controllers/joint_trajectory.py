@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from fleetsim.control.controllers.base import Controller, register
-from fleetsim.control.pid import Pid
+from fleetsim.control.pid import Pid, PidArray
 from fleetsim.control.trajectory import Trajectory, sample
 from fleetsim.errors import ControlError
 from fleetsim.msgs import control_msgs, trajectory_msgs
@@ -77,13 +77,14 @@ class JointTrajectoryController(Controller):
         p = self.params
         self.joints = [str(j) for j in self._require(p.joints, "joints")]
         hw.check_joints(self.joints, self.interface, self.full_name)
-        self.pids: list[Pid] = []
+        pids: list[Pid] = []
         if self.interface != "position":
             gains = self._require(p.gains, "gains")
             for j in self.joints:
                 if j not in gains:
                     raise ControlError(f"{self.full_name}: no gains/{j} (p, i, d, i_clamp)")
-                self.pids.append(Pid.from_params(gains[j], f"{self.full_name}/gains/{j}"))
+                pids.append(Pid.from_params(gains[j], f"{self.full_name}/gains/{j}"))
+        self.pids = PidArray(pids)
         self.ff = np.array([float(p.velocity_ff.get(j, 0.0)) for j in self.joints])
         self.default_tol = self._tolerances(p.constraints)
         self.traj: Trajectory | None = None
@@ -273,8 +274,7 @@ class JointTrajectoryController(Controller):
 
     # ------------------------------------------------------------------ control loop
     def starting(self, t: float) -> None:
-        for pid in self.pids:
-            pid.reset()
+        self.pids.reset()
         self._hold(t)  # as the controller: hold the current position on start
 
     def stopping(self, t: float) -> None:
@@ -291,11 +291,9 @@ class JointTrajectoryController(Controller):
         if self.interface == "position":
             cmd = des_p
         else:
-            cmd = self.ff * des_v + np.array(
-                [pid.compute(e, ev, dt) for pid, e, ev in zip(self.pids, err, err_v, strict=True)]
-            )
-        for j, c in zip(self.joints, cmd, strict=True):
-            self.hw.command(j, float(c))
+            cmd = self.ff * des_v + self.pids.compute(err, err_v, dt)
+        for j, c in zip(self.joints, cmd.tolist(), strict=True):
+            self.hw.command(j, c)
         s = self.state
         s.desired.positions, s.desired.velocities, s.desired.accelerations = des_p, des_v, des_a
         s.actual.positions, s.actual.velocities = q, qd

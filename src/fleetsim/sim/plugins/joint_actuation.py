@@ -14,6 +14,7 @@ import math
 from dataclasses import dataclass
 
 import mujoco
+import numpy as np
 
 from fleetsim.errors import SimulationError, did_you_mean
 from fleetsim.runtime.params import param
@@ -125,6 +126,14 @@ class JointActuationPlugin(ActuatorPlugin):
         """``{joint: (position, velocity)}`` of the actuated joints."""
         qpos, qvel = engine.data.qpos, engine.data.qvel
         return {j: (float(qpos[a]), float(qvel[v])) for j, a, v in self._addr}
+
+    def addresses(self, joints) -> tuple[np.ndarray, np.ndarray]:
+        """(J,) qpos and (J,) dof addresses of ``joints`` (actuated joints of this robot) in the
+        bound model, for reading many joints with one indexing."""
+        addr = {j: (a, v) for j, a, v in self._addr}
+        qa = np.array([addr[j][0] for j in joints], dtype=np.intp)
+        va = np.array([addr[j][1] for j in joints], dtype=np.intp)
+        return qa, va
 
 
 __all__ = ["JointActuationPlugin"]

@@ -10,6 +10,8 @@ from fleetsim.sim import Engine
 from fleetsim.sim.build import rpy_from_quat
 from fleetsim.sim.plugins.base import DrivePlugin
 
+from .conftest import unread
+
 ROBOTS = Path(__file__).resolve().parents[2] / "src" / "fleetsim" / "assets" / "robots"
 FILES = sorted(ROBOTS.glob("*/urdf/*.urdf.xacro"))
 
@@ -18,6 +20,7 @@ FILES = sorted(ROBOTS.glob("*/urdf/*.urdf.xacro"))
 def test_asset_robot_drives_upright(path):
     e = Engine(None)
     entry = e.spawn_robot("bot", load_robot(path))
+    unread(e)
     drive = next(p for p in entry.plugins if isinstance(p, DrivePlugin))
     worst_tilt = 0.0
     for _ in range(30):

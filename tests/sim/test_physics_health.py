@@ -23,7 +23,7 @@ from fleetsim.sim import Engine
 from fleetsim.sim.plugins.base import DrivePlugin
 from fleetsim.sim.world import GeomDesc, LinkDesc, ModelDesc, WorldDesc, ground_plane
 
-from .conftest import FIXTURES
+from .conftest import FIXTURES, unread
 
 ROBOTS = Path(__file__).resolve().parents[2] / "src" / "fleetsim" / "assets" / "robots"
 FILES = sorted(ROBOTS.glob("*/urdf/*.urdf.xacro"))
@@ -46,16 +46,6 @@ def tilt(e: Engine, name: str) -> float:
     """Angle (rad) between the model root's z axis and the world's."""
     w, x, y, _ = e.model_pose(name)[1]
     return math.acos(max(-1.0, min(1.0, 1.0 - 2.0 * (x * x + y * y))))
-
-
-def unread(e: Engine) -> None:
-    """Mark every sensor unread, as a simulator node does for topics with no subscriber: these
-    tests check physics, and the hunter's arm camera rendered and noised each frame was ~80 % of
-    its tests' time."""
-    for entry in e.models.values():
-        for p in entry.plugins:
-            if hasattr(p, "wanted"):
-                p.wanted = lambda: False
 
 
 def run_clean(e: Engine, commands, seconds: float) -> float:

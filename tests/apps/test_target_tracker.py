@@ -135,3 +135,10 @@ def test_one_state_step_and_batched_jacobian_equal_the_array_path_bit_for_bit():
             diff[2] = wrap(diff[2])
             want[:, i] = diff / (2 * h)
         assert np.array_equal(ctrv_jacobian(s, dt), want)
+        assert ctrv_jacobian(s, dt).flags.c_contiguous
+
+
+def test_a_state_with_an_infinite_heading_or_turn_rate_steps_to_nan_not_an_error():
+    for bad in ([0.0, 0.0, np.inf, 0.3, 0.1], [0.0, 0.0, 0.2, 0.3, -np.inf]):
+        with np.errstate(invalid="ignore"):
+            assert np.isnan(ctrv_step(np.array(bad), 0.1)).any()

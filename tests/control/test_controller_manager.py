@@ -211,3 +211,20 @@ def test_deleting_the_model_removes_its_controller_manager(hunters):
     assert "/hunter2/arm_group_controller" not in hunters.rt.graph.nodes
     assert "/hunter2/controller_manager/list_controllers" not in hunters.rt.graph.services
     hunters.rt.run(0.3)
+
+
+def test_joint_reads_follow_the_model_when_a_delete_recompiles_it(hunters):
+    """Trajectory controllers read their joints by cached addresses (`SimRobotHW.states`): when
+    deleting hunter1 recompiles the world, hunter2's joints move in qpos and the cache must
+    follow (the deleted robot is the first spawned, so hunter2's addresses do change)."""
+    hunters.rt.run(0.3)
+    hw = hunters.cm("hunter2").hw
+    before = hw._addresses[tuple(ARM)][1].copy()
+    hunters.sim.delete_model("hunter1")
+    hunters.rt.run(0.3)
+    q, qd = hw.states(ARM)
+    assert not np.array_equal(hw._addresses[tuple(ARM)][1], before)
+    truth = hw.plugin.states(hunters.sim.engine)
+    assert q.tolist() == [truth[j][0] for j in ARM]
+    assert qd.tolist() == [truth[j][1] for j in ARM]
+    assert np.abs(q).max() < 0.2  # still holding the arm's start, not reading another body

@@ -22,8 +22,10 @@ def test_bad_gains_name_the_key():
         Pid.from_params({"kp": 1}, "gains/j1")
     with pytest.raises(ControlError, match="gains/j1: no 'p' gain"):
         Pid.from_params({"d": 1}, "gains/j1")
-    with pytest.raises(ControlError, match="gains/j1/d: must be a number"):
+    with pytest.raises(ControlError, match="gains/j1/d: must be a finite number"):
         Pid.from_params({"p": 1, "d": "x"}, "gains/j1")
+    with pytest.raises(ControlError, match="gains/j1/i_clamp: must be a finite number, got nan"):
+        Pid.from_params({"p": 1, "i_clamp": float("nan")}, "gains/j1")
 
 
 def test_pid_array_matches_one_pid_per_joint_bit_for_bit():

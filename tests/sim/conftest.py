@@ -19,8 +19,8 @@ WILLOW = Path(SHARED, "data/maps/willow-full.yaml")
 
 def unread(engine) -> None:
     """Mark every sensor of the engine's models unread, as a simulator node does for topics
-    with no subscriber: for tests of physics alone (the hunter's arm camera, rendered and noised
-    every frame, was ~80 % of such a test's time)."""
+    with no subscriber: for tests of physics alone (the hunter's four cameras, rendered and
+    noised every frame, were ~80 % of such a test's time)."""
     for entry in engine.models.values():
         for p in entry.plugins:
             if hasattr(p, "wanted"):

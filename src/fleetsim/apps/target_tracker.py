@@ -70,8 +70,8 @@ def wrap(a):
 def ctrv_step(state: np.ndarray, dt: float) -> np.ndarray:
     """The CTRV motion of ``state`` (..., 5) over ``dt`` seconds (no noise)."""
     state = np.asarray(state, dtype=float)
-    if state.ndim == 1:
-        return _ctrv_step_one(state, dt)
+    if state.ndim == 1 and math.isfinite(state[2]) and math.isfinite(state[4]):
+        return _ctrv_step_one(state, dt)  # (the math module raises on an infinite angle)
     x, y, th, v, w = np.moveaxis(state, -1, 0)
     small = np.abs(w) < SMALL_YAW_RATE
     ws = np.where(small, 1.0, w)
@@ -108,7 +108,9 @@ def ctrv_jacobian(state: np.ndarray, dt: float) -> np.ndarray:
     moved = ctrv_step(np.concatenate([state + shifts, state - shifts]), dt)
     diff = moved[:5] - moved[5:]
     diff[:, 2] = wrap(diff[:, 2])
-    return diff.T / (2 * _JACOBIAN_STEPS)
+    # C order, as the column-by-column Jacobian was: the covariance products then take the
+    # same BLAS path
+    return np.ascontiguousarray(diff.T / (2 * _JACOBIAN_STEPS))
 
 
 def ctrv_process_noise(state: np.ndarray, dt: float, p: TrackerParams) -> np.ndarray:

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -37,8 +38,8 @@ class Pid:
         vals = {}
         for k in ("p", "i", "d", "i_clamp"):
             v = gains.get(k, 0.0)
-            if isinstance(v, bool) or not isinstance(v, int | float):
-                raise ControlError(f"{where}/{k}: must be a number, got {v!r}")
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+                raise ControlError(f"{where}/{k}: must be a finite number, got {v!r}")
             vals[k] = float(v)
         return cls(**vals)
 

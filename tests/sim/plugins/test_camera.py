@@ -225,3 +225,43 @@ def test_gaussian_image_noise_as_the_sensor_declares_it():
     bad = CAMERA.replace("<clip>", "<noise><type>gaussian</type><stddev>-1</stddev></noise><clip>")
     with pytest.raises(SimulationError, match=r"camera noise stddev must be >= 0, got -1.0"):
         Engine(red_wall_world()).spawn_robot("r", robot(bad))
+
+
+@pytest.mark.parametrize("mean", [0.0, 0.03, -0.02])
+def test_noise_in_place_equals_the_reference_formula(mean):
+    """`CameraPlugin.noisy` works in place for speed; it must equal the plain formula (draws
+    scaled, the image and the mean added, rounded, clipped) byte for byte."""
+    from types import SimpleNamespace
+
+    from fleetsim.sim.plugins.camera import CameraPlugin
+
+    image = np.random.default_rng(1).integers(0, 256, (48, 64, 3), dtype=np.uint8)
+    cam = SimpleNamespace(noise_std=0.02, noise_mean=mean)
+    got = CameraPlugin.noisy(cam, image, np.random.default_rng(5))
+    draws = np.random.default_rng(5).standard_normal(image.shape, dtype=np.float32)
+    want = np.clip(np.rint(draws * np.float32(255.0 * 0.02) + image + 255.0 * mean), 0, 255)
+    assert got.dtype == np.uint8 and np.array_equal(got, want.astype(np.uint8))
+    assert (got == 0).any() or (got == 255).any()  # the clip is exercised
+
+
+def test_every_shipped_robots_cameras_render_without_a_mujoco_warning(tmp_path, monkeypatch):
+    """The physics tests mark sensors unread; here every camera of every shipped robot renders
+    (and is noised) once, with no MuJoCo warning (a scene out of geometry slots, for one) and
+    no MUJOCO_LOG.TXT."""
+    from fleetsim.description import load_robot
+    from fleetsim.sim.plugins.camera import CameraPlugin
+
+    monkeypatch.chdir(tmp_path)
+    robots = Path(__file__).resolve().parents[3] / "src" / "fleetsim" / "assets" / "robots"
+    seen = 0
+    for path in sorted(robots.glob("*/urdf/*.urdf.xacro")):
+        e = Engine(WorldDesc("w", [ground_plane()]))
+        entry = e.spawn_robot("r", load_robot(path))
+        cams = [p for p in entry.plugins if isinstance(p, CameraPlugin)]
+        images = [x for x in e.advance(0.1) if isinstance(x, ImageReading)]
+        assert len({r.topic for r in images}) >= len(cams), path.parts[-3]
+        assert not e.data.warning.number.any(), path.parts[-3]
+        seen += len(cams)
+        e.close()
+    assert seen >= 4  # the hunter's four, at least
+    assert not (tmp_path / "MUJOCO_LOG.TXT").exists()

@@ -590,6 +590,23 @@ def test_a_standoff_yields_to_the_robot_met_head_on_only():
     assert top.update(12.1, 4.6, near, facing=["pioneer4"]) == "pioneer1"
 
 
+def test_a_standoff_with_several_robots_met_yields_to_the_one_with_the_highest_priority():
+    """Four jackals in two lanes of a corridor, a head-on pair in each (the corridor of 4 with
+    amcl, seed 1): jackal4 meets jackal3 (diagonally, in the other lane, nearer) and jackal1
+    (in its own lane). Yielding to the nearer one, jackal3, which is itself blocked, freed
+    nobody for 13 s; the robot the group lets through first is the one with the highest
+    priority, so that is the one yielded to. Without a standoff (the no-progress rule) the
+    nearest robot with priority is still the one yielded to."""
+    rule = make_rule("jackal4", deadlock_time=10.0, deadlock_progress=0.2, standoff_time=3.0)
+    around = {"jackal3": 1.1, "jackal2": 1.2, "jackal1": 1.38}
+    met = ["jackal3", "jackal1"]
+    assert rule.update(0.0, 5.0, around, facing=met) is None
+    assert rule.update(3.1, 4.9, around, facing=met) == "jackal1"
+    plain = make_rule("jackal4", deadlock_time=10.0, deadlock_progress=0.2, standoff_time=3.0)
+    plain.update(0.0, 5.0, around)
+    assert plain.update(10.1, 4.9, around) == "jackal3"
+
+
 def test_a_yield_ends_once_the_robot_yielded_to_is_out_of_our_way():
     """A robot we yield to that has gone off to the side, beyond deadlock_radius and clear of
     our plan ahead, is out of our way though not behind us: the yield ends there

@@ -15,7 +15,10 @@ measurement with RVO2: exact head-on pairs and 0.6 m corridors never finish). Ea
    ``standoff_time`` s, it is in a *standoff* with that robot: the passage is wide enough by the
    walls, but robots beside the two fill it (two pairs abreast in a corridor meet front to
    front and creep at a few cm/s; the no-progress clock alone waits ``deadlock_time`` for
-   that), and it yields only to a robot it faces;
+   that), and it yields only to a robot it faces: of several, the one with the highest
+   priority (four jackals in two lanes, a head-on pair in each: jackal4 yielding to jackal3,
+   the nearer, diagonally across and blocked itself, freed nobody; jackal1, in jackal4's own
+   lane, is the one the group lets through first);
 2. a stuck robot looks at the robots around it that are navigating (``controlled`` on
    /position_share; a robot parked at its goal will not move, waiting for it is pointless):
    priority goes by robot id (natural order, so ``lizi2`` before ``lizi10``); every robot sees
@@ -147,7 +150,10 @@ class DeadlockRule:
             self.best, self.best_time = remaining, now  # we keep the right of way
             self.narrow_since = now if narrow else None
             return None
-        self.yield_to = min(higher, key=lambda k: close[k])
+        if standoff:  # met head-on by several: the one the group lets through first
+            self.yield_to = min(higher, key=priority_key)
+        else:
+            self.yield_to = min(higher, key=lambda k: close[k])
         self.yield_until = now + self.yield_time
         self.yields += 1
         return self.yield_to

@@ -602,6 +602,11 @@ def test_a_standoff_with_several_robots_met_yields_to_the_one_with_the_highest_p
     met = ["jackal3", "jackal1"]
     assert rule.update(0.0, 5.0, around, facing=met) is None
     assert rule.update(3.1, 4.9, around, facing=met) == "jackal1"
+    # the highest priority among the robots met, not around: jackal1 beside us is not met
+    beside = make_rule("jackal4", deadlock_time=10.0, deadlock_progress=0.2, standoff_time=3.0)
+    met = ["jackal3", "jackal2"]
+    beside.update(0.0, 5.0, around, facing=met)
+    assert beside.update(3.1, 4.9, around, facing=met) == "jackal2"
     plain = make_rule("jackal4", deadlock_time=10.0, deadlock_progress=0.2, standoff_time=3.0)
     plain.update(0.0, 5.0, around)
     assert plain.update(10.1, 4.9, around) == "jackal3"

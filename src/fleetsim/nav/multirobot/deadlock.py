@@ -18,12 +18,13 @@ measurement with RVO2: exact head-on pairs and 0.6 m corridors never finish). Ea
    that), and it yields only to a robot it faces: of several, the one with the highest
    priority (four jackals in two lanes, a head-on pair in each: jackal4 yielding to jackal3,
    the nearer, diagonally across and blocked itself, freed nobody; jackal1, in jackal4's own
-   lane, is the one the group lets through first);
+   lane, is the highest-priority robot met);
 2. a stuck robot looks at the robots around it that are navigating (``controlled`` on
    /position_share; a robot parked at its goal will not move, waiting for it is pointless):
    priority goes by robot id (natural order, so ``lizi2`` before ``lizi10``); every robot sees
    the same ids, so all reach the same verdict without talking. If one of them has priority
-   over it, it *yields* to the nearest such robot: it takes full responsibility for avoiding
+   over it, it *yields* to the nearest such robot (in a standoff, the one with the highest
+   priority among those it faces; see 1): it takes full responsibility for avoiding
    it (the priority robot keeps its half and drives on), retreats along its own plan to a place
    wide enough for both and waits there, aside, until that robot has gone by or is out of
    its way (`fleetsim.nav.multirobot.yielding`; the planner calls `release`), or at most
@@ -150,7 +151,7 @@ class DeadlockRule:
             self.best, self.best_time = remaining, now  # we keep the right of way
             self.narrow_since = now if narrow else None
             return None
-        if standoff:  # met head-on by several: the one the group lets through first
+        if standoff:  # met head-on by several: the highest-priority robot met
             self.yield_to = min(higher, key=priority_key)
         else:
             self.yield_to = min(higher, key=lambda k: close[k])

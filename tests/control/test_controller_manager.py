@@ -219,11 +219,11 @@ def test_joint_reads_follow_the_model_when_a_delete_recompiles_it(hunters):
     follow (the deleted robot is the first spawned, so hunter2's addresses do change)."""
     hunters.rt.run(0.3)
     hw = hunters.cm("hunter2").hw
-    before = hw._addresses[tuple(ARM)][1].copy()
+    before = hw.plugin.addresses(ARM)[0].copy()
     hunters.sim.delete_model("hunter1")
     hunters.rt.run(0.3)
     q, qd = hw.states(ARM)
-    assert not np.array_equal(hw._addresses[tuple(ARM)][1], before)
+    assert not np.array_equal(hw.plugin.addresses(ARM)[0], before)
     truth = hw.plugin.states(hunters.sim.engine)
     assert q.tolist() == [truth[j][0] for j in ARM]
     assert qd.tolist() == [truth[j][1] for j in ARM]

@@ -36,7 +36,6 @@ class SimRobotHW:
         self.modes: dict[str, str] = dict(plugin.modes)
         self.robot = plugin.ctx.robot
         self.where = plugin.where
-        self._addresses: dict[tuple[str, ...], tuple] = {}
 
     @property
     def joints(self) -> list[str]:
@@ -61,27 +60,20 @@ class SimRobotHW:
 
     def positions(self, joints: list[str]) -> np.ndarray:
         """(J,) joint positions (rad or m)."""
-        st = self.plugin.states(self.engine)
-        return np.array([st[j][0] for j in joints])
+        return self.states(joints)[0]
 
     def states(self, joints: list[str]) -> tuple[np.ndarray, np.ndarray]:
         """(J,) positions and (J,) velocities from one read of the joints (a control step's).
 
-        Trajectory controllers call this at the physics rate (250 Hz on the hunter's arm), so
-        the joints' addresses are looked up once per joint list and model (a recompile, such as
-        a spawn, binds new ones)."""
-        key = tuple(joints)
-        hit = self._addresses.get(key)
-        if hit is None or hit[0] is not self.engine.model:
-            hit = (self.engine.model, *self.plugin.addresses(joints))
-            self._addresses[key] = hit
+        Trajectory controllers call this at the physics rate (250 Hz on the hunter's arm): the
+        joints' addresses come from the plugin, which keeps them until its next bind."""
+        qa, va = self.plugin.addresses(joints)
         d = self.engine.data
-        return d.qpos[hit[1]], d.qvel[hit[2]]
+        return d.qpos[qa], d.qvel[va]
 
     def velocities(self, joints: list[str]) -> np.ndarray:
         """(J,) joint velocities (rad/s or m/s)."""
-        st = self.plugin.states(self.engine)
-        return np.array([st[j][1] for j in joints])
+        return self.states(joints)[1]
 
     def efforts(self, joints: list[str]) -> np.ndarray:
         """(J,) actuator efforts applied in the last step (N m or N)."""

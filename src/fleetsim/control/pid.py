@@ -68,9 +68,6 @@ class PidArray:
         self.lim = np.abs(np.array([q.i_clamp for q in pids], dtype=float))
         self.i_term = np.zeros(len(pids))
 
-    def __len__(self) -> int:
-        return self.p.size
-
     def reset(self) -> None:
         self.i_term[:] = 0.0
 

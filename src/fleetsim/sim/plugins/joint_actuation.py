@@ -95,6 +95,7 @@ class JointActuationPlugin(ActuatorPlugin):
         self._addr = [
             (j, int(m.jnt_qposadr[i]), int(m.jnt_dofadr[i])) for j, i in zip(self.modes, jids)
         ]
+        self._addresses: dict[tuple[str, ...], tuple[np.ndarray, np.ndarray]] = {}
 
     def reset(self) -> None:
         self.targets = dict.fromkeys(self.modes, 0.0)
@@ -129,11 +130,18 @@ class JointActuationPlugin(ActuatorPlugin):
 
     def addresses(self, joints) -> tuple[np.ndarray, np.ndarray]:
         """(J,) qpos and (J,) dof addresses of ``joints`` (actuated joints of this robot) in the
-        bound model, for reading many joints with one indexing."""
-        addr = {j: (a, v) for j, a, v in self._addr}
-        qa = np.array([addr[j][0] for j in joints], dtype=np.intp)
-        va = np.array([addr[j][1] for j in joints], dtype=np.intp)
-        return qa, va
+        bound model, for reading many joints with one indexing; kept per joint list until the
+        next `bind` (a recompile, such as a spawn or a delete, moves them)."""
+        key = tuple(joints)
+        hit = self._addresses.get(key)
+        if hit is None:
+            addr = {j: (a, v) for j, a, v in self._addr}
+            hit = (
+                np.array([addr[j][0] for j in joints], dtype=np.intp),
+                np.array([addr[j][1] for j in joints], dtype=np.intp),
+            )
+            self._addresses[key] = hit
+        return hit
 
 
 __all__ = ["JointActuationPlugin"]

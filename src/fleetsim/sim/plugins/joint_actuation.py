@@ -18,7 +18,7 @@ import numpy as np
 
 from fleetsim.errors import SimulationError, did_you_mean
 from fleetsim.runtime.params import param
-from fleetsim.sim.plugins.base import ActuatorPlugin, register, require_joint
+from fleetsim.sim.plugins.base import ActuatorPlugin, joint_addresses, register, require_joint
 
 DEFAULT_EFFORT = 100.0  # N m (or N), when the URDF gives no effort limit
 KP_PER_EFFORT = 20.0  # position-servo stiffness per unit effort limit (1/rad)
@@ -91,10 +91,10 @@ class JointActuationPlugin(ActuatorPlugin):
         # each joint's qpos and dof addresses in this compile's model: `states` runs at the
         # physics rate under ros_control-style controllers (the hunter's arm: 250 Hz), where
         # looking each name up again cost ~2 us a joint a step
-        jids = [engine.joint_id(self.ctx.model, j) for j in self.modes]
-        self._addr = [
-            (j, int(m.jnt_qposadr[i]), int(m.jnt_dofadr[i])) for j, i in zip(self.modes, jids)
-        ]
+        qadr, dadr = joint_addresses(engine, self.ctx.model, list(self.modes))
+        self._addr = list(zip(self.modes, qadr.tolist(), dadr.tolist(), strict=True))
+        self._qadr, self._dadr = qadr, dadr
+        self._index = {j: k for k, j in enumerate(self.modes)}
         self._addresses: dict[tuple[str, ...], tuple[np.ndarray, np.ndarray]] = {}
 
     def reset(self) -> None:
@@ -135,12 +135,8 @@ class JointActuationPlugin(ActuatorPlugin):
         key = tuple(joints)
         hit = self._addresses.get(key)
         if hit is None:
-            addr = {j: (a, v) for j, a, v in self._addr}
-            hit = (
-                np.array([addr[j][0] for j in joints], dtype=np.intp),
-                np.array([addr[j][1] for j in joints], dtype=np.intp),
-            )
-            self._addresses[key] = hit
+            k = [self._index[j] for j in joints]
+            hit = self._addresses[key] = (self._qadr[k], self._dadr[k])
         return hit
 
 

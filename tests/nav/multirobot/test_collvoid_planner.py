@@ -624,3 +624,31 @@ def test_a_yield_ends_once_the_robot_yielded_to_is_out_of_our_way():
     assert pl._out_of_our_way(me, np.array([0.0, 2.5]), radii) is True  # 2.5 m to the side
     assert pl._out_of_our_way(me, np.array([-2.0, 1.5]), radii) is False  # within 2 m of us
     assert pl._out_of_our_way(me, np.array([0.0, 0.8]), radii) is False  # beside the way
+
+
+def test_robots_are_met_head_on_along_the_plans_way_as_the_yield_is_released(monkeypatch):
+    """Who is met head-on (ahead, `head_on`) and when a yield ends (the robot yielded to is
+    behind us, `has_passed`) are judged along the same direction, the plan's way where the
+    robot is. Judged from the robot's position to its carrot, a robot 1 m off its plan counted
+    a neighbour behind it along the plan as met, and the yield to it ended the next cycle."""
+    import fleetsim.nav.controllers.collvoid_planner as planner_module
+
+    f = Fleet([(0.0, 1.0, 0.0), (-0.6, 0.2, 0.0)], [(5.0, 0.0, 0.0), (-3.0, 0.2, 0.0)])
+    pl = f.planners[0]
+    line = np.linspace((0.0, 0.0), (5.0, 0.0), 50)
+    pl.set_plan(np.c_[line, np.zeros(50)])  # along y = 0; the robot stands 1 m off it
+    ways, original = [], planner_module.head_on
+
+    def spy(way, *args):
+        ways.append(np.array(way, dtype=float))
+        return original(way, *args)
+
+    monkeypatch.setattr(planner_module, "head_on", spy)
+    f.share()
+    f.rt.run(duration=0.1)
+    pl.compute_velocity_commands((0.0, 1.0, 0.0), (0.0, 0.0, 0.0))
+    assert ways, "robot2 navigating 1 m away: the head-on test ran"
+    way = ways[-1] / np.hypot(*ways[-1])
+    assert abs(way[1]) < 0.05, way  # the plan's way (east), not down to the carrot
+    rel = np.array([-0.6, 0.2]) - np.array([0.0, 1.0])
+    assert float(rel @ way) < 0.0  # robot2 is behind along it: not met, and passed

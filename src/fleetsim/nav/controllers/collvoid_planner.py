@@ -299,8 +299,10 @@ class CollvoidLocalPlanner(
         active = {k: d for k, d, c in zip(ids, dist.tolist(), controlled) if c}
         narrow: list[str] = []
         facing: list[str] = []
+        # the plan's way here: who is met ahead (head_on) and when a yield ends (has_passed)
+        along = carrot - self.plan[self.plan_index, :2]
         if active and self.yielding_to is None:
-            met = head_on(carrot - xy, pos - xy, nvel, yaws, controlled)
+            met = head_on(along, pos - xy, nvel, yaws, controlled)
             facing = [ids[k] for k in met]
             narrow = [
                 ids[k] for k in met if narrow_between(*self.grid, xy, pos[k], own_side[k], side[k])
@@ -309,7 +311,6 @@ class CollvoidLocalPlanner(
         self.waiting = False
         if self.yielding_to is not None:
             k = ids.index(self.yielding_to)
-            along = carrot - self.plan[self.plan_index, :2]  # the plan's way here
             pref = self._yield_velocity(xy, along, pos[k], own_side[k], side[k], remaining, pref)
             if self.yielding_to is not None:
                 resp[k] = 1.0

@@ -162,3 +162,73 @@ def test_inline_rosparam_yaml_error_names_the_launch_file_line(tmp_path):
                         "    bad: [1, 2\n  </rosparam>\n</node>")  # fmt: skip
     with pytest.raises(LaunchError, match=rf"{p}:6:\d+: YAML does not parse.*\({p}:3 <rosparam>\)"):
         load_xml(p)
+
+
+def _tree(tmp_path: Path, yaml_text: str, name: str = "params.yaml", ns: str = ""):
+    """The parameter tree of a launch file loading ``yaml_text`` (written to ``name``) into
+    /lizi1/move_base_node, or into its namespace ``ns`` under it."""
+    (tmp_path / name).write_text(yaml_text)
+    attr = f' ns="{ns}"' if ns else ""
+    p = write(
+        tmp_path,
+        '<group ns="lizi1">\n'
+        '<node pkg="move_base" type="move_base" name="move_base_node">\n'
+        f'  <rosparam file="$(dirname)/{name}" command="load"{attr}/>\n'
+        "</node>\n</group>",
+    )
+    return load_xml(p).param_tree(), tmp_path / name
+
+
+@pytest.mark.parametrize("planner", ["TrajectoryPlannerROS", "DWAPlannerROS"])
+def test_move_base_local_planner_value_of_wrong_type_names_yaml_file_and_line(tmp_path, planner):
+    """move_base hands its local planner a copy of the planner's namespace (DWAPlannerROS's
+    renamed to TrajectoryPlannerROS's): the copy keeps where each value was set."""
+    from fleetsim.nav.move_base_plugins import local_planner_namespace
+
+    key, pkg = "max_vel_x", "base_local_planner"
+    if planner == "DWAPlannerROS":
+        key, pkg = "max_rot_vel", "dwa_local_planner"
+    tree, yaml_file = _tree(tmp_path, f"{planner}:\n  min_vel_x: 0.1\n  {key}: fast\n")
+    where = "/lizi1/move_base_node"
+    name, raw = local_planner_namespace(f"{pkg}/{planner}", tree.get(where), 10.0, where)
+    want = "max_vel_x" if planner == "TrajectoryPlannerROS" else "max_vel_theta"
+    with pytest.raises(ParameterError, match=rf"parameter '{want}' must be float, got str "
+                       rf"'fast' \(set at {yaml_file}:3\)"):  # fmt: skip
+        load_params(TrajectoryPlannerParams, raw, f"{where}/{name}")
+
+
+def test_an_unknown_planner_parameter_is_warned_about_with_its_file_and_line(tmp_path, caplog):
+    from fleetsim.nav.move_base_plugins import local_planner_namespace
+
+    tree, yaml_file = _tree(tmp_path, "TrajectoryPlannerROS:\n  max_vel_X: 0.3\n")
+    where = "/lizi1/move_base_node"
+    _, raw = local_planner_namespace(
+        "base_local_planner/TrajectoryPlannerROS", tree.get(where), 10.0, where
+    )
+    with caplog.at_level("WARNING"):
+        load_params(TrajectoryPlannerParams, raw, where)
+    assert (
+        f"unknown parameter 'max_vel_X' (did you mean 'max_vel_x'?) (set at {yaml_file}:2)"
+        in caplog.text
+    )
+
+
+@pytest.mark.parametrize("form", ["plugins", "pre-Hydro"])
+def test_a_costmap_layer_value_of_wrong_type_names_yaml_file_and_line(tmp_path, form):
+    """The obstacle layer's observation source, and (without ``plugins``) the pre-Hydro keys
+    moved into their layers, keep where each value was set."""
+    from fleetsim.nav.costmap.layered_costmap import LayeredCostmap
+
+    if form == "plugins":
+        text = (
+            "plugins:\n  - {name: obstacle_layer, type: 'costmap_2d::ObstacleLayer'}\n"
+            "obstacle_layer:\n  observation_sources: scan\n"
+            "  scan: {data_type: LaserScan, marking: maybe}\n"
+        )
+        line, want = 5, r"parameter 'marking' must be bool, got str 'maybe'"
+    else:
+        text = "global_frame: odom\nobstacle_range: far\nrolling_window: true\n"
+        line, want = 2, r"parameter 'obstacle_range' must be float, got str 'far'"
+    tree, yaml_file = _tree(tmp_path, text, "costmap.yaml", ns="local_costmap")
+    with pytest.raises(ParameterError, match=rf"{want} \(set at {yaml_file}:{line}\)"):
+        LayeredCostmap.from_params(tree.get("/lizi1/move_base_node/local_costmap"), "local")

@@ -45,6 +45,7 @@ from fleetsim.nav.recovery import (
     RotateRecoveryParams,
 )
 from fleetsim.runtime import load_params
+from fleetsim.runtime.param_tree import ParamDict
 
 _log = logging.getLogger("fleetsim.nav.move_base")
 
@@ -130,19 +131,22 @@ def circumscribed_cost(layered: Any) -> tuple[int, float]:
 
 def dwa_namespace(ns: dict, where: str) -> dict:
     """DWAPlannerROS's parameters written as TrajectoryPlannerROS's (see the module doc)."""
-    out = dict(DWA_DEFAULTS)
+    out = ParamDict(DWA_DEFAULTS)
+    origins = getattr(ns, "origins", None) or {}
     for key, value in ns.items():
         if key in DWA_DROPPED:
             _log.warning("%s: DWAPlannerROS parameter '%s' has no counterpart; ignored", where, key)
         else:
             out[DWA_RENAMES.get(key, key)] = value
+            if key in origins:
+                out.origins[DWA_RENAMES.get(key, key)] = origins[key]
     return out
 
 
 def local_planner_namespace(value: str, ns: dict, controller_frequency: float, where: str):
     """(plugin name, TrajectoryPlannerROS-style namespace dict) for ``base_local_planner``."""
     name = _plugin_key("base_local_planner", value, LOCAL_PLANNERS, where)
-    raw = dict(ns.get(name) or {})
+    raw = ParamDict.copy_of(ns.get(name))
     if name == "DWAPlannerROS":
         _log.info(
             "%s: dwa_local_planner/DWAPlannerROS runs as base_local_planner's DWA mode", where

@@ -30,6 +30,14 @@ class ParamDict(dict):
         super().__init__(*args, **kwargs)
         self.origins: dict[str, str] = {}
 
+    @classmethod
+    def copy_of(cls, values: Mapping[str, Any] | None) -> ParamDict:
+        """A shallow copy of ``values`` that keeps the origins it carries (a plain ``dict()``
+        copy drops them, and a bad value's error then no longer names its file and line)."""
+        out = cls(values or {})
+        out.origins.update(getattr(values, "origins", None) or {})
+        return out
+
 
 # YAML writes a ParamDict as the mapping it is (recordings and `param dump` serialise trees)
 yaml.SafeDumper.add_representer(ParamDict, yaml.SafeDumper.represent_dict)

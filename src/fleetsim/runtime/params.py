@@ -214,11 +214,23 @@ def load_params(
                     name,
                 )
                 continue
-            log.warning("%sparameter '%s' is deprecated, use '%s'", prefix, key, name)
+            log.warning(
+                "%sparameter '%s' is deprecated, use '%s'%s",
+                prefix,
+                key,
+                name,
+                _set_at(origins, key),
+            )
         elif key not in infos:
             if key not in ignore:
                 known = list(infos) + list(alias_of)
-                log.warning("%sunknown parameter '%s'%s", prefix, key, did_you_mean(key, known))
+                log.warning(
+                    "%sunknown parameter '%s'%s%s",
+                    prefix,
+                    key,
+                    did_you_mean(key, known),
+                    _set_at(origins, key),
+                )
             continue
         info = infos[name]
         try:

@@ -37,6 +37,7 @@ from fleetsim.nav.costmap.voxel_layer import VoxelLayer
 from fleetsim.nav.errors import CostmapError
 from fleetsim.nav.map_io import OccupancyMap
 from fleetsim.runtime import load_params, param
+from fleetsim.runtime.param_tree import ParamDict
 
 _log = logging.getLogger("fleetsim.nav.costmap")
 
@@ -127,11 +128,14 @@ def _layer_specs(ns: dict[str, Any], p: CostmapParams) -> tuple[list[tuple[str, 
     consumed: set[str] = set()
 
     def move(layer: str, keys: tuple[str, ...] | list[str]) -> None:
-        sub = dict(ns.get(layer) or {})
+        sub = ParamDict.copy_of(ns.get(layer))
+        origins = getattr(ns, "origins", None) or {}
         for key in keys:
             if key in ns:
                 sub[key] = ns[key]
                 consumed.add(key)
+                if key in origins:
+                    sub.origins[key] = origins[key]
         ns[layer] = sub
 
     specs = []
@@ -194,7 +198,7 @@ class LayeredCostmap:
     @classmethod
     def from_params(cls, ns: dict[str, Any] | None, name: str = "costmap") -> LayeredCostmap:
         """Build from a costmap namespace dict (see the module docstring for both forms)."""
-        ns = dict(ns or {})
+        ns = ParamDict.copy_of(ns)  # the pre-Hydro keys move into it (_layer_specs)
         plugin_names = {str(e.get("name")) for e in ns.get("plugins") or [] if isinstance(e, dict)}
         first = load_params(
             CostmapParams, ns, name, ignore=frozenset(ns.keys()), logger=_log
@@ -216,7 +220,7 @@ class LayeredCostmap:
             if not isinstance(lns, dict):
                 raise CostmapError(f"{name}/{lname}: layer parameters must be a mapping")
             if issubclass(kind, ObstacleLayer):
-                layers.append(kind.from_namespace(lname, dict(lns), parent, name))
+                layers.append(kind.from_namespace(lname, ParamDict.copy_of(lns), parent, name))
             else:
                 lp = load_params(kind.Params, lns, f"{name}/{lname}", logger=_log)  # type: ignore[attr-defined]
                 layers.append(kind(lname, lp))  # type: ignore[call-arg]

@@ -24,6 +24,7 @@ from fleetsim.nav.costmap.layer import Bounds, CostmapLayer
 from fleetsim.nav.costmap.raytrace import clear_along_rays
 from fleetsim.nav.errors import CostmapError
 from fleetsim.runtime import load_params, param
+from fleetsim.runtime.param_tree import ParamDict
 
 _log = logging.getLogger("fleetsim.nav.costmap")
 _RANGE_DEFAULTS = {"obstacle_range": 2.5, "raytrace_range": 3.0}
@@ -197,7 +198,7 @@ class ObstacleLayer(CostmapLayer):
                     f"{where}: observation source '{src}' is listed in observation_sources but "
                     f"'{where}/{src}' is not a mapping (give it data_type, topic, marking, ...)"
                 )
-            raw = dict(raw)
+            raw = ParamDict.copy_of(raw)
             for key in _RANGE_DEFAULTS:
                 raw.setdefault(key, _searched(key, ns, parent))
             raw.setdefault("topic", src)

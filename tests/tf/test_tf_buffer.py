@@ -224,6 +224,19 @@ def test_frame_not_found_suggests_and_lists_known_frames():
         buf.lookup_transform("world", "map")
 
 
+def test_a_shared_frame_that_took_a_tf_prefix_is_named_with_the_fix():
+    """turtlebot3_navigation's ``global_frame: map`` under a tf_prefix resolves to
+    'lizi1/map' (ROS 1's tf::resolve); the message says that '/map' is the shared frame."""
+    buf = robot_buffer()
+    with pytest.raises(
+        FrameNotFound,
+        match=r"target_frame 'lizi1/map' does not exist in the tf tree \('map' exists: a frame "
+        r"written without a leading slash takes the node's tf_prefix; write '/map' for the "
+        r"shared frame\); known frames: ",
+    ):
+        buf.lookup_transform("lizi1/map", "lizi1/base_link")
+
+
 def test_disconnected_trees_name_both_roots():
     buf = robot_buffer()
     buf.set_transform(msg("lizi2/odom", "lizi2/base_link", 1.0))

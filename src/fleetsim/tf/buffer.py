@@ -402,7 +402,15 @@ class Buffer(TreeIntrospection):
         listed = ", ".join(known[:_MAX_LISTED_FRAMES]) or "none"
         if len(known) > _MAX_LISTED_FRAMES:
             listed += f" ... and {len(known) - _MAX_LISTED_FRAMES} more"
+        hint = did_you_mean(name, known)
+        tail = name.rpartition("/")[2]
+        if "/" in name and tail in self._frames:
+            # a frame parameter written without its leading slash took a tf_prefix (ROS 1's
+            # tf::resolve), and the shared frame exists unprefixed: the usual multi-robot slip
+            hint = (
+                f" ({tail!r} exists: a frame written without a leading slash takes the node's "
+                f"tf_prefix; write '/{tail}' for the shared frame)"
+            )
         return FrameNotFound(
-            f"{role} {name!r} does not exist in the tf tree{did_you_mean(name, known)}; "
-            f"known frames: {listed}"
+            f"{role} {name!r} does not exist in the tf tree{hint}; known frames: {listed}"
         )

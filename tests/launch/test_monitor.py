@@ -1,6 +1,7 @@
 """The run monitor counts goals for robots whose move_base is not in the launch plan, and
 counts a goal as reached only when the simulator's ground truth agrees."""
 
+import io
 import os
 from pathlib import Path
 
@@ -191,3 +192,36 @@ def test_without_a_simulator_here_ground_truth_comes_from_gazebo_model_states():
     assert (r.goals_sent, r.goals_reached, r.goals_unconfirmed) == (2, 1, 1)
     assert r.last_text == "reported reached, 4.0 m away by ground truth"
     assert r.distance_to_goal == pytest.approx(4.0)
+
+
+def test_the_notes_under_the_table_name_each_collision_and_the_whole_long_status():
+    """A run that fails on a collision says which robots touched, when and where (once per
+    pair: both robots record it); a status too long for the table's column is shortened there
+    and given whole below it."""
+    from types import SimpleNamespace
+
+    from fleetsim.cli.launch import STATUS_WIDTH, results_notes
+    from fleetsim.launch.monitor import RobotResult
+
+    long = "Failed to find a valid plan. Even after executing recovery behaviors. " * 2
+    a = RobotResult(namespace="/lizi1", model="lizi1", last_text="Goal reached.")
+    b = RobotResult(namespace="/lizi2", model="lizi2", last_text=long)
+    a.collision_events.append((14.672, "lizi2", 3.0, 4.5))
+    b.collision_events.append((14.672, "lizi1", 3.4, 4.5))
+    b.collision_events.append((20.0, "willowgarage", 7.25, 1.0))
+    monitor = SimpleNamespace(results=lambda: [a, b])
+    assert results_notes(monitor) == [
+        "collision at 14.67 s: /lizi1 touched robot /lizi2, /lizi1 at (3.00, 4.50)",
+        "collision at 20.00 s: /lizi2 touched 'willowgarage', /lizi2 at (7.25, 1.00)",
+        f"/lizi2 last status: {long}",
+    ]
+    cells = [list(c.cells) for c in results_table(monitor).columns]
+    status = cells[-1]
+    assert status[0] == "Goal reached." and len(status[1]) == STATUS_WIDTH
+    assert status[1].endswith("\u2026")
+    from rich.console import Console
+
+    con = Console(record=True, width=200, file=io.StringIO())
+    con.print(results_table(monitor))
+    shown = con.export_text()
+    assert "last result at [sim s]" in shown and "path [m]" in shown  # not eaten as markup

@@ -26,14 +26,20 @@ def test_goal_inside_a_wall_aborts_after_recoveries_with_the_reason():
     assert w.watch.cmds[-1][1].angular.z == 0.0
 
 
-def test_goal_outside_the_map_aborts_without_recoveries():
+def test_goal_outside_the_map_aborts_without_recoveries(caplog):
     params = move_base_params(planner_patience=0.5, recovery_behavior_enabled=False)
     w = nav_world(params)
     w.rt.run(duration=0.5)
-    h = run_goal(w, goal_msg(20.0, 20.0))
+    with caplog.at_level("WARNING"):
+        h = run_goal(w, goal_msg(20.0, 20.0))
     assert h.status == GoalStatus.ABORTED
     assert "navfn: the goal (20.000, 20.000) is off the global costmap" in h.text
     assert w.rt.now() < 2.0
+    # said at the first plan that fails, as navfn_ros does, not only when the goal aborts
+    # (with recoveries, half a minute or more later); once, not at every retry
+    warned = [r for r in caplog.records if "will always fail to this goal" in r.getMessage()]
+    assert len(warned) == 1
+    assert "navfn: the goal (20.000, 20.000) is off the global costmap" in warned[0].getMessage()
 
 
 def test_unreachable_goal_in_a_closed_box_aborts():

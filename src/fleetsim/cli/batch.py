@@ -14,6 +14,7 @@ from pathlib import Path
 import typer
 import yaml
 from rich.console import Console
+from rich.markup import escape
 from rich.table import Table
 from typer.core import TyperGroup
 
@@ -116,7 +117,7 @@ def report_cmd(
     for c in cols:
         t.add_column(c.removeprefix("arg_"))
     for c in ("rows", "errors", "success", "95% CI", "median time [s]", "median path [m]"):
-        t.add_column(c)
+        t.add_column(escape(c))  # "[s]" is rich markup otherwise
     metric_names = list(groups[0].metrics) if groups else []
     for m in metric_names:
         t.add_column(f"mean {m}")

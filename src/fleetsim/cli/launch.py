@@ -14,6 +14,7 @@ from pathlib import Path
 
 import typer
 from rich.console import Console
+from rich.markup import escape
 from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
@@ -58,7 +59,7 @@ def results_table(monitor) -> Table:
     columns = (
         "robot",
         "goals reached",
-        "time [s]",
+        "last result at [sim s]",
         "path [m]",
         "collisions",
         "to goal [m] (truth)",
@@ -66,7 +67,7 @@ def results_table(monitor) -> Table:
         "last status",
     )
     for col in columns:
-        t.add_column(col)
+        t.add_column(escape(col))  # "[m]" is rich markup otherwise, and the units vanished
     for r in monitor.results():
         t.add_row(
             r.namespace,
@@ -76,9 +77,46 @@ def results_table(monitor) -> Table:
             str(r.collisions),
             _metres(r.distance_to_goal),
             _metres(r.localization_error),
-            r.last_text or "-",
+            escape(_short(r.last_text)) or "-",
         )
     return t
+
+
+#: characters of a last status shown in the table; a longer one is given whole below it
+STATUS_WIDTH = 48
+
+
+def _short(text: str) -> str:
+    return text if len(text) <= STATUS_WIDTH else text[: STATUS_WIDTH - 1] + "\u2026"
+
+
+def results_notes(monitor) -> list[str]:
+    """Lines printed under the results table: each collision's onset (sim time, the robots,
+    where), once per pair, and the whole of each last status the table shortened."""
+    out, seen = [], set()
+    results = monitor.results()
+    names = {r.model: r.namespace for r in results if r.model}
+    for r in results:
+        for t, other, x, y in r.collision_events:
+            pair = (round(t, 3), frozenset((r.model, other)))
+            if pair in seen:
+                continue
+            seen.add(pair)
+            what = f"robot {names[other]}" if other in names else f"'{other}'"
+            out.append(
+                f"collision at {t:.2f} s: {r.namespace} touched {what}, {r.namespace} at "
+                f"({x:.2f}, {y:.2f})"
+            )
+    for r in results:
+        if len(r.last_text) > STATUS_WIDTH:
+            out.append(f"{r.namespace} last status: {r.last_text}")
+    return out
+
+
+def print_results(monitor) -> None:
+    console.print(results_table(monitor))
+    for line in results_notes(monitor):
+        console.print(line, markup=False, highlight=False)
 
 
 def run_launch(
@@ -109,7 +147,7 @@ def run_launch(
         plan = load_plan(resolve_launch_file(file), args, seed=seed)
         with LaunchSession(plan, seed=seed, viz=viz, record=record, connect=connect) as session:
             follow_until_stopped(session, duration, until_goals)
-            console.print(results_table(session.monitor))
+            print_results(session.monitor)
             return session.monitor
     if duration is None and not until_goals:
         raise LaunchError("give --duration S, --until-goals, or both")
@@ -139,7 +177,7 @@ def run_launch(
                 bar.update(task, completed=rt.now(), rtf=f"{rt.now() / max(wall, 1e-9):.1f}x RT")
                 if until is not None and until():
                     break
-        console.print(results_table(session.monitor))
+        print_results(session.monitor)
         if record:
             console.print(f"recorded to {record}")
         return session.monitor

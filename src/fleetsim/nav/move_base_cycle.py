@@ -15,7 +15,7 @@ import numpy as np
 
 from fleetsim.errors import FleetsimError, TransformError
 from fleetsim.msgs import geometry_msgs, move_base_msgs
-from fleetsim.nav.errors import ControllerError, PlannerError
+from fleetsim.nav.errors import ControllerError, GoalOutsideMap, PlannerError
 from fleetsim.nav.move_base_support import path_msg, pose_stamped, poses_in_frame
 
 PLANNING, CONTROLLING, CLEARING = "PLANNING", "CONTROLLING", "CLEARING"
@@ -56,6 +56,12 @@ class ExecuteCycle:
                     path = self.planner.create_plan(start, self.goal).poses
                 except PlannerError as e:
                     err, self._failed_key = str(e), key
+                    if isinstance(e, GoalOutsideMap):  # navfn_ros warns at once, as here
+                        self._warn(
+                            "goal off map",
+                            f"{err}: planning will always fail to this goal; move_base aborts "
+                            "it after its planner_patience and recovery behaviors",
+                        )
         if path is not None:
             self.last_valid_plan = now
             self.planning_retries = 0

@@ -53,6 +53,28 @@ def test_node_errors_name_the_node(tmp_path: Path):
         LaunchSession(load_plan(f))
 
 
+def test_a_node_twice_in_one_namespace_names_the_include_that_repeats_it(tmp_path: Path):
+    """The lesson's robot file included twice with the same ns (a copy-paste slip): the error
+    names the node's line and the <include> that brought the second copy, as two includes of
+    one file are two places."""
+    (tmp_path / "one.launch").write_text(
+        '<launch>\n<node pkg="tf" type="static_transform_publisher" name="laser" '
+        'args="0 0 0 0 0 0 base_link laser_link"/>\n</launch>'
+    )
+    f = tmp_path / "robots.launch"
+    f.write_text(
+        '<launch>\n<include file="$(dirname)/one.launch" ns="lizi1"/>\n'
+        '<include file="$(dirname)/one.launch" ns="lizi2"/>\n'
+        '<include file="$(dirname)/one.launch" ns="lizi1"/>\n</launch>'
+    )
+    with pytest.raises(
+        LaunchError,
+        match=rf"one.launch:2 <node> \(included from {f}:4 <include>\): node /lizi1/laser "
+        r"failed to start: a node named /lizi1/laser already exists",
+    ):
+        LaunchSession(load_plan(f))
+
+
 def test_missing_file():
     with pytest.raises(LaunchError, match="does not exist"):
         load_plan("/nope/x.launch")

@@ -89,6 +89,9 @@ class _Scope:
     private: list[tuple[str, Any, str]] = field(default_factory=list)
     #: inside a <node>: its <param> operations, set after its <rosparam>s as roslaunch does
     pending: list[ParamOp] | None = None
+    #: the <include> elements this file was reached through, innermost first ("" at the top):
+    #: a node's errors at start-up name them (the same file included twice is two places)
+    included_from: str = ""
 
     def child(self, **kw: Any) -> _Scope:
         base = {
@@ -100,6 +103,7 @@ class _Scope:
             "env": dict(self.env),
             "private": self.private,
             "pending": self.pending,
+            "included_from": self.included_from,
         }
         base.update(kw)
         return _Scope(**base)
@@ -336,7 +340,8 @@ class XmlLoader(ParamElements, NodeElements):
             for k in [*ctx.passed, *ctx.args]:
                 if ctx.value_of(k) is not None:
                     passed[k] = ctx.value_of(k)
-        inner = scope.child(ns=ns)
+        chain = f"{where}, included from {scope.included_from}" if scope.included_from else where
+        inner = scope.child(ns=ns, included_from=chain)
         declared: set[str] = set()
         for child in el:
             if not isinstance(child.tag, str):

@@ -116,7 +116,9 @@ class NodeElements:
             cwd=_CWDS[cwd],
             machine=self._machine_of(el, attrs, scope),
             env=dict(scope.env),
-            source=where,
+            source=f"{where} (included from {scope.included_from})"
+            if scope.included_from
+            else where,
         )
         private = names.join(ns, node.name)
         if self._flag(el, attrs, scope, "clear_params"):

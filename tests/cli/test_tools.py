@@ -283,6 +283,40 @@ def test_goal_prints_feedback_and_result(sim):
     )
 
 
+class NeverDone(Robot):
+    """A move_base that accepts a goal and never finishes it."""
+
+    def on_action(self):
+        if self.server.is_new_goal_available():
+            self.server.accept_new_goal()
+
+
+def test_a_goal_waited_for_ends_with_an_error_when_the_simulation_goes_away():
+    """``goal --wait`` on a run that ends first: not a client waiting for ever after its last
+    feedback, but an error saying the simulation went away."""
+    ep = free_endpoint()
+    rt = Runtime()
+    NeverDone(rt)
+    ZenohBridge(rt, listen=[ep])
+    stop = threading.Event()
+    th = threading.Thread(target=lambda: rt.run(until=stop.is_set, rate=2.0), daemon=True)
+    th.start()
+
+    def end_the_run():
+        time.sleep(3.0)
+        stop.set()
+        th.join(10)
+        rt.shutdown()
+
+    ender = threading.Thread(target=end_the_run, daemon=True)
+    ender.start()
+    try:
+        message = fails("goal", "lizi1", 1, 1, "--wait", "--timeout", 15, "-c", ep)
+    finally:
+        ender.join(15)
+    assert "went away before goal" in message and "/lizi1/move_base" in message, message
+
+
 def test_initialpose(sim):
     ep, robot = sim
     n0 = len(robot.poses)

@@ -108,7 +108,7 @@ def send_goal(
     )
     deadline = None if timeout is None else _wall.monotonic() + timeout
     limit = client.timeout * 3 if not wait else None
-    started = _wall.monotonic()
+    started = heard = _wall.monotonic()
     while True:
         if deadline is not None and _wall.monotonic() > deadline:
             raise TransportError(f"goal {goal_id.id} on {name}: no result within {timeout:g} s")
@@ -117,7 +117,11 @@ def send_goal(
         try:
             part, msg = inbox.get(timeout=0.1)
         except queue.Empty:
+            if _wall.monotonic() - heard > client.timeout:  # silent: is the server still there?
+                heard = _wall.monotonic()
+                _still_serving(client, name, goal_id.id)
             continue
+        heard = _wall.monotonic()
         if isinstance(msg, Exception):
             continue
         if part == "status" and not wait:
@@ -129,6 +133,19 @@ def send_goal(
                 on_feedback(msg.feedback)
         elif part == "result" and msg.status.goal_id.id == goal_id.id:
             return goal_id.id, msg.status.status, msg.status.text
+
+
+def _still_serving(client: SimulationClient, name: str, goal_id: str) -> None:
+    """Raise `TransportError` when the action server ``name`` (or the whole simulation) has
+    gone: a client waiting for a result would otherwise wait for ever after the run ended."""
+    try:
+        status = client.graph()["topics"].get(f"{name}/status")
+    except TransportError as e:
+        raise TransportError(
+            f"the simulation went away before goal {goal_id} on {name} had a result ({e})"
+        ) from None
+    if status is None or not status["publishers"]:
+        raise TransportError(f"{name} went away before goal {goal_id} had a result")
 
 
 def cancel_goal(client: SimulationClient, ns: str, goal_id: str, action: str = "move_base") -> None:

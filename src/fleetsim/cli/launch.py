@@ -113,10 +113,12 @@ def results_notes(monitor) -> list[str]:
     return out
 
 
-def print_results(monitor) -> None:
-    console.print(results_table(monitor))
+def print_results(monitor, to: Console | None = None) -> None:
+    """The results table and its notes (`results_notes`), on ``to`` (default: stderr)."""
+    to = to or console
+    to.print(results_table(monitor))
     for line in results_notes(monitor):
-        console.print(line, markup=False, highlight=False)
+        to.print(line, markup=False, highlight=False)
 
 
 def run_launch(

@@ -40,7 +40,7 @@ def marker_rotation(heading: float) -> np.ndarray:
 
 
 class FollowWorld(Node):
-    def __init__(self, runtime, start=(0.0, 0.0, 0.0)):
+    def __init__(self, runtime, start=(0.0, 0.0, 0.0), action="/move_base"):
         super().__init__(runtime, "follow_world")
         self.x, self.y, self.yaw = start
         self.marker: tuple[float, float, float] | None = None  # x, y, heading in map
@@ -53,7 +53,7 @@ class FollowWorld(Node):
             make_transform_stamped("base_footprint", CAMERA, self.now_msg(), *CAMERA_MOUNT)
         )
         self.server = self.create_action_server(
-            move_base_msgs.MoveBase, "/move_base", goal_callback=self.on_action_goal
+            move_base_msgs.MoveBase, action, goal_callback=self.on_action_goal
         )
         self.create_subscription(
             geometry_msgs.PoseStamped, "/move_base_simple/goal", self.on_simple_goal, 10

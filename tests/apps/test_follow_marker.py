@@ -77,6 +77,39 @@ def test_lost_for_4_s_then_rotates_in_120_degree_steps_until_seen():
     assert len(w.action_goals) == len(yaws)
 
 
+def test_no_move_base_action_server_to_explore_with_is_warned_about_and_a_remap_mends_it(
+    caplog,
+):
+    """follow_marker explores through the absolute /move_base (the original's name). With the
+    follower's move_base in a namespace there is no server there: the original blocks for ever
+    in waitForServer(); here it says so, names the remap, and goes on following. With
+    ``/move_base`` remapped to the namespace's move_base it explores."""
+    for remap in (False, True):
+        rt = Runtime(seed=0)
+        w = FollowWorld(rt, action="/hank/move_base")
+        params = {"marker_id": 0, "marker_to_target_pose": {"x": -0.8, "y": 0.0}}
+        remaps = {"/move_base": "/hank/move_base"} if remap else None
+        f = FollowMarker(rt, params=params, remaps=remaps)
+        w.marker = (3.0, 0.0, 0.0)
+        caplog.clear()
+        with caplog.at_level("WARNING"):
+            rt.run(duration=1.0)
+            w.marker = None
+            rt.run(duration=15.0)  # lost: exploration is due from 4 s on
+        warned = [r.getMessage() for r in caplog.records if "cannot explore" in r.getMessage()]
+        if remap:
+            assert warned == [] and len(w.action_goals) >= 2 and f.exploration.goals_sent >= 2
+        else:
+            assert w.action_goals == [] and not f.exploration.is_exploring()
+            assert len(warned) == 2  # once per 10 s, not at every detection
+            assert "no move_base action server at /move_base" in warned[0]
+            assert "remap /move_base to move_base" in warned[0]
+            w.marker = (w.x + 3.0, w.y, 0.0)  # seen again: it still follows
+            n = len(w.simple_goals)
+            rt.run(duration=0.5)
+            assert len(w.simple_goals) > n
+
+
 def test_move_to_target_goes_to_the_vantage_pose_once():
     rt, w, f = world(MOVE_TO_TARGET)
     rt.run(duration=4.0)

@@ -29,6 +29,8 @@ from fleetsim.tf.transforms import compose_transforms, inverse_transform
 
 #: the move_base action follow_marker explores with (absolute, as the original's)
 MOVE_BASE_ACTION = "/move_base"
+#: s between two warnings that no move_base action server is there to explore with
+NO_SERVER_WARN_PERIOD = 10.0
 #: rotate's step (rad)
 ROTATE_STEP = 2 * math.pi / 3
 #: move_to_target's "already there" test: distance (m) and signed yaw error (rad)
@@ -86,6 +88,7 @@ class Exploration(ABC):
         self.cancelled = False
         self.handle = None
         self.goals_sent = 0
+        self.warned_at = -math.inf
 
     @classmethod
     def create(cls, node, raw: Any, where: str) -> Exploration:
@@ -104,6 +107,18 @@ class Exploration(ABC):
     def start(self) -> bool:
         """Send the strategy's goal unless one is running or none is needed; True if sent."""
         if self.exploring:
+            return False
+        if not self.client.wait_for_server():
+            # the original blocks in waitForServer() for ever; here the follower goes on
+            # following, and the exploration starts once a server is there
+            now = self.node.now()
+            if now - self.warned_at >= NO_SERVER_WARN_PERIOD:
+                self.warned_at = now
+                self.node.get_logger().warning(
+                    f"cannot explore: no move_base action server at {self.client.name} "
+                    f"(follow_marker explores through the absolute {MOVE_BASE_ACTION}, as the "
+                    f"original does; in a namespace, remap {MOVE_BASE_ACTION} to move_base)"
+                )
             return False
         goal = self.goal()
         if goal is None:

@@ -204,6 +204,41 @@ def test_no_camera_info_no_transforms_and_one_error(caplog):
     assert len(errors) == 1 and "/camera_info" in errors[0].getMessage()
 
 
+def test_no_images_at_all_are_reported_and_the_report_stops_with_the_first(caplog):
+    """A detector on a robot without a camera (the tutorial's burger) or behind a remap that
+    misses it never gets an image: it says so at 5 s and every 30 s, not at every tick, and
+    once an image has come, never again."""
+    bare = Runtime()
+    ArucoDetect(bare, params={"dictionary": 0})  # nothing publishes /camera
+    with caplog.at_level("WARNING"):
+        bare.run(duration=40.0)
+    said = [r.getMessage() for r in caplog.records if "no image on" in r.getMessage()]
+    assert len(said) == 2, said  # at 5 s and at 35 s
+    assert "no image on /camera for 5 s (nothing publishes it)" in said[0]
+    assert "for 35 s" in said[1]
+    caplog.clear()
+    hn = Harness()  # a publisher is there: the first image ends the reports
+    with caplog.at_level("WARNING"):
+        hn.rt.run(duration=6.0)
+        hn.send(np.zeros((H, W, 3), np.uint8))
+        hn.rt.run(duration=60.0)
+    said = [r.getMessage() for r in caplog.records if "no image on" in r.getMessage()]
+    assert len(said) == 1 and "(none came)" in said[0]
+
+
+def test_axes_drawn_past_the_image_edge_write_nothing_to_stderr(capfd):
+    """/fiducial_images with a marker at the image's edge: OpenCV's drawFrameAxes clips the
+    axes, and the WARN line it writes for that (every frame) stays out of the run's output."""
+    hn = Harness({"fiducial_len": 0.15, "publish_images": True})
+    t = np.array([1.08, 0.0, 1.5])  # at the right edge: the x axis ends past the frame
+    capfd.readouterr()
+    for k in range(3):
+        hn.send(marker_image(facing(0).as_rotvec(), t, K, W, H), t=1.0 + k)
+    assert len(hn.images) == 3 and len(hn.transforms[-1].transforms) == 1
+    err = capfd.readouterr().err
+    assert "drawFrameAxes" not in err, err
+
+
 def test_camera_info_with_zeros_names_the_topic():
     hn = Harness(info=False, remaps={"camera_info": "/camera/rgb/camera_info"})
     bad = camera_info_msg(np.zeros((3, 3)), W, H, FRAME)

@@ -54,6 +54,8 @@ from fleetsim.vision.image_transport import bgr_array, decompressed_array, gray_
 
 #: images before a missing camera_info is reported (the package's frameNum > 5)
 FRAMES_BEFORE_NO_INTRINSICS = 5
+#: s of sim time without any image before that is reported (and again every NO_IMAGES_AGAIN s)
+NO_IMAGES_TIME, NO_IMAGES_AGAIN = 5.0, 30.0
 
 #: what a frame without markers yields (empty, so sharing them between frames is safe)
 _NO_CORNERS = np.zeros((0, 4, 2), np.float32)
@@ -118,6 +120,26 @@ class ArucoDetect(Node):
         self.create_subscription(sensor_msgs.CameraInfo, self.info_topic, self.on_camera_info, 1)
         self.create_subscription(std_msgs.String, "ignore_fiducials", self.on_ignore, 1)
         self.create_service(std_srvs.SetBool, "enable_detections", self.on_enable)
+        self._got_image = False
+        self._no_image_ticks = 0
+        self._no_images = self.create_timer(NO_IMAGES_TIME, self._check_images)
+
+    def _check_images(self) -> None:
+        """Say so while no image has come, at NO_IMAGES_TIME s and every NO_IMAGES_AGAIN s (the
+        package waits in silence: a follower on a robot without a camera, or a remap that misses
+        it, then never acts and nothing tells why)."""
+        if self._got_image:
+            self._no_images.cancel()
+            return
+        self._no_image_ticks += 1
+        if (self._no_image_ticks - 1) % round(NO_IMAGES_AGAIN / NO_IMAGES_TIME):
+            return
+        topic = self.runtime.graph.topics.get(self.image_topic)
+        who = "nothing publishes it" if topic is None or not topic.publishers else "none came"
+        self.get_logger().warning(
+            f"no image on {self.image_topic} for {self._no_image_ticks * NO_IMAGES_TIME:.0f} s "
+            f"({who}): does this robot have a camera, and do the remaps lead to it?"
+        )
 
     # -- inputs --------------------------------------------------------------------------------
     def on_camera_info(self, msg: sensor_msgs.CameraInfo) -> None:
@@ -156,11 +178,13 @@ class ArucoDetect(Node):
         return std_srvs.SetBool.Response(success=True, message=text)
 
     def on_image(self, msg: sensor_msgs.Image) -> None:
+        self._got_image = True
         if self.enabled:
             gray = gray_array(msg, self.image_topic)
             self.process(gray, msg.header.stamp, lambda: bgr_array(msg, self.image_topic))
 
     def on_compressed(self, msg: sensor_msgs.CompressedImage) -> None:
+        self._got_image = True
         if self.enabled:
             if self.images_pub is not None and self.images_pub.get_num_connections():
                 # one decode to colour serves both (only when someone looks at the images)
@@ -266,10 +290,18 @@ class ArucoDetect(Node):
                 img, list(corners.reshape(-1, 1, 4, 2)), ids.reshape(-1, 1)
             )
         if poses is not None:
-            for rvec, tvec in zip(poses[1], poses[2]):
-                cv2.drawFrameAxes(
-                    img, self.camera_matrix, self.dist_coeffs, rvec, tvec, self.params.fiducial_len
-                )
+            # OpenCV writes a WARN line to stderr for every axis drawn past the image's edge (a
+            # marker near the edge, every frame): the drawing is clipped as it should be
+            level = cv2.utils.logging.getLogLevel()
+            cv2.utils.logging.setLogLevel(cv2.utils.logging.LOG_LEVEL_ERROR)
+            try:
+                for rvec, tvec in zip(poses[1], poses[2]):
+                    cv2.drawFrameAxes(
+                        img, self.camera_matrix, self.dist_coeffs, rvec, tvec,
+                        self.params.fiducial_len,
+                    )  # fmt: skip
+            finally:
+                cv2.utils.logging.setLogLevel(level)
         self.images_pub.publish(image_message(img, "bgr8", header))
 
 

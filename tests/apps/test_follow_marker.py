@@ -110,6 +110,28 @@ def test_no_move_base_action_server_to_explore_with_is_warned_about_and_a_remap_
             assert len(w.simple_goals) > n
 
 
+def test_markers_seen_but_never_ours_are_warned_about_once(caplog):
+    """The camera sees marker 0 for 12 s but the follower was told marker_id 7 (a typo, or an
+    id outside the detector's dictionary): it explores, as the original does, and says once
+    which ids it does see. Following marker 0, nothing is said."""
+    for marker_id, warned in ((7, 1), (0, 0)):
+        rt = Runtime(seed=0)
+        w = FollowWorld(rt)
+        params = {"marker_id": marker_id, "marker_to_target_pose": {"x": -0.8, "y": 0.0}}
+        FollowMarker(rt, params=params)
+        w.marker = (3.0, 0.0, 0.0)  # fiducial 0
+        caplog.clear()
+        with caplog.at_level("WARNING"):
+            rt.run(duration=14.0)
+        said = [r.getMessage() for r in caplog.records if "seen only marker ids" in r.getMessage()]
+        assert len(said) == warned, said
+        if warned:
+            assert (
+                "following marker_id 7, but for 10 s the camera has seen only marker ids 0"
+                in (said[0])
+            )
+
+
 def test_move_to_target_goes_to_the_vantage_pose_once():
     rt, w, f = world(MOVE_TO_TARGET)
     rt.run(duration=4.0)

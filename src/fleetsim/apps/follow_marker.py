@@ -42,6 +42,8 @@ from fleetsim.tf.transforms import compose_transforms
 
 #: the marker is lost after this much image time without an update (s)
 UPDATE_TIMEOUT = 4.0
+#: s of image time with other markers seen and ours never before that is warned about
+OTHERS_ONLY_TIME = 10.0
 #: period of the move_base/clear_costmaps calls (s)
 CLEAR_COSTMAPS_PERIOD = 5.0
 #: the fixed re-orientation of the ArUco frame: x into the face, z up
@@ -93,6 +95,9 @@ class FollowMarker(Node):
         self.last_update: float = 0.0  # image time of the last update (ros::Time(0) at start)
         self.goals_sent = 0
         self._warned: set[str] = set()
+        self._others_seen: set[int] = set()  # ids seen while ours never was (_others_only)
+        self._others_since: float | None = None
+        self._ours_seen = False
         self._patience = TransformPatience()  # tf failures are reported once they last
         self.goal_pub = self.create_publisher(geometry_msgs.PoseStamped, "move_base_simple/goal")
         self.tf_pub = TransformBroadcaster(self)
@@ -102,6 +107,25 @@ class FollowMarker(Node):
             fiducial_msgs.FiducialTransformArray, "fiducial_transforms", self.on_fiducials, 1
         )
         self.create_timer(CLEAR_COSTMAPS_PERIOD, self.clear_costmaps)
+
+    def _others_only(self, msg: fiducial_msgs.FiducialTransformArray, stamp: float) -> None:
+        """Warn once when for `OTHERS_ONLY_TIME` s of image time the camera has seen markers,
+        but never ``~marker_id`` (a marker_id the marker does not carry, or one outside the
+        detector's dictionary, which the follower cannot check: it only explores)."""
+        ids = {t.fiducial_id for t in msg.transforms}
+        if not ids:
+            return
+        self._others_seen |= ids
+        if self._others_since is None:
+            self._others_since = stamp
+        elif stamp - self._others_since >= OTHERS_ONLY_TIME and not self._ours_seen:
+            seen = ", ".join(str(i) for i in sorted(self._others_seen))
+            self._warn_once(
+                "others",
+                f"following marker_id {self.params.marker_id}, but for "
+                f"{stamp - self._others_since:.0f} s the camera has seen only marker ids {seen}; "
+                "is ~marker_id the id the marker carries?",
+            )
 
     def _warn_once(self, key: str, text: str) -> None:
         if key not in self._warned:
@@ -131,9 +155,11 @@ class FollowMarker(Node):
         stamp = msg.header.stamp.to_sec()
         found = next((t for t in msg.transforms if t.fiducial_id == self.params.marker_id), None)
         if found is None:
+            self._others_only(msg, stamp)
             if stamp - self.last_update > UPDATE_TIMEOUT:
                 self.exploration.start()
             return
+        self._ours_seen = True
         if self.exploration.is_exploring():
             self.exploration.cancel()
             self.last_update = stamp

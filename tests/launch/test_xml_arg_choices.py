@@ -47,3 +47,25 @@ def test_anything_but_choice_inside_arg_is_an_error(tmp_path: Path):
     p.write_text(ROBOTS.replace('<choice value="2"/>', '<choise value="2"/>'))
     with pytest.raises(LaunchError, match=r"t.launch:4 <choise>: <arg> may hold only <choice"):
         load_xml(p)
+
+
+@pytest.mark.parametrize(
+    "scenario, arg, value, allowed",
+    [
+        ("hunter_run", "sim_type", "gazeboo", "gazebo, rviz, gazeborviz"),
+        ("navigation_multi", "localization", "amlc", "fake, amcl"),
+        ("pioneer_multi", "localization", "AMCL", "fake, amcl"),
+        ("visual_servoing", "follower", "predictiv", "follow_marker, predictive"),
+        ("visual_servoing", "exploration_strategy", "rotat", "move_to_target, rotate"),
+        ("visual_servoing", "patrol", "buildng", "circle, building"),
+    ],
+)
+def test_shipped_switches_refuse_a_misspelt_value(scenario, arg, value, allowed):
+    """Switches read with if/unless match no branch on a misspelt value: the manual's
+    run2.launch with sim_type:=gazeboo ran on with no simulator and no robot, exit 0. The
+    shipped files list their values, so any other is an error naming the arg."""
+    from fleetsim.launch.runner import load_plan
+    from fleetsim.launch.scenarios import resolve_launch_file
+
+    with pytest.raises(LaunchError, match=rf"arg '{arg}' is '{value}'; allowed values: {allowed}"):
+        load_plan(resolve_launch_file(scenario), {arg: value})

@@ -52,6 +52,10 @@ def _version(value: bool) -> None:
         raise typer.Exit()
 
 
+#: loggers of libraries whose INFO lines are not the run's news (shown with --verbose)
+QUIET_LIBRARIES = ("OpenGL", "numba", "matplotlib", "PIL")
+
+
 @app.callback()
 def _root(
     version: bool = typer.Option(
@@ -65,6 +69,9 @@ def _root(
         handlers=[RichHandler(console=err_console, show_path=False, show_time=False)],
         force=True,
     )
+    if not verbose:  # other libraries' notes at INFO ("No OpenGL_accelerate module loaded")
+        for name in QUIET_LIBRARIES:
+            logging.getLogger(name).setLevel(logging.WARNING)
 
 
 @app.command()

@@ -232,3 +232,22 @@ def test_a_costmap_layer_value_of_wrong_type_names_yaml_file_and_line(tmp_path, 
     tree, yaml_file = _tree(tmp_path, text, "costmap.yaml", ns="local_costmap")
     with pytest.raises(ParameterError, match=rf"{want} \(set at {yaml_file}:{line}\)"):
         LayeredCostmap.from_params(tree.get("/lizi1/move_base_node/local_costmap"), "local")
+
+
+def test_a_list_a_node_parses_after_loading_names_its_line(tmp_path):
+    """aruco_detect's id lists are strings parsed after the parameters load: an id outside the
+    dictionary still names the launch file's line."""
+    from fleetsim.vision import ArucoDetect
+
+    p = write(
+        tmp_path,
+        '<node pkg="aruco_detect" type="aruco_detect" name="aruco_detect">\n'
+        '  <param name="dictionary" value="0"/>\n'
+        '  <param name="ignore_fiducials" value="3-60"/>\n'
+        "</node>",
+    )
+    rt = Runtime()
+    load_xml(p).apply_params(rt.params)
+    with pytest.raises(ParameterError, match=rf"id 60 in '3-60' is not in the dictionary, whose "
+                       rf"ids are 0..49 \(set at {p}:4 <param>\)"):  # fmt: skip
+        ArucoDetect(rt)

@@ -105,6 +105,13 @@ class Node:
             logger=self._logger,
         )
 
+    def param_origin(self, name: str) -> str:
+        """`` (set at FILE:LINE)`` for the private parameter ``name`` when a file set it, else
+        "": for errors a node raises on a value after loading it (a list to parse, a pair of
+        parameters that disagree)."""
+        origin = self.runtime.params.origin(names.join(self.full_name, name))
+        return f" (set at {origin})" if origin else ""
+
     def get_param(self, name: str, default: Any = None) -> Any:
         """Read a parameter by (relative, private or global) name."""
         return self.runtime.params.get(self.resolve_name(name), default)

@@ -79,14 +79,20 @@ class ArucoDetect(Node):
             )
         self.dictionary = aruco_dictionary(p.dictionary, f"{where}: parameter 'dictionary'")
         self.dictionary_size = dictionary_size(p.dictionary)
-        self.ignore_ids = parse_id_list(
-            p.ignore_fiducials, self.dictionary_size, f"{where}: parameter 'ignore_fiducials'"
-        )
-        self.len_override = parse_len_override(
-            p.fiducial_len_override,
-            self.dictionary_size,
-            f"{where}: parameter 'fiducial_len_override'",
-        )
+        try:
+            self.ignore_ids = parse_id_list(
+                p.ignore_fiducials, self.dictionary_size, f"{where}: parameter 'ignore_fiducials'"
+            )
+        except ParameterError as e:
+            raise ParameterError(f"{e}{self.param_origin('ignore_fiducials')}") from None
+        try:
+            self.len_override = parse_len_override(
+                p.fiducial_len_override,
+                self.dictionary_size,
+                f"{where}: parameter 'fiducial_len_override'",
+            )
+        except ParameterError as e:
+            raise ParameterError(f"{e}{self.param_origin('fiducial_len_override')}") from None
         self.detector = cv2.aruco.ArucoDetector(self.dictionary, detector_parameters(p))
         self.enabled = True
         self.frames = 0  # images processed (image_seq)

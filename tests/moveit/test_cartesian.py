@@ -47,6 +47,7 @@ def test_a_reachable_pose_is_reached_with_its_orientation(arm):
     a.set_pose_target(target)
     assert a.go(), a.last_result()
     now = a.get_current_pose().pose
+    assert type(now.position.x) is float and type(now.orientation.w) is float  # as rospy's
     assert np.linalg.norm(xyz(now) - pos) < 0.01
     o = now.orientation
     assert angle_between([o.x, o.y, o.z, o.w], quat) < 0.02

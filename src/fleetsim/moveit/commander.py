@@ -140,8 +140,8 @@ class MoveGroupCommander:
         pos, quat = ctx.kin.link_pose(np.array(self.get_current_joint_values()), link)
         ps = geometry_msgs.PoseStamped()
         ps.header.frame_id = self.get_planning_frame()
-        ps.pose.position = geometry_msgs.Point(*pos)
-        ps.pose.orientation = geometry_msgs.Quaternion(*quat)
+        ps.pose.position = geometry_msgs.Point(*map(float, pos))
+        ps.pose.orientation = geometry_msgs.Quaternion(*map(float, quat))
         return ps
 
     # ------------------------------------------------------------------ targets

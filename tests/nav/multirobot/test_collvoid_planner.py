@@ -22,6 +22,7 @@ from fleetsim.nav.multirobot.holonomic import (
     detour_velocity,
     gaps_closed,
     obstacle_points,
+    rotated,
     tracking_command,
     without_robots,
 )
@@ -652,3 +653,26 @@ def test_robots_are_met_head_on_along_the_plans_way_as_the_yield_is_released(mon
     assert abs(way[1]) < 0.05, way  # the plan's way (east), not down to the carrot
     rel = np.array([-0.6, 0.2]) - np.array([0.0, 1.0])
     assert float(rel @ way) < 0.0  # robot2 is behind along it: not met, and passed
+
+
+@pytest.mark.parametrize(
+    "walls, y, kept",
+    [
+        ((), 0.0, True),  # open floor: kept right
+        ([(-8, 1.0, 8, 1.2), (-8, -1.2, 8, -1.0)], -0.55, True),  # a 2 m corridor's right lane
+        ([(0.3, -0.45, 3.0, -0.25)], 0.0, False),  # a wall 0.25 m to the right, ahead
+    ],
+)
+def test_keeping_right_is_dropped_where_a_wall_closes_the_right(walls, y, kept):
+    """Keeping right of an oncoming robot turns the preferred velocity by left_pref; where a
+    wall closes that side (a door's jamb, approached diagonally) it would press the robot into
+    the wall, so the velocity is left as it is. In a 2 m corridor's lane it is still kept."""
+    f = Fleet([(0.0, y, 0.0)], [(5.0, y, 0.0)], walls=walls)
+    pl = f.planners[0]
+    f.share()
+    f.rt.run(duration=0.1)
+    pl.compute_velocity_commands((0.0, y, 0.0), (0.3, 0.0, 0.0))  # this cycle's walls
+    pref = np.array([0.5, 0.0])
+    got = pl._kept_right(np.array([0.0, y]), pref, BODY)
+    turned = rotated(pref, pl.params.left_pref)
+    assert np.allclose(got, turned if kept else pref), got

@@ -322,7 +322,7 @@ class CollvoidLocalPlanner(
             near_goal = remaining < KEEP_RIGHT_UNTIL
             meeting = self._oncoming(pos - xy, nvel, vel, pref, dist, remaining)
             if not near_goal and meeting.any():
-                pref = rotated(pref, p.left_pref)
+                pref = self._kept_right(xy, pref, own_r)
             # the way past a standing robot: the room beside it (`neighbour_radii`: the
             # spreads across the line between the two, its body's extent across it), not
             # ORCA's leg (the same with no spread)

@@ -20,8 +20,8 @@ from fleetsim.nav.multirobot.crossing import (
     collision_course,
     room_to_turn,
 )
-from fleetsim.nav.multirobot.holonomic import detour_velocity, gaps_closed
-from fleetsim.nav.multirobot.yielding import has_passed, out_of_way
+from fleetsim.nav.multirobot.holonomic import detour_velocity, gaps_closed, rotated
+from fleetsim.nav.multirobot.yielding import clear_distance, has_passed, out_of_way
 
 #: m/s: a neighbour slower than this is treated as standing still (full responsibility)
 STILL_SPEED = 0.02
@@ -35,10 +35,28 @@ DETOUR_REACH = 1.0
 #: their goal, to come back to it from the side and turn there); circle of 16, seeds 0-4: 1.5 m
 #: 21.0 / 24.0 s mean / max makespan, 1.0 m 20.3 / 23.6 s, 2.5 m 24.7 / 28.4 s
 KEEP_RIGHT_UNTIL = 1.0
+#: m beyond the robot's radius the way kept right must be free of walls (in a 2 m corridor a
+#: lizi keeping right runs ~0.45 m off the wall, 0.8 m along its turned way: still kept right)
+KEEP_RIGHT_ROOM = 0.25
 
 
 class CollvoidPreference:
     """The preferred velocity's rules around other robots (see the module doc)."""
+
+    def _kept_right(self, xy, pref, own_r) -> np.ndarray:
+        """``pref`` turned by ``left_pref`` (keeping right of an oncoming robot), unless a wall
+        closes that side: the turned way meets a lethal cell of this cycle's walls within
+        ``own_r`` + `KEEP_RIGHT_ROOM` m. Then ``pref`` as it is: two lizis bound through a
+        1.6 m doorway from either side, diagonally across it, each kept right into the wall
+        beside the door and stood there 26 s (a new user's world, never tuned on)."""
+        turned = rotated(pref, self.params.left_pref)
+        n = float(np.hypot(*turned))
+        if n < 1e-9:
+            return turned
+        reach = own_r + KEEP_RIGHT_ROOM
+        if clear_distance(*self.grid, xy, turned / n, reach) < reach:
+            return pref
+        return turned
 
     def _yield_velocity(self, xy, to_goal, other, own_r, other_r, remaining, pref):
         """Yielding (`fleetsim.nav.multirobot.yielding`): to the refuge back along the plan,

@@ -29,3 +29,13 @@ def test_a_barn_run_has_the_protocols_columns(tmp_path: Path, monkeypatch):
     expected = optimal_time_of(path_from_grid(np.load(BARN_DIR / "path_3.npy")))
     assert row["barn_optimal_time"] == pytest.approx(expected)
     assert 0.0 < row["time"] < 3.0  # the protocol's clock starts when the jackal has moved
+
+
+def test_the_collided_with_column_names_each_onset():
+    from fleetsim.batch.worker import collision_text
+
+    events = [(14.7, "lizi5", 7.821, 6.0), (26.5, "map_walls", 8.16, 6.594)]
+    assert collision_text(events) == (
+        "14.70 s lizi5 at (7.82, 6.00); 26.50 s map_walls at (8.16, 6.59)"
+    )
+    assert collision_text([]) == ""

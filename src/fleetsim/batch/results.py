@@ -39,6 +39,9 @@ ROBOT_COLUMNS = {
     "time": "float",  # s of sim time at the robot's last goal result
     "path_length": "float",  # m, ground truth
     "collisions": "int",
+    # each collision's onset: "14.70 s lizi5 at (7.82, 6.00)", "; "-separated (a robot-robot
+    # contact is in both robots' rows)
+    "collided_with": "str",
     "last_status": "str",
     "sim_time": "float",  # s of sim time the run lasted
     "wall_time": "float",  # s of wall time of the run's process (start-up included)

@@ -76,6 +76,7 @@ def run_here(run: RunSpec, out: Path, record: bool = False) -> list[dict[str, An
                     time=r.time_of_last_result,
                     path_length=r.path_length,
                     collisions=r.collisions,
+                    collided_with=collision_text(r.collision_events),
                     last_status=r.last_text,
                 )
                 if metrics is not None:
@@ -88,6 +89,13 @@ def run_here(run: RunSpec, out: Path, record: bool = False) -> list[dict[str, An
             )
             rows.append(row)
     return rows
+
+
+def collision_text(events) -> str:
+    """The ``collided_with`` column: each collision's onset (`RobotResult.collision_events`:
+    sim time, the other model, this robot's x, y) as "14.70 s lizi5 at (7.82, 6.00)", joined by
+    "; "."""
+    return "; ".join(f"{t:.2f} s {other} at ({x:.2f}, {y:.2f})" for t, other, x, y in events)
 
 
 def main(argv: list[str]) -> int:

@@ -95,7 +95,13 @@ def run(
     )  # fmt: skip
     failed = len({r["run_id"] for r in table.rows if r["error"]})
     runs = len({r["run_id"] for r in table.rows})
-    console.print(f"{runs} runs ({failed} failed): {out}/results.csv, {out}/results.parquet")
+    judged = {r["run_id"] for r in table.rows if not r["error"] and r["success"] is not None}
+    missed = {r["run_id"] for r in table.rows if r["success"] is False}
+    console.print(
+        f"{runs} runs ({failed} ended in an error; of the {len(judged)} with goals, "
+        f"{len(judged - missed)} reached every goal without a collision): {out}/results.csv, "
+        f"{out}/results.parquet"
+    )
 
 
 @app.command("report")

@@ -230,9 +230,10 @@ def test_a_shared_frame_that_took_a_tf_prefix_is_named_with_the_fix():
     buf = robot_buffer()
     with pytest.raises(
         FrameNotFound,
-        match=r"target_frame 'lizi1/map' does not exist in the tf tree \('map' exists: a frame "
-        r"written without a leading slash takes the node's tf_prefix; write '/map' for the "
-        r"shared frame\); known frames: ",
+        match=r"target_frame 'lizi1/map' does not exist in the tf tree \('map' exists "
+        r"unprefixed: if it is the shared frame, write '/map' \(a frame written without a "
+        r"leading slash takes the node's tf_prefix\); if it is this robot's own, its publisher "
+        r"lacks the tf_prefix\); known frames: ",
     ):
         buf.lookup_transform("lizi1/map", "lizi1/base_link")
 

@@ -29,8 +29,9 @@ from fleetsim.tf.transforms import compose_transforms, inverse_transform
 
 #: the move_base action follow_marker explores with (absolute, as the original's)
 MOVE_BASE_ACTION = "/move_base"
-#: s between two warnings that no move_base action server is there to explore with
-NO_SERVER_WARN_PERIOD = 10.0
+#: s an exploration goal may go unanswered before it counts as sent to nobody, and s between
+#: two warnings of that
+NO_SERVER_TIME, NO_SERVER_WARN_PERIOD = 5.0, 10.0
 #: rotate's step (rad)
 ROTATE_STEP = 2 * math.pi / 3
 #: move_to_target's "already there" test: distance (m) and signed yaw error (rad)
@@ -89,6 +90,7 @@ class Exploration(ABC):
         self.handle = None
         self.goals_sent = 0
         self.warned_at = -math.inf
+        self.sent_at = -math.inf
 
     @classmethod
     def create(cls, node, raw: Any, where: str) -> Exploration:
@@ -107,19 +109,9 @@ class Exploration(ABC):
     def start(self) -> bool:
         """Send the strategy's goal unless one is running or none is needed; True if sent."""
         if self.exploring:
-            return False
-        if not self.client.wait_for_server():
-            # the original blocks in waitForServer() for ever; here the follower goes on
-            # following, and the exploration starts once a server is there
-            now = self.node.now()
-            if now - self.warned_at >= NO_SERVER_WARN_PERIOD:
-                self.warned_at = now
-                self.node.get_logger().warning(
-                    f"cannot explore: no move_base action server at {self.client.name} "
-                    f"(follow_marker explores through the absolute {MOVE_BASE_ACTION}, as the "
-                    f"original does; in a namespace, remap {MOVE_BASE_ACTION} to move_base)"
-                )
-            return False
+            if not self._unanswered():
+                return False
+            self.exploring = False  # sent to nobody: send again (a server may have come)
         goal = self.goal()
         if goal is None:
             return False
@@ -128,13 +120,34 @@ class Exploration(ABC):
         self.handle = self.client.send_goal(
             move_base_msgs.MoveBaseGoal(target_pose=goal), self._done
         )
+        self.sent_at = self.node.now()
         self.node.get_logger().info(f"Started exploration ({self.name})")
+        return True
+
+    def _unanswered(self) -> bool:
+        """The running goal has had no word from any server for `NO_SERVER_TIME` s: warned
+        about (every `NO_SERVER_WARN_PERIOD` s). The original blocks in waitForServer() for
+        ever; a follower in a namespace has no server at the absolute /move_base, and sent its
+        exploration goal to nobody and stood still for good. Judged by the goal's status, not
+        the local graph: move_base may run in another process."""
+        h, now = self.handle, self.node.now()
+        if h is None or h.heard or now - self.sent_at < NO_SERVER_TIME:
+            return False
+        if now - self.warned_at >= NO_SERVER_WARN_PERIOD:
+            self.warned_at = now
+            self.node.get_logger().warning(
+                f"cannot explore: no move_base action server answers at {self.client.name} "
+                f"(follow_marker explores through the absolute {MOVE_BASE_ACTION}, as the "
+                f"original does; in a namespace, remap {MOVE_BASE_ACTION} to move_base)"
+            )
         return True
 
     def cancel(self) -> None:
         if self.exploring and not self.cancelled and self.handle is not None:
             self.handle.cancel()
             self.cancelled = True
+            if not self.handle.heard:  # no server to answer: no done callback will come
+                self.exploring = self.cancelled = False
 
     def _done(self, handle: Any) -> None:
         if handle is self.handle:

@@ -56,11 +56,17 @@ class ExecuteCycle:
                     path = self.planner.create_plan(start, self.goal).poses
                 except PlannerError as e:
                     err, self._failed_key = str(e), key
-                    if isinstance(e, GoalOutsideMap):  # navfn_ros warns at once, as here
+                    gc = self.global_costmap
+                    off = (
+                        not gc.layered.rolling_window
+                        and gc.costmap.world_to_map(*self.goal[:2]) is None
+                    )
+                    if isinstance(e, GoalOutsideMap) and off:  # navfn_ros warns at once
                         self._warn(
-                            "goal off map",
+                            f"goal off map {self.goal}",  # once a goal
                             f"{err}: planning will always fail to this goal; move_base aborts "
                             "it after its planner_patience and recovery behaviors",
+                            period=math.inf,
                         )
         if path is not None:
             self.last_valid_plan = now

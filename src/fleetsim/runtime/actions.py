@@ -252,6 +252,7 @@ class ClientGoalHandle:
         self.goal_id = goal_id
         self.goal = goal
         self.status = 0  # PENDING
+        self.heard = False  # a server has sent a status, feedback or result of this goal
         self.text = ""
         self.result: Any = None
         self.feedback: Any = None
@@ -330,13 +331,13 @@ class ActionClient:
         for st in msg.status_list:
             h = self.handles.get(st.goal_id.id)
             if h is not None and h.result is None:
-                h.status, h.text = st.status, st.text
+                h.status, h.text, h.heard = st.status, st.text, True
 
     def _on_feedback(self, msg) -> None:
         h = self.handles.get(msg.status.goal_id.id)
         if h is not None:
             h.feedback = msg.feedback
-            h.status = msg.status.status
+            h.status, h.heard = msg.status.status, True
             if h.feedback_cb is not None:
                 h.feedback_cb(h, msg.feedback)
 
@@ -345,5 +346,6 @@ class ActionClient:
         if h is None or h.result is not None:
             return
         h.status, h.text, h.result = msg.status.status, msg.status.text, msg.result
+        h.heard = True
         if h.done_cb is not None:
             h.done_cb(h)

@@ -408,8 +408,9 @@ class Buffer(TreeIntrospection):
             # a frame parameter written without its leading slash took a tf_prefix (ROS 1's
             # tf::resolve), and the shared frame exists unprefixed: the usual multi-robot slip
             hint = (
-                f" ({tail!r} exists: a frame written without a leading slash takes the node's "
-                f"tf_prefix; write '/{tail}' for the shared frame)"
+                f" ({tail!r} exists unprefixed: if it is the shared frame, write '/{tail}' (a "
+                "frame written without a leading slash takes the node's tf_prefix); if it is "
+                "this robot's own, its publisher lacks the tf_prefix)"
             )
         return FrameNotFound(
             f"{role} {name!r} does not exist in the tf tree{hint}; known frames: {listed}"

@@ -140,11 +140,9 @@ class ArucoDetect(Node):
         self._no_image_ticks += 1
         if (self._no_image_ticks - 1) % round(NO_IMAGES_AGAIN / NO_IMAGES_TIME):
             return
-        topic = self.runtime.graph.topics.get(self.image_topic)
-        who = "nothing publishes it" if topic is None or not topic.publishers else "none came"
         self.get_logger().warning(
-            f"no image on {self.image_topic} for {self._no_image_ticks * NO_IMAGES_TIME:.0f} s "
-            f"({who}): does this robot have a camera, and do the remaps lead to it?"
+            f"no image on {self.image_topic} for {self._no_image_ticks * NO_IMAGES_TIME:.0f} s: "
+            "does this robot have a camera, and do the remaps (and ~image_transport) lead to it?"
         )
 
     # -- inputs --------------------------------------------------------------------------------

@@ -301,6 +301,8 @@ class CollvoidLocalPlanner(
         facing: list[str] = []
         # the plan's way here: who is met ahead (head_on) and when a yield ends (has_passed)
         along = carrot - self.plan[self.plan_index, :2]
+        if float(np.hypot(*along)) < 1e-6:  # at the plan's last point: the way to the carrot
+            along = carrot - xy
         if active and self.yielding_to is None:
             met = head_on(along, pos - xy, nvel, yaws, controlled)
             facing = [ids[k] for k in met]

@@ -136,6 +136,8 @@ def _layer_specs(ns: dict[str, Any], p: CostmapParams) -> tuple[list[tuple[str, 
                 consumed.add(key)
                 if key in origins:
                     sub.origins[key] = origins[key]
+                else:
+                    sub.origins.pop(key, None)
         ns[layer] = sub
 
     specs = []

@@ -57,3 +57,17 @@ def test_bad_columns(tmp_path: Path):
         t.append([{**row(0, "a"), "speed": 1}])
     with pytest.raises(BatchError, match="no batch results at"):
         read_results(tmp_path / "elsewhere")
+
+
+def test_a_results_file_from_before_a_column_was_added_resumes_with_it_empty(tmp_path: Path):
+    """A batch written before ``collided_with`` existed goes on with --resume (the column is
+    empty in its rows); another spec's columns are still refused."""
+    t = ResultsTable(tmp_path, COLUMNS)
+    t.append([row(0, "a", success=True, path_length=2.5, collided_with="1.00 s lizi2")])
+    lines = (tmp_path / "results.csv").read_text().splitlines()
+    k = lines[0].split(",").index("collided_with")
+    old = "\n".join(",".join(c for i, c in enumerate(line.split(",")) if i != k) for line in lines)
+    (tmp_path / "results.csv").write_text(old + "\n")
+    again = ResultsTable(tmp_path, COLUMNS, resume=True)
+    assert again.finished() == {"a"} and again.rows[0]["collided_with"] == ""
+    assert again.rows[0]["path_length"] == 2.5  # the columns after it read as they were

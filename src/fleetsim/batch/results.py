@@ -49,6 +49,9 @@ ROBOT_COLUMNS = {
     "mujoco_warnings": "int",
 }
 TAIL_COLUMNS = {"error": "str", "run_dir": "str"}
+#: columns added since the first release: a results file written before one of them was added
+#: is resumed with it empty (collided_with: stop 52)
+ADDED_COLUMNS = ("collided_with",)
 #: columns that depend on the machine, not on the run: left out when comparing tables
 WALL_CLOCK_COLUMNS = ("wall_time", "rtf")
 
@@ -112,13 +115,17 @@ class ResultsTable:
     def _read(self, path: Path) -> list[dict[str, Any]]:
         with path.open(newline="") as f:
             reader = csv.DictReader(f)
-            if list(reader.fieldnames or []) != list(self.columns):
+            have = list(reader.fieldnames or [])
+            older = [c for c in self.columns if c in have or c not in ADDED_COLUMNS]
+            if have != list(self.columns) and have != older:
                 raise BatchError(
-                    f"{path}: its columns ({', '.join(reader.fieldnames or [])}) are not this "
-                    f"batch's ({', '.join(self.columns)}): it was written by another spec; "
+                    f"{path}: its columns ({', '.join(have)}) are not this batch's "
+                    f"({', '.join(self.columns)}): it was written by another spec; "
                     "choose another output folder (-o)"
                 )
-            return [{k: _from_text(r[k], self.columns[k]) for k in self.columns} for r in reader]
+            return [
+                {k: _from_text(r.get(k, ""), self.columns[k]) for k in self.columns} for r in reader
+            ]
 
     def finished(self) -> set[str]:
         """run_ids of the runs already in the table (finished without an error)."""

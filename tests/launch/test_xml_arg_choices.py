@@ -55,7 +55,6 @@ def test_anything_but_choice_inside_arg_is_an_error(tmp_path: Path):
         ("hunter_run", "sim_type", "gazeboo", "gazebo, rviz, gazeborviz"),
         ("navigation_multi", "localization", "amlc", "fake, amcl"),
         ("pioneer_multi", "localization", "AMCL", "fake, amcl"),
-        ("navigation_multi", "local_planner", "colvoid", "dwa, mppi, collvoid"),
         ("visual_servoing", "follower", "predictiv", "follow_marker, predictive"),
         ("visual_servoing", "exploration_strategy", "rotat", "move_to_target, rotate"),
         ("visual_servoing", "patrol", "buildng", "circle, building"),

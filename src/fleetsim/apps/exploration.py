@@ -89,7 +89,6 @@ class Exploration(ABC):
         self.cancelled = False
         self.handle = None
         self.goals_sent = 0
-        self.warned_at = -math.inf
         self.sent_at = -math.inf
 
     @classmethod
@@ -133,13 +132,13 @@ class Exploration(ABC):
         h, now = self.handle, self.node.now()
         if h is None or h.heard or now - self.sent_at < NO_SERVER_TIME:
             return False
-        if now - self.warned_at >= NO_SERVER_WARN_PERIOD:
-            self.warned_at = now
-            self.node.get_logger().warning(
-                f"cannot explore: no move_base action server answers at {self.client.name} "
-                f"(follow_marker explores through the absolute {MOVE_BASE_ACTION}, as the "
-                f"original does; in a namespace, remap {MOVE_BASE_ACTION} to move_base)"
-            )
+        self.node._warn(
+            "exploration: no server",
+            f"cannot explore: no move_base action server answers at {self.client.name} "
+            f"(follow_marker explores through the absolute {MOVE_BASE_ACTION}, as the "
+            f"original does; in a namespace, remap {MOVE_BASE_ACTION} to move_base)",
+            NO_SERVER_WARN_PERIOD,
+        )
         return True
 
     def cancel(self) -> None:

@@ -94,7 +94,6 @@ class FollowMarker(Node):
         self.map_frame = "map"
         self.last_update: float = 0.0  # image time of the last update (ros::Time(0) at start)
         self.goals_sent = 0
-        self._warned: set[str] = set()
         self._others_seen: set[int] = set()  # ids seen while ours never was (_others_only)
         self._others_since: float | None = None
         self._ours_seen = False
@@ -126,11 +125,6 @@ class FollowMarker(Node):
                 f"{stamp - self._others_since:.0f} s the camera has seen only marker ids {seen}; "
                 "is ~marker_id the id the marker carries?",
             )
-
-    def _warn_once(self, key: str, text: str) -> None:
-        if key not in self._warned:
-            self._warned.add(key)
-            self.get_logger().warning(text)
 
     def _lookup(self, key: str, target: str, source: str, stamp: Any):
         """``target <- source`` at ``stamp``, or None (warned about once the failure has lasted

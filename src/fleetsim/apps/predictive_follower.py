@@ -110,7 +110,6 @@ class PredictiveFollower(Node):
         self.sightings = 0
         self.trail: deque[tuple[float, float, float]] = deque()  # stamp, x, y in map
         self.infeasible_cycles = 0
-        self._warned_at: dict[str, float] = {}
         self._patience = TransformPatience()
         self.cmd_pub = self.create_publisher(geometry_msgs.Twist, "cmd_vel", 1)
         self.pose_pub = self.create_publisher(
@@ -125,13 +124,6 @@ class PredictiveFollower(Node):
         self.create_timer(1.0 / p.controller_frequency, self.control_cycle)
 
     # -- inputs ----------------------------------------------------------------------------------
-    def _warn(self, key: str, text: str, period: float = 5.0) -> None:
-        now = self.now()
-        last = self._warned_at.get(key)
-        if last is None or now - last >= period:
-            self._warned_at[key] = now
-            self.get_logger().warning(text)
-
     def on_odom(self, msg: nav_msgs.Odometry) -> None:
         t = msg.twist.twist
         self.velocity = np.array([t.linear.x, t.angular.z])

@@ -179,7 +179,6 @@ class MoveBase(ExecuteCycle, Node):
         )
         self.create_subscription(nav_msgs.Odometry, "odom", self.on_odom, 1)
         self.services = MoveBaseServices(self)
-        self._warned_at: dict[str, float] = {}  # key -> sim time of its last warning
         self._odom_vel: tuple[float, float, float] | None = None
         self._prev_local: tuple[float, np.ndarray] | None = None
         self.goal_msg: geometry_msgs.PoseStamped | None = None
@@ -216,12 +215,6 @@ class MoveBase(ExecuteCycle, Node):
         )
 
     # -- small helpers -------------------------------------------------------------------------
-    def _warn(self, key: str, text: str, period: float = 5.0) -> None:
-        last = self._warned_at.get(key)
-        if last is None or self.now() - last >= period:
-            self._warned_at[key] = self.now()
-            self.get_logger().warning(text)
-
     def publish_zero_velocity(self) -> None:
         self.cmd_pub.publish(geometry_msgs.Twist())
 

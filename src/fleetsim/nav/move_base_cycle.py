@@ -57,11 +57,13 @@ class ExecuteCycle:
                 except PlannerError as e:
                     err, self._failed_key = str(e), key
                     gc = self.global_costmap
-                    off = (
-                        not gc.layered.rolling_window
+                    # navfn_ros warns at once of a goal off a static map (not of one off its
+                    # planning window, which moves with the robot)
+                    if (
+                        isinstance(e, GoalOutsideMap)
+                        and not gc.layered.rolling_window
                         and gc.costmap.world_to_map(*self.goal[:2]) is None
-                    )
-                    if isinstance(e, GoalOutsideMap) and off:  # navfn_ros warns at once
+                    ):
                         self._warn(
                             f"goal off map {self.goal}",  # once a goal
                             f"{err}: planning will always fail to this goal; move_base aborts "

@@ -16,7 +16,7 @@ import numpy as np
 from fleetsim.errors import GraphError
 from fleetsim.runtime import names
 from fleetsim.runtime.graph import Publisher, Service, ServiceClient, Subscription
-from fleetsim.runtime.params import load_params
+from fleetsim.runtime.params import _set_at, load_params
 from fleetsim.runtime.scheduler import Timer
 
 
@@ -78,6 +78,7 @@ class Node:
         self._actions: list[Any] = []
         self._logger = NodeLogger(self)
         self._warned: set[str] = set()  # keys already warned about (see _warn_once)
+        self._warned_at: dict[str, float] = {}  # key -> sim time of its last warning (_warn)
         self.rng: np.random.Generator = runtime.rng(self.full_name)
         if params:
             runtime.params.update(self.full_name, dict(params))
@@ -109,8 +110,7 @@ class Node:
         """`` (set at FILE:LINE)`` for the private parameter ``name`` when a file set it, else
         "": for errors a node raises on a value after loading it (a list to parse, a pair of
         parameters that disagree)."""
-        origin = self.runtime.params.origin(names.join(self.full_name, name))
-        return f" (set at {origin})" if origin else ""
+        return _set_at({name: self.runtime.params.origin(names.join(self.full_name, name))}, name)
 
     def get_param(self, name: str, default: Any = None) -> Any:
         """Read a parameter by (relative, private or global) name."""
@@ -152,6 +152,15 @@ class Node:
 
     def get_logger(self) -> NodeLogger:
         return self._logger
+
+    def _warn(self, key: str, text: str, period: float = 5.0) -> None:
+        """Log ``text`` as a warning at most once every ``period`` s of sim time per ``key``
+        (``ROS_WARN_THROTTLE`` by key; ``math.inf``: once)."""
+        now = self.now()
+        last = self._warned_at.get(key)
+        if last is None or now - last >= period:
+            self._warned_at[key] = now
+            self._logger.warning(text)
 
     def _warn_once(self, key: str, text: str) -> None:
         """Log ``text`` as a warning the first time ``key`` is seen (``ROS_WARN_ONCE`` by key);

@@ -79,20 +79,8 @@ class ArucoDetect(Node):
             )
         self.dictionary = aruco_dictionary(p.dictionary, f"{where}: parameter 'dictionary'")
         self.dictionary_size = dictionary_size(p.dictionary)
-        try:
-            self.ignore_ids = parse_id_list(
-                p.ignore_fiducials, self.dictionary_size, f"{where}: parameter 'ignore_fiducials'"
-            )
-        except ParameterError as e:
-            raise ParameterError(f"{e}{self.param_origin('ignore_fiducials')}") from None
-        try:
-            self.len_override = parse_len_override(
-                p.fiducial_len_override,
-                self.dictionary_size,
-                f"{where}: parameter 'fiducial_len_override'",
-            )
-        except ParameterError as e:
-            raise ParameterError(f"{e}{self.param_origin('fiducial_len_override')}") from None
+        self.ignore_ids = self._parsed("ignore_fiducials", parse_id_list)
+        self.len_override = self._parsed("fiducial_len_override", parse_len_override)
         self.detector = cv2.aruco.ArucoDetector(self.dictionary, detector_parameters(p))
         self.enabled = True
         self.frames = 0  # images processed (image_seq)
@@ -129,6 +117,15 @@ class ArucoDetect(Node):
         self._got_image = False
         self._no_image_ticks = 0
         self._no_images = self.create_timer(NO_IMAGES_TIME, self._check_images)
+
+    def _parsed(self, name: str, parse: Any) -> Any:
+        """Parameter ``name`` (a string of ids) parsed against the dictionary by ``parse``; an
+        error names the file and line that set it."""
+        where = f"{self.full_name}: parameter '{name}'"
+        try:
+            return parse(getattr(self.params, name), self.dictionary_size, where)
+        except ParameterError as e:
+            raise ParameterError(f"{e}{self.param_origin(name)}") from None
 
     def _check_images(self) -> None:
         """Say so while no image has come, at NO_IMAGES_TIME s and every NO_IMAGES_AGAIN s (the

@@ -93,7 +93,6 @@ class Costmap2DROS:
         self.initialized = False  # one update ran with every static layer holding a map
         self.update_count = 0
         self.last_pose: tuple[float, float, float] | None = None
-        self._warned: dict[str, float] = {}
         self._patience = TransformPatience()  # missing transforms: reported when they last
         self.sources = ObservationSources(self)
         self._subs: list[Any] = []
@@ -137,11 +136,7 @@ class Costmap2DROS:
 
     def _warn(self, key: str, text: str, period: float = 5.0) -> None:
         """Warn at most once every ``period`` s of sim time per key (ROS_WARN_THROTTLE)."""
-        now = self.node.now()
-        last = self._warned.get(key)
-        if last is None or now - last >= period:
-            self._warned[key] = now
-            self.node.get_logger().warning(f"{self.name}: {text}")
+        self.node._warn(f"{self.name}: {key}", f"{self.name}: {text}", period)
 
     def _static_layers(self) -> list[StaticLayer]:
         return [la for la in self.layered.layers if isinstance(la, StaticLayer)]

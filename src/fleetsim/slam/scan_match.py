@@ -179,7 +179,6 @@ def _moved(pose, move, ld, ad, out):
         out[2] -= ad
 
 
-@numba.njit(cache=True)
 def matched_poses(
     pool, table, poses, laser, ranges, angles, geom, kernel, sigma, lsigma, skip,
     lstep, astep, iterations, minimum_score, reach=0.0, climb_skip=0, constrained=0.0,
@@ -209,6 +208,20 @@ def matched_poses(
     out : (P, 3) float64, the matched poses (the sampled pose where the score <= minimum_score);
     scores : (P,) the match scores; likes : (P,) the log-likelihoods at ``out``.
     """
+    # one compiled signature: numba compiles the kernel anew (~5 s) for each set of argument
+    # types, and an omitted default or an int passed for a float is another set
+    return _matched_poses(
+        pool, table, poses, laser, ranges, angles, geom, int(kernel), float(sigma),
+        float(lsigma), int(skip), float(lstep), float(astep), int(iterations),
+        float(minimum_score), float(reach), int(climb_skip), float(constrained),
+    )  # fmt: skip
+
+
+@numba.njit(cache=True)
+def _matched_poses(
+    pool, table, poses, laser, ranges, angles, geom, kernel, sigma, lsigma, skip,
+    lstep, astep, iterations, minimum_score, reach, climb_skip, constrained,
+):  # fmt: skip
     n = poses.shape[0]
     out = poses.copy()
     scores = np.zeros(n)

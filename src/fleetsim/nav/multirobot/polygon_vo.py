@@ -175,8 +175,10 @@ def pair_shapes(
         counts[k] = len(o)
     own = np.ascontiguousarray(own, dtype=np.float64).reshape(-1, 2)
     pads = np.asarray(pads, dtype=np.float64)
+    # a writable C copy either way: a read-only broadcast view is another type, which numba
+    # compiles the kernel for again (~5 s)
     sets = pads.reshape(-1, n) if pads.ndim == 2 else np.broadcast_to(pads, (1, n))
-    shapes, sizes = _pair_shapes(rel, own, packed, counts, np.ascontiguousarray(sets), int(sides))
+    shapes, sizes = _pair_shapes(rel, own, packed, counts, np.array(sets, order="C"), int(sides))
     return (shapes, sizes) if pads.ndim == 2 else (shapes[0], sizes[0])
 
 

@@ -49,3 +49,21 @@ def test_a_yaml_launch_file_is_not_taken_for_a_spec(tmp_path: Path, capsys):
     f.write_text("launch:\n- arg: {name: speed, default: '0.2'}\n")
     assert main(["batch", str(f), "--arg", "sped=1", "-o", str(tmp_path / "out")]) == 1
     assert "declares no arg 'sped' (did you mean 'speed'?)" in capsys.readouterr().err
+
+
+def test_the_closing_line_tells_runs_that_missed_goals_from_errors_and_successes():
+    from fleetsim.cli.batch import closing_line
+
+    def row(run, success, error=""):
+        return {"run_id": run, "success": success, "error": error}
+
+    rows = [
+        row("a", True), row("a", None),  # a robot without goals does not spoil the run
+        row("b", True), row("b", False),  # one robot collided or missed: the run missed
+        row("c", False, "timed out: still running after 20 s"),
+        row("d", None),  # no robot had goals: not judged
+    ]  # fmt: skip
+    assert closing_line(rows, "out") == (
+        "4 runs (1 ended in an error; of the 2 with goals, 1 reached every goal without a "
+        "collision): out/results.csv, out/results.parquet"
+    )

@@ -1,5 +1,6 @@
 """The `fleetsim` entry point: help, version, one-line errors."""
 
+import logging
 import subprocess
 import sys
 
@@ -38,3 +39,13 @@ def test_console_script_prints_errors_without_traceback(tmp_path):
     assert r.returncode == 1
     assert "error: bad thing in x.yaml:3" in r.stderr
     assert "Traceback" not in r.stderr
+
+
+def test_other_libraries_info_lines_show_only_with_verbose(tmp_path):
+    argv = ["batch", "no_such_scenario", "-o", str(tmp_path / "out")]  # fails before any run
+    assert main(argv) == 1
+    opengl = logging.getLogger("OpenGL")
+    assert not opengl.isEnabledFor(logging.INFO) and opengl.isEnabledFor(logging.WARNING)
+    assert logging.getLogger("fleetsim").isEnabledFor(logging.INFO)
+    assert main(["-v", *argv]) == 1
+    assert opengl.isEnabledFor(logging.DEBUG)

@@ -93,11 +93,18 @@ def run(
         spec, out, workers=workers, address=address, resume=resume, record=record,
         progress=not no_progress, console=console,
     )  # fmt: skip
-    failed = len({r["run_id"] for r in table.rows if r["error"]})
-    runs = len({r["run_id"] for r in table.rows})
-    judged = {r["run_id"] for r in table.rows if not r["error"] and r["success"] is not None}
-    missed = {r["run_id"] for r in table.rows if r["success"] is False}
-    console.print(
+    console.print(closing_line(table.rows, out))
+
+
+def closing_line(rows: list[dict], out) -> str:
+    """The batch's last line: its runs (a run has a row per robot), those that ended in an
+    error, and of the others with goals those where every robot reached every goal without a
+    collision (``success`` true; null for a robot without goals), then the results files."""
+    failed = len({r["run_id"] for r in rows if r["error"]})
+    runs = len({r["run_id"] for r in rows})
+    judged = {r["run_id"] for r in rows if not r["error"] and r["success"] is not None}
+    missed = {r["run_id"] for r in rows if r["success"] is False}
+    return (
         f"{runs} runs ({failed} ended in an error; of the {len(judged)} with goals, "
         f"{len(judged - missed)} reached every goal without a collision): {out}/results.csv, "
         f"{out}/results.parquet"

@@ -69,9 +69,9 @@ def _root(
         handlers=[RichHandler(console=err_console, show_path=False, show_time=False)],
         force=True,
     )
-    if not verbose:  # other libraries' notes at INFO ("No OpenGL_accelerate module loaded")
-        for name in QUIET_LIBRARIES:
-            logging.getLogger(name).setLevel(logging.WARNING)
+    # other libraries' notes at INFO ("No OpenGL_accelerate module loaded"), shown with -v
+    for name in QUIET_LIBRARIES:
+        logging.getLogger(name).setLevel(logging.NOTSET if verbose else logging.WARNING)
 
 
 @app.command()

@@ -676,3 +676,37 @@ def test_keeping_right_is_dropped_where_a_wall_closes_the_right(walls, y, kept):
     got = pl._kept_right(np.array([0.0, y]), pref, BODY)
     turned = rotated(pref, pl.params.left_pref)
     assert np.allclose(got, turned if kept else pref), got
+
+
+@pytest.mark.parametrize(
+    "walls, kept",
+    [((), True), ([(0.3, -0.45, 3.0, -0.25)], False)],  # open floor; a wall 0.25 m to the right
+)
+def test_a_robot_met_head_on_is_kept_right_of_unless_a_wall_closes_the_right(walls, kept):
+    """The planner's cycle itself: robot2 comes head-on along robot1's way, so robot1's
+    preferred velocity is turned by left_pref before ORCA, except where a wall closes the
+    right side (then the velocity it wanted goes on unturned)."""
+    f = Fleet([(0.0, 0.0, 0.0), (2.5, 0.0, math.pi)], [(5.0, 0.0, 0.0), (-2.5, 0.0, math.pi)],
+              walls=walls)  # fmt: skip
+    f.vel[:, 0] = 0.3
+    pl = f.planners[0]
+    seen = {}
+    around, give = pl._around_still, pl._give_way
+
+    def spy_around(pref, *args):
+        seen["pref"] = np.array(pref)
+        return around(pref, *args)
+
+    def spy_give(pref, wanted, *args):
+        seen["wanted"] = np.array(wanted)
+        return give(pref, wanted, *args)
+
+    pl._around_still, pl._give_way = spy_around, spy_give
+    f.share()
+    f.rt.run(duration=0.1)
+    pl.compute_velocity_commands((0.0, 0.0, 0.0), (0.3, 0.0, 0.0))
+    assert seen, "robot2 was in robot1's view"
+    wanted = seen["wanted"]
+    assert np.hypot(*wanted) > 0.1 and abs(wanted[1]) < 0.05, wanted  # east, along the plan
+    expected = rotated(wanted, pl.params.left_pref) if kept else wanted
+    assert np.allclose(seen["pref"], expected), (seen["pref"], expected)

@@ -77,3 +77,22 @@ def test_report_command(tmp_path: Path, capsys):
     assert "2/3 (67%)" in out.out and "barn_worlds.png" in out.err
     assert main(["batch", "report", str(tmp_path / "none")]) == 1
     assert "no batch results at" in capsys.readouterr().err
+
+
+def test_a_batch_of_seeds_only_is_plotted_per_robot(tmp_path: Path):
+    rows = [
+        {"run": k, "run_id": f"r{k // 2}", "scenario": "swap", "seed": k // 2, "arg_world": "3",
+         "robot": f"/lizi{k % 2 + 1}", "success": k != 3,
+         "time": 30.0 + k, "path_length": 12.0, "collisions": int(k == 3), "error": ""}
+        for k in range(6)
+    ]  # fmt: skip
+    table = pa.Table.from_pylist([{c: r.get(c) for c in columns_for(["world"], {})} for r in rows])
+    assert swept(table) == []
+    _, cols, files = report(table, None, tmp_path)
+    assert cols == [] and sorted(f.name for f in files) == ["success_vs_robot.png", "summary.csv"]
+    by_robot = summarize(table, ["robot"])
+    assert [(g.key, g.successes, g.judged) for g in by_robot] == [
+        (("/lizi1",), 3, 3), (("/lizi2",), 2, 3),
+    ]  # fmt: skip
+    w, h = Image.open(tmp_path / "success_vs_robot.png").size
+    assert w > 300 and h > 200

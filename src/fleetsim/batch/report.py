@@ -7,7 +7,8 @@ whose scenario decides success; failed runs count as failures), medians of time 
 rows) and path length, collisions, and the mean of every numeric scenario metric.
 
 Plots: success rate (with the interval) and median time against each swept argument
-(``success_vs_<arg>.png``), and, for BARN results, one stacked bar of outcomes per world with
+(``success_vs_<arg>.png``; against the robot, ``success_vs_robot.png``, when only the seed
+varied), and, for BARN results, one stacked bar of outcomes per world with
 its mean metric above it (``barn_worlds.png``), the figure the BARN papers show.
 """
 
@@ -185,8 +186,10 @@ def plot_against(table: pa.Table, column: str, path: Path) -> None:
         [g.ci[1] - r if g.judged else 0 for r, g in zip(rate, groups)],
     ]
     fig, (a1, a2) = plt.subplots(2, 1, figsize=(6.4, 6.0), sharex=True)
-    # integer values (world numbers, counts) are points, not a curve between them
-    style = "o" if numeric and all(float(v).is_integer() for v in labels) else "o-"
+    # names (robots, scenarios) and integer values (world numbers, counts) are points, not a
+    # curve between them
+    curve = numeric and not all(float(v).is_integer() for v in labels)
+    style = "o-" if curve else "o"
     a1.errorbar(x, rate, yerr=err, fmt=style, capsize=4)
     a1.set_ylim(-0.05, 1.05)
     a1.set_ylabel(f"success rate ({CONFIDENCE:.0%} Wilson CI)")
@@ -196,6 +199,7 @@ def plot_against(table: pa.Table, column: str, path: Path) -> None:
     a2.set_xlabel(name)
     if not numeric:
         a2.set_xticks(x, labels)
+        a2.set_xlim(-0.5, len(x) - 0.5)
     a1.set_title(f"{len(table)} rows; success and time against {name}")
     fig.tight_layout()
     fig.savefig(path, dpi=100)
@@ -247,7 +251,8 @@ def report(
     outdir.mkdir(parents=True, exist_ok=True)
     files = [outdir / SUMMARY]
     write_summary(groups, cols, files[0])
-    for col in swept(table) if not by else cols:
+    # nothing swept (seeds only): each robot's success over the seeds, and its time
+    for col in (swept(table) or ["robot"]) if not by else cols:
         p = outdir / f"success_vs_{col.removeprefix(ARG_PREFIX)}.png"
         plot_against(table, col, p)
         files.append(p)

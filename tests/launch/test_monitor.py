@@ -225,3 +225,15 @@ def test_the_notes_under_the_table_name_each_collision_and_the_whole_long_status
     con.print(results_table(monitor))
     shown = con.export_text()
     assert "last result at [sim s]" in shown and "path [m]" in shown  # not eaten as markup
+
+
+def test_a_robot_in_the_root_namespace_is_named_by_its_model_in_the_table():
+    from types import SimpleNamespace
+
+    from fleetsim.launch.monitor import RobotResult
+
+    root = RobotResult(namespace="/", model="robocluedo_robot")
+    named = RobotResult(namespace="/lizi1", model="lizi1")
+    monitor = SimpleNamespace(results=lambda: [root, named])
+    robots = list(results_table(monitor).columns[0].cells)
+    assert robots == ["/ (robocluedo_robot)", "/lizi1"]

@@ -69,8 +69,10 @@ def results_table(monitor) -> Table:
     for col in columns:
         t.add_column(escape(col))  # "[m]" is rich markup otherwise, and the units vanished
     for r in monitor.results():
+        # a robot spawned in the root namespace (the manual's hunter) is told by its model
+        name = f"/ ({r.model})" if r.namespace == "/" and r.model else r.namespace
         t.add_row(
-            r.namespace,
+            escape(name),
             f"{r.goals_reached}/{r.goals_sent}",
             "-" if r.time_of_last_result is None else f"{r.time_of_last_result:.1f}",
             f"{r.path_length:.1f}",

@@ -284,3 +284,33 @@ def test_a_rolling_window_turned_from_the_map_places_it_by_tf(yaw):
     mirror = int((-side - m.origin_y) / m.resolution)
     assert LETHAL_OBSTACLE in m.costs[wall - 1 : wall + 2, col]
     assert LETHAL_OBSTACLE not in m.costs[mirror - 2 : mirror + 3, col]
+
+
+def test_a_source_that_never_gets_a_reading_is_warned_about_naming_what_is_published(caplog):
+    """A source reading a topic nobody publishes (the laser is on ``scan``, the source on
+    ``base_scan``) marks nothing: after SILENT_AFTER s a warning names the topic and where its
+    type is published; a source that gets readings is not warned about."""
+    from fleetsim.nav.costmap.sources import SILENT_AFTER
+
+    extra = {"scan": {**COMMON["scan"], "topic": "base_scan"}}
+    rt, bot, node, cm = world("local_costmap", extra=extra)
+    rt.run(duration=SILENT_AFTER - 1.0)
+    assert "no reading" not in caplog.text  # not before its time
+    rt.run(duration=2.0)
+    assert (
+        "obstacle_layer/scan: no reading on /lizi1/base_scan in 1" in caplog.text
+        and "(no publisher; LaserScan is published on /lizi1/scan)" in caplog.text
+    ), caplog.text
+    caplog.clear()
+    rt2, *_ = world("local_costmap")  # the source on the laser's topic
+    rt2.run(duration=SILENT_AFTER + 2.0)
+    assert "no reading" not in caplog.text, caplog.text
+
+
+def test_a_sensor_frame_tf_never_has_is_warned_about(caplog):
+    """A ``sensor_frame`` typo: every reading is dropped (no origin to clear from), and the
+    warning names the sensor frame, though the message's own frame is found each time."""
+    extra = {"scan": {**COMMON["scan"], "sensor_frame": "laser_link"}}
+    rt, bot, node, cm = world("local_costmap", extra=extra)
+    rt.run(duration=GRACE + 2.0)
+    assert "(sensor_frame) in frame 'lizi1/laser_link'" in caplog.text, caplog.text

@@ -244,6 +244,7 @@ class Costmap2DROS:
         if pose is None:
             return False
         self.sources.read_unread()
+        self.sources.warn_silent()
         self._place_maps()
         missing = [la.name for la in self._static_layers() if la.map_grid is None]
         if missing:

@@ -30,6 +30,9 @@ if TYPE_CHECKING:
 #: readings kept per source until the next update reads the newest one tf can place
 UNREAD_KEPT = 4
 
+#: sim seconds after subscribing before a source that never got a reading is warned about
+SILENT_AFTER = 10.0
+
 
 def _scan_points(msg: Any, sp: Any, where: str) -> np.ndarray:
     return points_from_scan(msg, sp.inf_is_valid)
@@ -56,6 +59,8 @@ class ObservationSources:
         #: whether a source has an expected_update_rate (then `is_current` reads the readings
         #: that wait, to know when each source was last heard from)
         self.watched = False
+        # sources not heard from yet: (layer, source) -> (subscription, sim time subscribed)
+        self._silent: dict[tuple[str, str], tuple[Any, float]] = {}
 
     def subscribe(self, layer: ObstacleLayer, source: str) -> Any:
         """Subscribe ``source`` of ``layer`` to its topic; returns the subscription."""
@@ -98,7 +103,10 @@ class ObservationSources:
             rot, trans = moved
             origin = trans
             if sensor_frame and sensor_frame != frame:
-                at = cm._to_global(sensor_frame, stamp, where)
+                # its own key: the message frame's lookup just succeeded, which would restart
+                # the patience of a shared one on every reading, and a sensor_frame tf never
+                # has (a typo) went unreported while the source dropped every reading
+                at = cm._to_global(sensor_frame, stamp, f"{where} (sensor_frame)")
                 if at is None:
                     return False
                 origin = at[1]
@@ -110,6 +118,7 @@ class ObservationSources:
 
             def on_reading(msg: Any) -> None:
                 if not cm.stopped:
+                    self._silent.pop(key, None)
                     ingest(msg, cm.node.now())
 
         else:  # only the newest reading counts: keep it until the next update reads it
@@ -118,9 +127,37 @@ class ObservationSources:
 
             def on_reading(msg: Any) -> None:
                 if not cm.stopped:
+                    self._silent.pop(key, None)
                     unread.append((msg, cm.node.now()))
 
-        return cm.node.create_subscription(msg_type, sp.topic, on_reading, 1)
+        sub = cm.node.create_subscription(msg_type, sp.topic, on_reading, 1)
+        self._silent[key] = (sub, cm.node.now())
+        return sub
+
+    def warn_silent(self) -> None:
+        """Warn (every 30 s) about each source that has had no reading in the `SILENT_AFTER`
+        s since it subscribed, naming its topic and, when nobody publishes there, the topics of
+        its type that have a publisher (a laser on ``base_scan`` or ``/scan`` for a source
+        reading ``scan``: the costmap would otherwise hold no obstacle of it, silently, as in
+        ROS unless ``expected_update_rate`` is set)."""
+        cm = self.costmap
+        now = cm.node.now()
+        for (layer, source), (sub, since) in self._silent.items():
+            if now - since < SILENT_AFTER:
+                continue
+            topic = sub.topic
+            text = f"{layer}/{source}: no reading on {topic.name} in {now - since:.0f} s"
+            if not topic.publishers:
+                kind = topic.type
+                others = sorted(
+                    name
+                    for name, t in cm.node.runtime.graph.topics.items()
+                    if t.type is kind and t.publishers and name != topic.name
+                )
+                seen = f"; {kind.__name__} is published on {', '.join(others[:6])}"
+                text += f" (no publisher{seen if others else ''})"
+            text += ": the layer marks nothing from it (check the source's topic)"
+            cm._warn(f"silent:{layer}/{source}", text, 30.0)
 
     def read_unread(self) -> None:
         """Feed each source's newest reading that tf can place (the ones before it would be

@@ -316,3 +316,26 @@ def test_an_amcl_in_a_namespace_is_told_to_remap_static_map(caplog):
         "no service /lizi1/static_map, but /static_map is there; add "
         '<remap from="static_map" to="/static_map"/>' in caplog.text
     )
+
+
+def test_an_amcl_reading_a_topic_nobody_publishes_says_so(caplog):
+    """amcl on ``scan`` while the laser publishes ``base_scan``: after SILENT_AFTER s without a
+    scan it warns, naming where scans are published; an amcl that gets scans does not."""
+    from fleetsim.localization.amcl.node import SILENT_AFTER
+
+    rt = Runtime(seed=0)
+    rt.params.set("/lizi1/tf_prefix", "lizi1")
+    FakeMapServer(rt)
+    FakeRobot(rt, "/lizi1", ROUTE, seed=0)
+    Amcl(rt, "amcl", "/lizi1", remaps={"static_map": "/static_map", "scan": "base_scan"})
+    with caplog.at_level(logging.WARNING):
+        rt.run(duration=SILENT_AFTER + 0.5)
+    assert (
+        "no scan received on /lizi1/base_scan in 10 s (no publisher; LaserScan is published on "
+        "/lizi1/scan)" in caplog.text
+    ), caplog.text
+    caplog.clear()
+    rt2, *_ = robot_world()
+    with caplog.at_level(logging.WARNING):
+        rt2.run(duration=SILENT_AFTER + 0.5)
+    assert "no scan received" not in caplog.text

@@ -169,6 +169,21 @@ class Node:
             self._warned.add(key)
             self._logger.warning(text)
 
+    def unpublished_hint(self, sub: Subscription) -> str:
+        """For a subscription that hears nothing: "" when its topic has a publisher, else
+        " (no publisher; LaserScan is published on /a, /b)" naming up to six topics of its
+        type that have one (a laser on ``base_scan`` for a node reading ``scan``)."""
+        topic = sub.topic
+        if topic.publishers:
+            return ""
+        others = sorted(
+            name
+            for name, t in self.runtime.graph.topics.items()
+            if t.type is topic.type and t.publishers and name != topic.name
+        )
+        seen = f"; {topic.type.__name__} is published on {', '.join(others[:6])}"
+        return f" (no publisher{seen if others else ''})"
+
     @property
     def tf_buffer(self):
         return self.runtime.tf_buffer

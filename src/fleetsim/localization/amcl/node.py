@@ -47,6 +47,7 @@ from .scan import beams_from_scan
 
 MAP_RETRY_PERIOD = 1.0  # s of sim time between static_map attempts
 SCAN_QUEUE_SIZE = 100  # scans waiting for their odometry in tf (amcl's laser_scan_filter_)
+SILENT_AFTER = 10.0  # s of sim time without a scan before it is warned about
 
 #: s of sim time before a missing map service is reported (nodes start in any order)
 MAP_GRACE = 1.0
@@ -92,7 +93,11 @@ class Amcl(Node):
             SCAN_QUEUE_SIZE,
             frames=lambda scan: (self.odom_frame, self.base_frame),
         )
-        self.create_subscription(sensor_msgs.LaserScan, "scan", self.on_scan, queue_size=1)
+        self._scan_sub = self.create_subscription(
+            sensor_msgs.LaserScan, "scan", self.on_scan, queue_size=1
+        )
+        self._scans_heard, self._started = False, self.now()
+        self._silence_timer = self.create_timer(SILENT_AFTER, self._warn_if_no_scan)
         self.create_subscription(
             geometry_msgs.PoseWithCovarianceStamped, "initialpose", self.on_initial_pose, 2
         )
@@ -259,6 +264,21 @@ class Amcl(Node):
         ):
             self.set_param(f"~{key}", float(value))
 
+    def _warn_if_no_scan(self) -> None:
+        """`SILENT_AFTER` s without a scan: said (every 30 s) until one comes, naming where
+        scans are published (amcl on the wrong topic publishes no map -> odom, and the
+        costmaps then report a missing 'map' frame, which blamed tf, not amcl)."""
+        if self._scans_heard:
+            self._silence_timer.cancel()
+            return
+        self._warn(
+            "no_scan",
+            f"no scan received on {self._scan_sub.topic.name} in {self.now() - self._started:.0f} s"
+            f"{self.unpublished_hint(self._scan_sub)}: no pose estimate and no map -> odom "
+            "transform until one comes (remap 'scan' to the laser's topic)",
+            30.0,
+        )
+
     # ----- the scan callback -----
     def on_scan(self, scan: sensor_msgs.LaserScan) -> None:
         """Queue the scan and process every queued one whose odometry is in tf.
@@ -267,6 +287,7 @@ class Amcl(Node):
         has not arrived yet (the simulator publishes a scan before the tf of the same step) waits
         for it; the next tf message retries the queue.
         """
+        self._scans_heard = True
         if self.filter.grid is None:
             self._warn_once("no_map", "received a scan but no map yet; waiting for the map")
             return

@@ -145,18 +145,11 @@ class ObservationSources:
         for (layer, source), (sub, since) in self._silent.items():
             if now - since < SILENT_AFTER:
                 continue
-            topic = sub.topic
-            text = f"{layer}/{source}: no reading on {topic.name} in {now - since:.0f} s"
-            if not topic.publishers:
-                kind = topic.type
-                others = sorted(
-                    name
-                    for name, t in cm.node.runtime.graph.topics.items()
-                    if t.type is kind and t.publishers and name != topic.name
-                )
-                seen = f"; {kind.__name__} is published on {', '.join(others[:6])}"
-                text += f" (no publisher{seen if others else ''})"
-            text += ": the layer marks nothing from it (check the source's topic)"
+            text = (
+                f"{layer}/{source}: no reading on {sub.topic.name} in {now - since:.0f} s"
+                f"{cm.node.unpublished_hint(sub)}: the layer marks nothing from it (check the "
+                "source's topic)"
+            )
             cm._warn(f"silent:{layer}/{source}", text, 30.0)
 
     def read_unread(self) -> None:

@@ -171,3 +171,24 @@ def test_true_odometries_equal_mj_object_velocity_bit_for_bit(diffbot, skidbot):
             assert quat[k].tolist() == [x, y, z, w]
     assert np.abs(ang[:, 2]).min() > 0.05 and np.abs(lin[:, 0]).min() > 0.05  # all moving
     assert [w.number for w in e.data.warning] == [0] * len(e.data.warning)
+
+
+@pytest.mark.parametrize(
+    ("tag", "value", "words"),
+    [
+        ("wheelSeparation", "30", "wheelSeparation 30 m, but the joints"),
+        ("wheelDiameter", "10", "wheelDiameter 10 m, but the wheel of joint"),
+    ],
+)
+def test_a_wheel_geometry_in_the_wrong_unit_is_warned_about(tag, value, words, caplog):
+    """30 for 0.30 m: Gazebo drives with it as given; fleetsim says it differs from the
+    model's wheels, and a right value (the fixture's) is not warned about."""
+    text = robot_text("diffbot.urdf")
+    Engine(None).spawn_robot("ok", parse_urdf(text), (0, 0, 0, 0, 0, 0))
+    assert "but the" not in caplog.text
+    bad = text.replace(f"<{tag}>0.", f"<{tag}>{value}<!-- -->0.", 1)
+    bad = bad.replace(f"<{tag}>{value}<!-- -->0.30<", f"<{tag}>{value}<")
+    bad = bad.replace(f"<{tag}>{value}<!-- -->0.10<", f"<{tag}>{value}<")
+    assert f"<{tag}>{value}<" in bad
+    Engine(None).spawn_robot("bad", parse_urdf(bad), (0, 0, 0, 0, 0, 0))
+    assert words in caplog.text and "is in metres" in caplog.text, caplog.text

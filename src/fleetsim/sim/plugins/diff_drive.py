@@ -251,6 +251,52 @@ class DiffDrivePlugin(WheeledDrive):
         self.publish_tf = p.publishOdomTF and p.publishTf
         self._setup()
 
+    def bind(self, engine) -> None:
+        super().bind(engine)
+        self._check_geometry(engine)
+
+    def _check_geometry(self, engine) -> None:
+        """Warn when ``wheelSeparation`` or ``wheelDiameter`` is far (more than
+        `GEOMETRY_TOLERANCE`) from the model's own: the wheel joints' distance along the axle,
+        the wheel's collision cylinder or sphere. Gazebo takes them as given, so a value in
+        the wrong unit (30 for 0.30 m) only shows as odometry that drifts and turns that
+        overshoot; a robot whose collision wheel differs on purpose keeps its value."""
+        m, d, p = engine.model, engine.data, self.params
+        ids = [
+            mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_JOINT, f"{self.ctx.model}/{j}")
+            for j in (p.leftJoint, p.rightJoint)
+        ]
+        axle = d.xaxis[ids[0]]
+        track = abs(float(np.dot(d.xanchor[ids[0]] - d.xanchor[ids[1]], axle)))
+        if track > 1e-3 and abs(p.wheelSeparation - track) > GEOMETRY_TOLERANCE * track:
+            _log.warning(
+                "%s: wheelSeparation %g m, but the joints '%s' and '%s' are %.3f m apart along "
+                "the axle: odometry and turns will be off (wheelSeparation is in metres)",
+                self.where, p.wheelSeparation, p.leftJoint, p.rightJoint, track,
+            )  # fmt: skip
+        body = m.jnt_bodyid[ids[0]]
+        radii = [
+            float(m.geom_size[g, 0])
+            for g in range(m.body_geomadr[body], m.body_geomadr[body] + m.body_geomnum[body])
+            if m.geom_contype[g] or m.geom_conaffinity[g]
+            if int(m.geom_type[g]) in ROUND_GEOMS
+        ]
+        if len(radii) == 1 and abs(p.wheelDiameter - 2 * radii[0]) > GEOMETRY_TOLERANCE * (
+            2 * radii[0]
+        ):
+            _log.warning(
+                "%s: wheelDiameter %g m, but the wheel of joint '%s' collides as a %.3f m "
+                "diameter: speeds and odometry will be off (wheelDiameter is in metres)",
+                self.where, p.wheelDiameter, p.leftJoint, 2 * radii[0],
+            )  # fmt: skip
+
+
+#: relative difference between a diff drive's wheelSeparation/wheelDiameter and the model's
+#: own geometry above which it is warned about
+GEOMETRY_TOLERANCE = 0.25
+#: a wheel's collision geometry whose first size is its radius
+ROUND_GEOMS = (int(mujoco.mjtGeom.mjGEOM_CYLINDER), int(mujoco.mjtGeom.mjGEOM_SPHERE))
+
 
 def true_odometries(model, data, roots: np.ndarray) -> tuple[np.ndarray, ...]:
     """World poses and body-frame twists of the bodies ``roots`` ((B,) int64 body ids), as

@@ -148,9 +148,35 @@ def add_robot(spec: mujoco.MjSpec, robot: Any, name: str, pose: Pose) -> str:
             )
             _add_joint(child, joint, prefix, robot)
             stack.append((joint.child, child))
+    _warn_massless(robot)
     for j in robot.joints.values():
         if j.mimic is not None:
             warnings.warn(
                 f"{robot.source}: mimic joint '{j.name}' moves freely in simulation", stacklevel=2
             )
     return prefix + root
+
+
+def _warn_massless(robot: Any) -> None:
+    """Warn about each link a moving joint carries with no ``<inertial>``, no mass or no
+    inertia: fleetsim gives it `MIN_MASS` and `MIN_INERTIA` and drives on, while Gazebo drops
+    a link without an inertial, with its joint, and ODE refuses a zero mass, so the model would
+    not drive there (a wheel without an inertial is the usual slip)."""
+    for j in robot.joints.values():
+        if j.type == "fixed":
+            continue
+        ine = robot.links[j.child].inertial
+        if ine is None:
+            what = "has no <inertial>"
+        elif ine.mass <= 0:
+            what = f"has mass {ine.mass:g}"
+        elif ine.ixx <= 0 or ine.iyy <= 0 or ine.izz <= 0:
+            what = f"has inertia ixx {ine.ixx:g} iyy {ine.iyy:g} izz {ine.izz:g}"
+        else:
+            continue
+        warnings.warn(
+            f"{robot.source}: link '{j.child}' (moved by {j.type} joint '{j.name}') {what}: "
+            f"simulated with {MIN_MASS * 1000:g} g and a tiny inertia; Gazebo would drop it or "
+            "refuse it, give it a positive mass and inertia",
+            stacklevel=3,
+        )

@@ -59,6 +59,22 @@ def test_dwa_planner_names_map_onto_the_dwa_mode(caplog):
     assert p.acc_lim_x == 1.0 and p.gdist_scale == 24.0  # DWAPlannerROS's default
     assert "'max_trans_vel' has no counterpart" in caplog.text
     assert dwa_namespace({}, "x")["min_vel_x"] == 0.0
+    assert p.min_vel_theta == -2.0  # a magnitude in DWA: as far right as left
+
+
+def test_dwa_planner_noetic_names_keep_rotation_symmetric(caplog):
+    """melodic/noetic DWAPlannerROS names: min_vel_theta is the least rotational speed (a
+    magnitude), not TrajectoryPlannerROS's signed lower bound; max_vel_trans has no
+    counterpart (said so, not "did you mean 'max_vel_theta'")."""
+    ns = {"max_vel_theta": 1.5, "min_vel_theta": 0.4, "max_vel_trans": 0.5, "min_vel_x": 0.0}
+    with caplog.at_level(logging.WARNING):
+        _, planner = local_planner(
+            "dwa_local_planner/DWAPlannerROS", {"DWAPlannerROS": ns}, 20.0, LocalCostmap(), "/mb"
+        )
+    p = planner.params
+    assert (p.max_vel_theta, p.min_vel_theta, p.min_in_place_vel_theta) == (1.5, -1.5, 0.4)
+    assert "'max_vel_trans' has no counterpart" in caplog.text
+    assert "did you mean" not in caplog.text
 
 
 @pytest.mark.parametrize(

@@ -67,6 +67,10 @@ RECOVERY_TYPES = (
 DWA_RENAMES = {
     "max_rot_vel": "max_vel_theta",
     "min_rot_vel": "min_in_place_vel_theta",
+    # melodic/noetic's name for min_rot_vel: the least rotational speed, a magnitude (0.4),
+    # where TrajectoryPlannerROS's min_vel_theta is the signed lower bound (-1.0); read as that,
+    # 0.4 allowed left turns only, and two robots stopped mid-route (a new user's probe)
+    "min_vel_theta": "min_in_place_vel_theta",
     "path_distance_bias": "pdist_scale",
     "goal_distance_bias": "gdist_scale",
     "vth_samples": "vtheta_samples",
@@ -87,7 +91,8 @@ DWA_DROPPED = frozenset(
     {"max_trans_vel", "min_trans_vel", "max_vel_y", "min_vel_y", "vy_samples", "trans_stopped_vel",
      "rot_stopped_vel", "forward_point_distance", "stop_time_buffer", "scaling_speed",
      "max_scaling_factor", "use_dwa", "publish_traj_pc", "publish_cost_grid_pc", "restore_defaults",
-     "twirling_scale", "acc_limit_trans", "theta_stopped_vel"}
+     "twirling_scale", "acc_limit_trans", "theta_stopped_vel", "max_vel_trans", "min_vel_trans",
+     "acc_lim_trans"}
 )  # fmt: skip
 
 
@@ -140,6 +145,11 @@ def dwa_namespace(ns: dict, where: str) -> dict:
             out[DWA_RENAMES.get(key, key)] = value
             if key in origins:
                 out.origins[DWA_RENAMES.get(key, key)] = origins[key]
+    # DWAPlannerROS bounds the rotational speed by its magnitude both ways (a value of the wrong
+    # type is left to the parameter check, which names its file and line)
+    top = out.get("max_vel_theta", 1.0)
+    if isinstance(top, int | float) and not isinstance(top, bool):
+        out["min_vel_theta"] = -abs(float(top))
     return out
 
 

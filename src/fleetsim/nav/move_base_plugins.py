@@ -110,6 +110,7 @@ def global_planner(value: str, ns: dict, costmap_ros: Any, where: str) -> tuple[
     name = _plugin_key("base_global_planner", value, GLOBAL_PLANNERS, where)
     params = load_params(NavfnParams, ns.get(name) or {}, f"{where}/{name}", logger=_log)
     planner = NavFn(costmap_ros.costmap, params, costmap_ros.global_frame)
+    planner.costmap_revision = lambda: costmap_ros.update_count
     cost, radius = circumscribed_cost(costmap_ros.layered)
     if params.circumscribed_clearance and cost == 0:
         _log.warning(

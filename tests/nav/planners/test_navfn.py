@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from fleetsim.nav.costmap import Costmap2D
+from fleetsim.nav.costmap import NO_INFORMATION, Costmap2D
 from fleetsim.nav.errors import GoalOccupied, GoalOutsideMap, NoPathFound, StartOutsideMap
 from fleetsim.nav.planners import NavFn, NavfnParams
 from fleetsim.nav.planners.navfn_kernels import (
@@ -372,3 +372,31 @@ def test_a_descent_caught_on_a_plateaus_edge_still_finds_its_way():
     steps = np.hypot(*np.diff(poses[:, :2], axis=0).T)
     assert steps.max() < 2.5 * float(data["resolution"])  # a connected path
     assert steps.sum() < 1.6 * np.hypot(*(data["goal"][:2] - data["start"][:2]))
+
+
+def test_known_bounds_are_read_once_per_costmap_update_and_stale_ones_change_no_plan(monkeypatch):
+    """With its costmap's update count (`costmap_revision`) NavFn reads the known cells' bounds
+    once per update; bounds left stale by a write between updates (here the whole map made
+    known, free, with the count held) still give the whole map's plans."""
+    import fleetsim.nav.planners.navfn as navfn_module
+
+    rng = np.random.default_rng(3)
+    m = _slam_costmap(rng)
+    reads, revision = [], [0]
+    real = navfn_module.known_bounds
+    monkeypatch.setattr(navfn_module, "known_bounds", lambda c: reads.append(1) or real(c))
+    nf = NavFn(m, NavfnParams())
+    nf.costmap_revision = lambda: revision[0]
+    s, g = (-8.0 + 65 * 0.05, -7.0 + 155 * 0.05, 0.0), (-8.0 + 150 * 0.05, -7.0 + 200 * 0.05, 0)
+    first = nf.create_plan(s, g).poses
+    nf.create_plan(s, g)
+    assert len(reads) == 1
+    revision[0] += 1
+    again = nf.create_plan(s, g).poses
+    assert len(reads) == 2 and np.array_equal(first, again)
+    m.costs[m.costs == NO_INFORMATION] = 0  # known and free now, the count held: stale bounds
+    stale = nf.create_plan(s, g).poses
+    assert len(reads) == 2
+    whole = NavFn(m, NavfnParams())
+    monkeypatch.setattr(NavFn, "_known_part", lambda self, full, s, c: full)
+    np.testing.assert_allclose(stale, whole.create_plan(s, g).poses, rtol=0, atol=1e-9)

@@ -149,3 +149,19 @@ def test_a_moveback_recovery_backs_the_robot_up_then_move_base_goes_on():
     assert 2.4 <= w.bot.pose[0] <= 2.55, w.bot.pose  # 0.5 m straight back, then stopped
     assert abs(w.bot.pose[1] - 1.0) < 1e-6 and w.watch.cmds[-1][1].linear.x == 0.0
     assert w.mb.recoveries[0].moveback.outcome == "moved backwards 0.5 m"
+
+
+def test_a_goal_in_a_wall_of_the_map_is_warned_about_at_the_first_failed_plan(caplog):
+    """navfn says nothing of a goal in a wall until move_base aborts it after its patience and
+    recoveries; fleetsim warns once, at the first plan that fails, as for a goal off the map."""
+    w = nav_world(move_base_params(planner_patience=1.0))
+    with caplog.at_level("WARNING"):
+        h = w.client.send_goal(goal_msg(4.0, 1.0))
+        w.rt.run(duration=0.5)
+        warned = [
+            r.getMessage() for r in caplog.records if "in a wall of the map" in r.getMessage()
+        ]
+        assert len(warned) == 1 and "the goal (4.000, 1.000) is in an obstacle" in warned[0]
+        w.rt.run(duration=60.0, until=lambda: h.done)
+    assert h.status == GoalStatus.ABORTED
+    assert len([r for r in caplog.records if "in a wall of the map" in r.getMessage()]) == 1

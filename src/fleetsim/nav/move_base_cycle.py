@@ -15,7 +15,8 @@ import numpy as np
 
 from fleetsim.errors import FleetsimError, TransformError
 from fleetsim.msgs import geometry_msgs, move_base_msgs
-from fleetsim.nav.errors import ControllerError, GoalOutsideMap, PlannerError
+from fleetsim.nav.costmap import LETHAL_OBSTACLE
+from fleetsim.nav.errors import ControllerError, GoalOccupied, GoalOutsideMap, PlannerError
 from fleetsim.nav.move_base_support import path_msg, pose_stamped, poses_in_frame
 
 PLANNING, CONTROLLING, CLEARING = "PLANNING", "CONTROLLING", "CLEARING"
@@ -29,6 +30,16 @@ ABORT_TEXT = {
 
 class ExecuteCycle:
     """The planning attempt and the control cycle of `MoveBase` (a mixin; see the module)."""
+
+    def _in_a_map_wall(self, goal) -> bool:
+        """Whether ``goal`` (x, y, ...) lies on a lethal cell of a static layer's map (the
+        map itself, not another robot standing there or the inflation round a wall)."""
+        for layer in self.global_costmap._static_layers():
+            grid = layer.map_grid
+            cell = grid.world_to_map(*goal[:2]) if grid is not None else None
+            if cell is not None and grid.costs[cell[1], cell[0]] == LETHAL_OBSTACLE:
+                return True
+        return False
 
     def _plan(self) -> None:
         """One planning attempt (move_base's planThread body)."""
@@ -68,6 +79,19 @@ class ExecuteCycle:
                             f"goal off map {self.goal}",  # once a goal
                             f"{err}: planning will always fail to this goal; move_base aborts "
                             "it after its planner_patience and recovery behaviors",
+                            period=math.inf,
+                        )
+                    elif (
+                        isinstance(e, GoalOccupied)
+                        and not gc.layered.rolling_window
+                        and self._in_a_map_wall(self.goal)
+                    ):
+                        # a fleetsim addition: navfn says nothing until move_base gives up
+                        self._warn(
+                            f"goal in map wall {self.goal}",  # once a goal
+                            f"{err}: the goal is in a wall of the map, so planning fails while "
+                            "the map holds it; move_base aborts it after its planner_patience "
+                            "and recovery behaviors",
                             period=math.inf,
                         )
         if path is not None:

@@ -135,3 +135,17 @@ def test_lesson_parameters_load_without_unknown_warnings(caplog):
 def test_unknown_global_planner_is_an_error():
     with pytest.raises(ParameterError, match=r"'base_global_planner' = 'global_planner/Glob"):
         nav_world(move_base_params(base_global_planner="global_planner/GlobalPlanner"))
+
+
+def test_local_planner_parameters_in_move_base_own_namespace_are_said_to_be_misplaced(caplog):
+    """A base_local_planner_params.yaml without its 'TrajectoryPlannerROS:' line puts
+    max_vel_x and acc_lim_x into move_base's namespace: one warning names them and where they
+    belong, instead of two plain "unknown parameter" lines; move_base's own keys are not in it."""
+    params = move_base_params(max_vel_x=0.3, acc_lim_x=1.0, controller_frequency=10.0)
+    with caplog.at_level("WARNING"):
+        nav_world(params)
+    said = [r.getMessage() for r in caplog.records if "TrajectoryPlannerROS's" in r.getMessage()]
+    assert len(said) == 1, said
+    assert "'acc_lim_x', 'max_vel_x' are TrajectoryPlannerROS's, read only under " in said[0]
+    assert "/lizi1/move_base/TrajectoryPlannerROS/" in said[0]
+    assert not [r for r in caplog.records if "unknown parameter" in r.getMessage()]

@@ -206,6 +206,7 @@ class MoveBase(ExecuteCycle, Node):
             del raw["max_planning_retries"]
         listed = raw.get("recovery_behaviors")
         extra = [str(e.get("name")) for e in listed or [] if isinstance(e, dict)]
+        extra += self._misplaced_planner_params(raw)
         return load_params(
             self.Params,
             raw,
@@ -213,6 +214,32 @@ class MoveBase(ExecuteCycle, Node):
             ignore=frozenset((*self.PARAM_NAMESPACES, *extra)),
             logger=self.get_logger(),
         )
+
+    def _misplaced_planner_params(self, raw: dict) -> list[str]:
+        """TrajectoryPlannerROS's parameters set in move_base's own namespace (a
+        base_local_planner_params.yaml without its ``TrajectoryPlannerROS:`` line): each is
+        said to be read only under the planner's name, which then runs on its defaults (where
+        a plain "unknown parameter" left the why to the user); returns their keys."""
+        from fleetsim.nav.controllers.trajectory_params import TrajectoryPlannerParams
+        from fleetsim.runtime.params import describe_params
+
+        own = {i.name for i in describe_params(self.Params)}
+        planner = {i.name for i in describe_params(TrajectoryPlannerParams)} - own
+        misplaced = sorted(k for k in raw if k in planner)
+        if misplaced:
+            origin = (getattr(raw, "origins", None) or {}).get(misplaced[0])
+            self.get_logger().warning(
+                "%s: %s %s TrajectoryPlannerROS's, read only under %s/TrajectoryPlannerROS/ "
+                "(put 'TrajectoryPlannerROS:' above %s in its YAML%s); the local planner runs "
+                "on its defaults there",
+                self.full_name,
+                ", ".join(f"'{k}'" for k in misplaced),
+                "is" if len(misplaced) == 1 else "are",
+                self.full_name,
+                "it" if len(misplaced) == 1 else "them",
+                f"; '{misplaced[0]}' is set at {origin}" if origin else "",
+            )
+        return misplaced
 
     # -- small helpers -------------------------------------------------------------------------
     def publish_zero_velocity(self) -> None:

@@ -314,3 +314,15 @@ def test_a_sensor_frame_tf_never_has_is_warned_about(caplog):
     rt, bot, node, cm = world("local_costmap", extra=extra)
     rt.run(duration=GRACE + 2.0)
     assert "(sensor_frame) in frame 'lizi1/laser_link'" in caplog.text, caplog.text
+
+
+def test_a_costmap_shut_down_until_a_goal_does_not_call_its_laser_silent(caplog):
+    """shutdown_costmaps: the costmaps stop at start-up and start with the first goal, 15 s
+    later; the laser was heard meanwhile, so the first updates warn of no silent source."""
+    rt, bot, node, cm = world("local_costmap")
+    cm.stop()  # before any reading
+    rt.run(duration=15.0)
+    cm.start()
+    cm.update()  # the first update after the start, before the laser's next reading
+    rt.run(duration=1.0)
+    assert "no reading" not in caplog.text, caplog.text

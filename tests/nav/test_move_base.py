@@ -149,3 +149,9 @@ def test_local_planner_parameters_in_move_base_own_namespace_are_said_to_be_misp
     assert "'acc_lim_x', 'max_vel_x' are TrajectoryPlannerROS's, read only under " in said[0]
     assert "/lizi1/move_base/TrajectoryPlannerROS/" in said[0]
     assert not [r for r in caplog.records if "unknown parameter" in r.getMessage()]
+    caplog.clear()  # another planner's names differ: not guessed, a plain unknown parameter
+    dwa = {**params, "base_local_planner": "dwa_local_planner/DWAPlannerROS"}
+    with caplog.at_level("WARNING"):
+        nav_world(dwa)
+    assert not [r for r in caplog.records if "TrajectoryPlannerROS's" in r.getMessage()]
+    assert any("unknown parameter 'max_vel_x'" in r.getMessage() for r in caplog.records)

@@ -58,3 +58,19 @@ def test_a_moving_link_without_mass_or_inertia_is_warned_about(inertial, words):
         Engine(None).spawn_robot("r", parse_urdf(text), (0, 0, 0.5, 0, 0, 0))
     texts = [str(w.message) for w in said if "link 'arm'" in str(w.message)]
     assert texts == ([] if words is None else [texts[0]]) and (words is None or words in texts[0])
+
+
+def test_a_moving_link_whose_mass_is_on_a_link_fixed_to_it_is_not_warned_about():
+    """Gazebo lumps a fixed child's inertial into its parent (a wheel link with its mass on a
+    fixed hub link is valid there), and fleetsim's welded child keeps its mass."""
+    text = URDF.replace(
+        "</robot>",
+        '<link name="hub"><inertial><mass value="0.5"/><inertia ixx="0.01" iyy="0.01" '
+        'izz="0.01" ixy="0" ixz="0" iyz="0"/></inertial></link>'
+        '<joint name="hub_j" type="fixed"><parent link="arm"/><child link="hub"/></joint>'
+        "</robot>",
+    )
+    with warnings.catch_warnings(record=True) as said:
+        warnings.simplefilter("always")
+        Engine(None).spawn_robot("r", parse_urdf(text), (0, 0, 0.5, 0, 0, 0))
+    assert not [w for w in said if "link 'arm'" in str(w.message)]

@@ -223,6 +223,9 @@ class MoveBase(ExecuteCycle, Node):
         from fleetsim.nav.controllers.trajectory_params import TrajectoryPlannerParams
         from fleetsim.runtime.params import describe_params
 
+        planner_name = str(raw.get("base_local_planner", "base_local_planner/TrajectoryPlannerROS"))
+        if planner_name.rsplit("/", 1)[-1] != "TrajectoryPlannerROS":
+            return []  # other planners' names differ (DWA's, collvoid's, MPPI's): not guessed
         own = {i.name for i in describe_params(self.Params)}
         planner = {i.name for i in describe_params(TrajectoryPlannerParams)} - own
         misplaced = sorted(k for k in raw if k in planner)

@@ -19,6 +19,11 @@ from fleetsim.runtime.graph import Publisher, Service, ServiceClient, Subscripti
 from fleetsim.runtime.params import _set_at, load_params
 from fleetsim.runtime.scheduler import Timer
 
+#: sim seconds a sensor subscription may hear nothing before it is warned about (a costmap's
+#: observation source, amcl's scans), and how often the warning repeats
+SILENT_AFTER = 10.0
+SILENT_REPEAT = 30.0
+
 
 class NodeLogger(logging.LoggerAdapter):
     """Prefixes each record with the sim time and the node's resolved name."""
@@ -170,16 +175,21 @@ class Node:
             self._logger.warning(text)
 
     def unpublished_hint(self, sub: Subscription) -> str:
-        """For a subscription that hears nothing: "" when its topic has a publisher, else
+        """For a subscription that hears nothing: "" when its topic has a publisher here, else
         " (no publisher; LaserScan is published on /a, /b)" naming up to six topics of its
-        type that have one (a laser on ``base_scan`` for a node reading ``scan``)."""
+        type that have one, those in this node's namespace first (a laser on ``base_scan`` for
+        a node reading ``scan``). A publisher in another process is not seen here."""
         topic = sub.topic
         if topic.publishers:
             return ""
+        own = self.namespace.rstrip("/") + "/"
         others = sorted(
-            name
-            for name, t in self.runtime.graph.topics.items()
-            if t.type is topic.type and t.publishers and name != topic.name
+            (
+                name
+                for name, t in self.runtime.graph.topics.items()
+                if t.type is topic.type and t.publishers and name != topic.name
+            ),
+            key=lambda name: (not name.startswith(own), name),
         )
         seen = f"; {topic.type.__name__} is published on {', '.join(others[:6])}"
         return f" (no publisher{seen if others else ''})"

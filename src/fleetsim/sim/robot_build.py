@@ -157,26 +157,37 @@ def add_robot(spec: mujoco.MjSpec, robot: Any, name: str, pose: Pose) -> str:
     return prefix + root
 
 
+def _welded_mass(robot: Any, link: str) -> float:
+    """The mass of ``link`` and of the links fixed to it, down the tree (kg)."""
+    ine = robot.links[link].inertial
+    mass = max(ine.mass, 0.0) if ine is not None else 0.0
+    for j in robot.children(link):
+        if j.type == "fixed":
+            mass += _welded_mass(robot, j.child)
+    return mass
+
+
 def _warn_massless(robot: Any) -> None:
-    """Warn about each link a moving joint carries with no ``<inertial>``, no mass or no
-    inertia: fleetsim gives it `MIN_MASS` and `MIN_INERTIA` and drives on, while Gazebo drops
-    a link without an inertial, with its joint, and ODE refuses a zero mass, so the model would
-    not drive there (a wheel without an inertial is the usual slip)."""
+    """Warn about each link a moving joint carries with no mass (no ``<inertial>`` or mass 0,
+    and no link fixed to it has any: Gazebo lumps a fixed child's inertial into its parent, and
+    fleetsim's welded child keeps its own) or with a mass and no inertia. fleetsim gives it
+    `MIN_MASS` or `MIN_INERTIA` and drives on, while Gazebo drops a link without an inertial,
+    with its joint, and ODE refuses a zero mass or inertia, so the model would not drive there
+    (a wheel without an inertial is the usual slip)."""
     for j in robot.joints.values():
         if j.type == "fixed":
             continue
         ine = robot.links[j.child].inertial
-        if ine is None:
-            what = "has no <inertial>"
-        elif ine.mass <= 0:
-            what = f"has mass {ine.mass:g}"
-        elif ine.ixx <= 0 or ine.iyy <= 0 or ine.izz <= 0:
-            what = f"has inertia ixx {ine.ixx:g} iyy {ine.iyy:g} izz {ine.izz:g}"
+        if _welded_mass(robot, j.child) <= 0:
+            what = "has no <inertial>" if ine is None else f"has mass {ine.mass:g}"
+            what += f", nor has any link fixed to it: simulated with {MIN_MASS * 1000:g} g"
+        elif ine is not None and ine.mass > 0 and min(ine.ixx, ine.iyy, ine.izz) <= 0:
+            what = f"has inertia ixx {ine.ixx:g} iyy {ine.iyy:g} izz {ine.izz:g}: simulated "
+            what += "with a tiny one"
         else:
             continue
         warnings.warn(
-            f"{robot.source}: link '{j.child}' (moved by {j.type} joint '{j.name}') {what}: "
-            f"simulated with {MIN_MASS * 1000:g} g and a tiny inertia; Gazebo would drop it or "
-            "refuse it, give it a positive mass and inertia",
+            f"{robot.source}: link '{j.child}' (moved by {j.type} joint '{j.name}') {what}; "
+            "Gazebo would drop or refuse it: give it a positive mass and inertia",
             stacklevel=3,
         )

@@ -29,6 +29,7 @@ from fleetsim.errors import ExtrapolationError, FleetsimError, TransformError
 from fleetsim.msgs import geometry_msgs, nav_msgs, sensor_msgs, std_msgs, std_srvs
 from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.runtime import Node
+from fleetsim.runtime.node import SILENT_AFTER, SILENT_REPEAT
 from fleetsim.tf import (
     MessageFilter,
     TransformBroadcaster,
@@ -47,7 +48,6 @@ from .scan import beams_from_scan
 
 MAP_RETRY_PERIOD = 1.0  # s of sim time between static_map attempts
 SCAN_QUEUE_SIZE = 100  # scans waiting for their odometry in tf (amcl's laser_scan_filter_)
-SILENT_AFTER = 10.0  # s of sim time without a scan before it is warned about
 
 #: s of sim time before a missing map service is reported (nodes start in any order)
 MAP_GRACE = 1.0
@@ -265,9 +265,9 @@ class Amcl(Node):
             self.set_param(f"~{key}", float(value))
 
     def _warn_if_no_scan(self) -> None:
-        """`SILENT_AFTER` s without a scan: said (every 30 s) until one comes, naming where
-        scans are published (amcl on the wrong topic publishes no map -> odom, and the
-        costmaps then report a missing 'map' frame, which blamed tf, not amcl)."""
+        """`SILENT_AFTER` s without a scan: said (every `SILENT_REPEAT` s) until one comes,
+        naming where scans are published (amcl on the wrong topic publishes no map -> odom,
+        and the costmaps then report a missing 'map' frame, which blamed tf, not amcl)."""
         if self._scans_heard:
             self._silence_timer.cancel()
             return
@@ -276,7 +276,7 @@ class Amcl(Node):
             f"no scan received on {self._scan_sub.topic.name} in {self.now() - self._started:.0f} s"
             f"{self.unpublished_hint(self._scan_sub)}: no pose estimate and no map -> odom "
             "transform until one comes (remap 'scan' to the laser's topic)",
-            30.0,
+            SILENT_REPEAT,
         )
 
     # ----- the scan callback -----

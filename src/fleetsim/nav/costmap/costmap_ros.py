@@ -366,6 +366,7 @@ class Costmap2DROS:
         if self.stopped:
             self.stopped = False
             self.sources.last_reading.clear()
+            self.sources.armed_at = None  # silence counted from the next update with a pose
             for layer in self._static_layers():
                 layer.reset()
                 self._subscribe_map(layer)

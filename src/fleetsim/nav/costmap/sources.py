@@ -21,6 +21,7 @@ from fleetsim.msgs import get_type, sensor_msgs
 from fleetsim.nav.costmap.obstacle_layer import ObstacleLayer
 from fleetsim.nav.costmap.readings import points_from_cloud1, points_from_cloud2, points_from_scan
 from fleetsim.nav.errors import CostmapError
+from fleetsim.runtime.node import SILENT_AFTER, SILENT_REPEAT
 from fleetsim.tf import resolve_frame_once
 from fleetsim.tf.names import normalize_frame
 
@@ -29,9 +30,6 @@ if TYPE_CHECKING:
 
 #: readings kept per source until the next update reads the newest one tf can place
 UNREAD_KEPT = 4
-
-#: sim seconds after subscribing before a source that never got a reading is warned about
-SILENT_AFTER = 10.0
 
 
 def _scan_points(msg: Any, sp: Any, where: str) -> np.ndarray:
@@ -61,6 +59,9 @@ class ObservationSources:
         self.watched = False
         # sources not heard from yet: (layer, source) -> (subscription, sim time subscribed)
         self._silent: dict[tuple[str, str], tuple[Any, float]] = {}
+        # sim time of the first update with a robot pose since the costmap (re)started: the
+        # silence is counted from there (a robot spawned late, costmaps shut down until a goal)
+        self.armed_at: float | None = None
 
     def subscribe(self, layer: ObstacleLayer, source: str) -> Any:
         """Subscribe ``source`` of ``layer`` to its topic; returns the subscription."""
@@ -117,8 +118,8 @@ class ObservationSources:
         if sp.observation_persistence > 0.0:  # every reading in the window counts: read it now
 
             def on_reading(msg: Any) -> None:
+                self._silent.pop(key, None)  # heard, stopped or not
                 if not cm.stopped:
-                    self._silent.pop(key, None)
                     ingest(msg, cm.node.now())
 
         else:  # only the newest reading counts: keep it until the next update reads it
@@ -126,8 +127,8 @@ class ObservationSources:
             self._unread[key] = (unread, ingest)
 
             def on_reading(msg: Any) -> None:
+                self._silent.pop(key, None)  # heard, stopped or not
                 if not cm.stopped:
-                    self._silent.pop(key, None)
                     unread.append((msg, cm.node.now()))
 
         sub = cm.node.create_subscription(msg_type, sp.topic, on_reading, 1)
@@ -135,14 +136,18 @@ class ObservationSources:
         return sub
 
     def warn_silent(self) -> None:
-        """Warn (every 30 s) about each source that has had no reading in the `SILENT_AFTER`
-        s since it subscribed, naming its topic and, when nobody publishes there, the topics of
-        its type that have a publisher (a laser on ``base_scan`` or ``/scan`` for a source
+        """Warn (every `SILENT_REPEAT` s) about each source that has had no reading in the
+        `SILENT_AFTER` s since it subscribed or the costmap's first update with a pose (after
+        a start), whichever came last, naming its topic and, when nobody publishes there, the
+        topics of its type that have a publisher (a laser on ``base_scan`` or ``/scan`` for a source
         reading ``scan``: the costmap would otherwise hold no obstacle of it, silently, as in
         ROS unless ``expected_update_rate`` is set)."""
         cm = self.costmap
         now = cm.node.now()
-        for (layer, source), (sub, since) in self._silent.items():
+        if self.armed_at is None:
+            self.armed_at = now
+        for (layer, source), (sub, subscribed) in self._silent.items():
+            since = max(subscribed, self.armed_at)
             if now - since < SILENT_AFTER:
                 continue
             text = (
@@ -150,7 +155,7 @@ class ObservationSources:
                 f"{cm.node.unpublished_hint(sub)}: the layer marks nothing from it (check the "
                 "source's topic)"
             )
-            cm._warn(f"silent:{layer}/{source}", text, 30.0)
+            cm._warn(f"silent:{layer}/{source}", text, SILENT_REPEAT)
 
     def read_unread(self) -> None:
         """Feed each source's newest reading that tf can place (the ones before it would be

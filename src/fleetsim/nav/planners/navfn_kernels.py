@@ -25,9 +25,10 @@ INV_SQRT2 = np.float32(0.707106781)
 def navfn_costs(costs, allow_unknown):
     """navfn's cost array from a costmap (NavFn::setCostmap with isROS, then its border).
 
-    costs : (ny, nx) uint8 costmap. Free cells become ``COST_NEUTRAL + COST_FACTOR * cost``
-    (at most 253); cells at or above INSCRIBED become COST_OBS, unknown cells COST_OBS - 1
-    when ``allow_unknown`` else COST_OBS; the outermost ring is COST_OBS.
+    costs : (ny, nx) uint8 costmap (uint8 only: each value indexes a 256-entry table). Free
+    cells become ``COST_NEUTRAL + COST_FACTOR * cost`` (at most 253); cells at or above
+    INSCRIBED become COST_OBS, unknown cells COST_OBS - 1 when ``allow_unknown`` else
+    COST_OBS; the outermost ring is COST_OBS.
     Returns (ny * nx,) uint8.
     """
     # one table lookup a cell, the border after: a branch a cell cost 2-4x as much on a

@@ -253,7 +253,9 @@ class DiffDrivePlugin(WheeledDrive):
 
     def bind(self, engine) -> None:
         super().bind(engine)
-        self._check_geometry(engine)
+        if not getattr(self, "_geometry_checked", False):  # once: every spawn rebinds
+            self._geometry_checked = True
+            self._check_geometry(engine)
 
     def _check_geometry(self, engine) -> None:
         """Warn when ``wheelSeparation`` or ``wheelDiameter`` is far (more than

@@ -349,3 +349,11 @@ def test_tf_echo_and_tree(sim, tmp_path):
     assert "use a .pdf, .png, .svg or .gv name" in fails(
         "tf", "tree", "-o", tmp_path / "f.doc", "--duration", 0.3, "-c", ep
     )
+
+
+def test_a_yaw_of_more_than_a_turn_is_noted_as_likely_degrees():
+    from fleetsim.cli.tools import yaw_note
+
+    assert yaw_note(1.57) is None and yaw_note(-6.28) is None
+    note = yaw_note(90.0)
+    assert "yaw 90 rad is more than a full turn" in note and "would be 1.5708" in note

@@ -9,6 +9,7 @@ the simulation never sees it. The lead adds the apps in ``cli/main.py`` and call
 
 from __future__ import annotations
 
+import math
 import time as _wall
 from contextlib import contextmanager
 from typing import Any
@@ -353,6 +354,23 @@ def tf_tree(
 
 
 # -- goal and initialpose -----------------------------------------------------------------------
+def yaw_note(yaw: float) -> str | None:
+    """A note for a yaw of more than a turn, most likely degrees typed for radians (90 for a
+    quarter turn); None otherwise. The pose is sent as given either way, as rostopic would."""
+    if abs(yaw) <= 2 * math.pi:
+        return None
+    return (
+        f"note: yaw {yaw:g} rad is more than a full turn; yaw is in radians "
+        f"({yaw:g} degrees would be {math.radians(yaw):.4f})"
+    )
+
+
+def _say_yaw(yaw: float) -> None:
+    note = yaw_note(yaw)
+    if note:
+        typer.echo(note, err=True)
+
+
 def goal(
     ns: str = typer.Argument(..., metavar="NS", help="Robot namespace, e.g. lizi1."),
     x: float = typer.Argument(..., help="Goal x, m."),
@@ -379,6 +397,7 @@ def goal(
                 f"feedback: x={pos.x:.2f} y={pos.y:.2f} yaw={yaw_of(p.pose.orientation):.2f}"
             )
 
+    _say_yaw(yaw)
     with _client(connect) as c:
         gid = None
         try:
@@ -409,6 +428,7 @@ def initialpose(
     """Set robot NS's pose estimate (PoseWithCovarianceStamped on NS/initialpose, as RViz)."""
     from fleetsim.transport.goal import publish_initial_pose
 
+    _say_yaw(yaw)
     with _client(connect) as c:
         topic = publish_initial_pose(c, ns, x, y, yaw, frame)
     typer.echo(f"published initial pose on {topic}")

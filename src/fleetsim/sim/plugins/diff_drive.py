@@ -249,11 +249,12 @@ class DiffDrivePlugin(WheeledDrive):
         self.accel = p.wheelAcceleration
         self.encoder = p.odometrySource == "encoder"
         self.publish_tf = p.publishOdomTF and p.publishTf
+        self._geometry_checked = False  # once: every spawn rebinds every plugin
         self._setup()
 
     def bind(self, engine) -> None:
         super().bind(engine)
-        if not getattr(self, "_geometry_checked", False):  # once: every spawn rebinds
+        if not self._geometry_checked:
             self._geometry_checked = True
             self._check_geometry(engine)
 

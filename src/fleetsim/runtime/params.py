@@ -183,6 +183,7 @@ def load_params(
     *,
     ignore: tuple[str, ...] | frozenset[str] = (),
     logger: logging.Logger | None = None,
+    also_known: tuple[str, ...] | frozenset[str] = (),
 ) -> Any:
     """Build a ``cls`` instance from ``values``, validating every field.
 
@@ -193,6 +194,8 @@ def load_params(
     where : where the values came from, for messages (``"/lizi1/amcl"`` or ``"amcl.yaml"``).
     ignore : keys that belong to someone else (sub-namespaces read by plugins); not warned about.
     logger : where warnings go (renamed and unknown parameters).
+    also_known : names others read at this level (the pre-Hydro costmap's layer keys), offered
+        as "did you mean" for an unknown key besides ``cls``'s own.
     """
     log = logger or _log
     origins = getattr(values, "origins", None) or {}
@@ -223,7 +226,7 @@ def load_params(
             )
         elif key not in infos:
             if key not in ignore:
-                known = list(infos) + list(alias_of)
+                known = [*infos, *alias_of, *also_known]
                 log.warning(
                     "%sunknown parameter '%s'%s%s",
                     prefix,

@@ -108,6 +108,20 @@ def test_bad_parameter_is_named(caplog):
     assert "did you mean 'rolling_window'" in caplog.text
 
 
+def test_misspelled_pre_hydro_layer_key_is_offered_the_layer_key(caplog):
+    # the lesson's costmap_common_params.yaml form: inflation_radius at the costmap's level,
+    # read by the implicit inflation layer; a typo there had no suggestion
+    with caplog.at_level(logging.WARNING):
+        c = LayeredCostmap.from_params(
+            {"inflation_raduis": 0.7, "observation_sources": ""}, "global_costmap"
+        )
+    warned = [r.getMessage() for r in caplog.records if "inflation_raduis" in r.getMessage()]
+    assert warned == [
+        "global_costmap: unknown parameter 'inflation_raduis' (did you mean 'inflation_radius'?)"
+    ]
+    assert c.layer("inflation_layer").params.inflation_radius != 0.7  # not read, as in ROS
+
+
 def test_static_layer_values_and_map_resize():
     data = np.array([[0, 100, -1], [50, 99, 0]], dtype=np.int8)
     assert costs_from_occupancy(data).tolist() == [[0, 254, 255], [0, 0, 0]]

@@ -94,6 +94,9 @@ _MOVED_VOXEL = (
 )
 _MOVED_OBSTACLE = ("max_obstacle_height", "raytrace_range", "obstacle_range")
 _MOVED_INFLATION = ("cost_scaling_factor", "inflation_radius")
+_PRE_HYDRO_KEYS = (
+    *_MOVED_STATIC, *_MOVED_VOXEL, *_MOVED_OBSTACLE, *_MOVED_INFLATION, "observation_sources"
+)  # fmt: skip
 _SEARCHED = frozenset({"obstacle_range", "raytrace_range"})  # read by sources via searchParam
 
 
@@ -208,7 +211,12 @@ class LayeredCostmap:
         specs, consumed = _layer_specs(ns, first)
         sub_namespaces = {n for n, _ in specs} | plugin_names
         ignore = frozenset(sub_namespaces | consumed | _SEARCHED)
-        params = load_params(CostmapParams, ns, name, ignore=ignore, logger=_log)
+        # the pre-Hydro form's layer keys are read at this level too: a misspelled one
+        # (``inflation_raduis``) is offered its layer's name
+        layer_keys = () if first.plugins is not None else _PRE_HYDRO_KEYS
+        params = load_params(
+            CostmapParams, ns, name, ignore=ignore, logger=_log, also_known=layer_keys
+        )
         parent = {k: v for k, v in ns.items() if not isinstance(v, dict)}
         layers: list[Layer] = []
         for lname, ltype in specs:

@@ -238,6 +238,37 @@ def test_a_shared_frame_that_took_a_tf_prefix_is_named_with_the_fix():
         buf.lookup_transform("lizi1/map", "lizi1/base_link")
 
 
+def test_a_bare_frame_whose_prefixed_twins_exist_names_the_missing_tf_prefix():
+    """Robots in <group ns> without a tf_prefix parameter: the simulator prefixes their
+    frames with the namespace (lizi1/odom) while their nodes ask for the bare 'odom', and a
+    robot_state_publisher's bare links form a tree of their own."""
+    buf = robot_buffer()
+    buf.set_transform(msg("lizi2/odom", "lizi2/base_link", 1.0))
+    buf.set_transform(msg("base_link", "wheel", 1.0))
+    fix = (
+        r"frames named 'odom' under a tf_prefix exist \(lizi1/odom, lizi2/odom\): a node without "
+        r"a tf_prefix uses the bare name, while the simulator prefixes a robot's frames with its "
+        r"namespace; set the tf_prefix parameter in each robot's namespace \(<param "
+        r'name="tf_prefix" value="lizi1"/> in its <group ns>\) so that its nodes use it too; '
+        r"known frames: "
+    )
+    with pytest.raises(
+        FrameNotFound, match=r"target_frame 'odom' does not exist in the tf tree; " + fix
+    ):
+        buf.lookup_transform("odom", "base_link")
+    with pytest.raises(
+        ConnectivityError, match=r"would connect them; frames named 'base_link' under"
+    ):
+        buf.lookup_transform("map", "base_link")
+    # a prefixed name is not hinted at this way, nor a bare one with no twin
+    with pytest.raises(FrameNotFound) as e:
+        buf.lookup_transform("lizi3/odom", "lizi1/base_link")
+    assert "under a tf_prefix" not in str(e.value)
+    with pytest.raises(FrameNotFound) as e:
+        buf.lookup_transform("world", "lizi1/base_link")
+    assert "under a tf_prefix" not in str(e.value)
+
+
 def test_disconnected_trees_name_both_roots():
     buf = robot_buffer()
     buf.set_transform(msg("lizi2/odom", "lizi2/base_link", 1.0))

@@ -382,11 +382,32 @@ class Buffer(TreeIntrospection):
                 up = [frames[n] for n in chain_s[:i]]
                 self._paths[(target_frame, source_frame)] = (self._version, down, up)
                 return down, up
+        twins = self._prefixed_twins(source) or self._prefixed_twins(target)
         raise ConnectivityError(
             f"cannot transform {source!r} into {target!r}: they are in disconnected tf trees "
             f"({target!r} is under root {chain_t[-1]!r}, {source!r} under root {chain_s[-1]!r}); "
             f"a transform linking {chain_t[-1]!r} and {chain_s[-1]!r} (e.g. from a localization "
-            "node or a static_transform_publisher) would connect them"
+            f"node or a static_transform_publisher) would connect them{twins}"
+        )
+
+    def _prefixed_twins(self, name: str) -> str:
+        """A hint when ``name`` is bare and frames of that name under a tf_prefix exist
+        (``lizi1/odom`` for ``odom``): robots in namespaces without a ``tf_prefix`` parameter,
+        whose simulated frames take the namespace while their nodes' frames stay bare."""
+        if "/" in name:
+            return ""
+        twins = sorted(f for f in self._frames if f.rpartition("/")[2] == name and "/" in f)
+        if not twins:
+            return ""
+        listed = ", ".join(twins[:4]) + (
+            f" ... and {len(twins) - 4} more" if len(twins) > 4 else ""
+        )
+        return (
+            f"; frames named {name!r} under a tf_prefix exist ({listed}): a node without a "
+            "tf_prefix uses the bare name, while the simulator prefixes a robot's frames with "
+            "its namespace; set the tf_prefix parameter in each robot's namespace (<param "
+            f'name="tf_prefix" value="{twins[0].rpartition("/")[0]}"/> in its <group ns>) so '
+            "that its nodes use it too"
         )
 
     def _ancestors(self, name: str) -> list[str]:
@@ -402,7 +423,7 @@ class Buffer(TreeIntrospection):
         listed = ", ".join(known[:_MAX_LISTED_FRAMES]) or "none"
         if len(known) > _MAX_LISTED_FRAMES:
             listed += f" ... and {len(known) - _MAX_LISTED_FRAMES} more"
-        hint = did_you_mean(name, known)
+        hint = self._prefixed_twins(name) or did_you_mean(name, known)
         tail = name.rpartition("/")[2]
         if "/" in name and tail in self._frames:
             # a frame parameter written without its leading slash took a tf_prefix (ROS 1's

@@ -240,3 +240,31 @@ def test_footprint_collisions_match_the_outline_or_an_obstacle_inside(seed):
             assert got == k.COLLISION
         elif got == k.COLLISION:
             assert inside  # only an obstacle within the footprint, not under its outline
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_centre_only_batches_score_as_the_general_pose_cost(seed):
+    """CostCritic's and ObstaclesCritic's loops take `centre_cost` when neither the footprint
+    nor an escape applies; every pose, on and off the grid, scores as `pose_cost` says."""
+    rng = np.random.default_rng(seed)
+    m = Costmap2D(40, 40, 0.05, origin_x=-0.3, origin_y=0.2)
+    m.costs[:] = rng.choice(
+        [0, 40, 120, 252, 253, 254, 255], size=(40, 40), p=[0.5, 0.2, 0.1, 0.1, 0.01, 0.01, 0.08]
+    )
+    clear2 = squared_distances_to(m.costs == 254)
+    outline = outline_points(footprint_from_radius(0.2), 0.05)
+    poses = rng.uniform((-0.4, 0.1, -3.0), (1.8, 2.3, 3.0), (64, 12, 3))  # some off the grid
+    headings = np.stack([np.cos(poses[..., 2]), np.sin(poses[..., 2])], axis=-1)
+    grid = (m.costs, clear2, m.origin_x, m.origin_y, 0.05, outline, False, 1.0, 50.0, -1.0)
+    each = np.array([[k.pose_cost(*grid, *poses[b, t, :2], *headings[b, t]) for t in range(12)]
+                     for b in range(64)])  # fmt: skip
+    collides = each == k.COLLISION
+    first_hit = np.where(collides.any(axis=1), collides.argmax(axis=1), 12)
+    assert 0 < collides.any(axis=1).sum() < 64
+    expected = [np.where(each[b, :first_hit[b]] >= 200, 300.0, each[b, :first_hit[b]]).sum() / 12
+                for b in range(64)]  # fmt: skip
+    term, hit = k.cost_terms(poses, headings, *grid, 1, 200.0, 300.0, False)
+    assert np.array_equal(hit, collides.any(axis=1))
+    assert np.allclose(term, expected, rtol=0, atol=1e-12)
+    _, _, obstacle_hit = k.obstacle_terms(poses, headings, *grid, 0.2, 10.0, 0.1, 0.5, False)
+    assert np.array_equal(obstacle_hit, collides.any(axis=1))

@@ -166,7 +166,15 @@ def test_a_burger_from_one_robot_launch_reaches_its_goal_quietly(monkeypatch, tm
     monkeypatch.chdir(tmp_path)  # where MuJoCo would write MUJOCO_LOG.TXT
     plan = load_plan(_user_launch(tmp_path), {"model": "burger"})
     with caplog.at_level(logging.WARNING), LaunchSession(plan, seed=1) as s:
-        s.run(duration=16.0)
+        # its wheels are placed from the drive's joint states (publishWheelJointState), with
+        # no joint_state_publisher to publish them at 0 as well
+        assert "/robot1/joint_state_publisher" not in s.nodes
+        wheel = []
+        for seconds in (6.0, 1.0, 9.0):
+            s.run(duration=seconds)
+            tf = s.runtime.tf_buffer.lookup_transform("robot1/base_link", "robot1/wheel_left_link")
+            wheel.append(tf.transform.rotation)
+        assert abs(wheel[0].x - wheel[1].x) + abs(wheel[0].w - wheel[1].w) > 0.05  # it rolls
         engine = s.nodes["/gazebo"].engine
         assert {i: w.number for i, w in enumerate(engine.data.warning) if w.number} == {}
         (result,) = [r for r in s.monitor.results() if r.namespace.strip("/") == "robot1"]

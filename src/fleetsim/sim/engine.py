@@ -250,7 +250,8 @@ class Engine(StateQueries):
             if cls is not None:
                 where = f"{robot.source}:{spec.source_line or '?'}"
                 ctx = base.PluginContext(entry.name, entry.namespace, entry.tf_prefix, robot, where)
-                out.append(cls(ctx, spec, *sensor))
+                plugin = cls(ctx, spec, *sensor)
+                out.extend([plugin, *plugin.companions()])
 
         for block in robot.gazebo:
             for spec in block.plugins:

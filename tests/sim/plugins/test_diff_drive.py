@@ -2,13 +2,14 @@
 
 import math
 
+import mujoco
 import numpy as np
 import pytest
 
 from fleetsim.description import parse_urdf
 from fleetsim.errors import SimulationError
 from fleetsim.sim import Engine
-from fleetsim.sim.plugins.base import OdometryReading
+from fleetsim.sim.plugins.base import JointStateReading, OdometryReading
 
 from ..conftest import robot_text
 
@@ -192,3 +193,41 @@ def test_a_wheel_geometry_in_the_wrong_unit_is_warned_about(tag, value, words, c
     assert f"<{tag}>{value}<" in bad
     Engine(None).spawn_robot("bad", parse_urdf(bad), (0, 0, 0, 0, 0, 0))
     assert words in caplog.text and "is in metres" in caplog.text, caplog.text
+
+
+@pytest.mark.parametrize("publish", [True, False])
+def test_publish_wheel_joint_state_publishes_the_wheels_on_joint_states(publish):
+    """gazebo_ros_diff_drive's publishWheelJointState: the two wheels' joint states on the
+    robot's joint_states at the drive's updateRate (turtlebot3_gazebo runs no
+    joint_state_publisher and relies on it)."""
+    text = robot_text("diffbot.urdf")
+    text = text.replace(  # only the drive may publish joint states here
+        "<jointName>left_wheel_joint, right_wheel_joint</jointName>",
+        "<jointName>left_wheel_joint</jointName><topicName>other</topicName>",
+    ).replace(
+        '<updateRate>50</updateRate>\n    </plugin>\n    <plugin name="p3d"',
+        f"<updateRate>50</updateRate><publishWheelJointState>{str(publish).lower()}"
+        '</publishWheelJointState>\n    </plugin>\n    <plugin name="p3d"',
+    )
+    assert "publishWheelJointState" in text
+    e = Engine(None)
+    entry = e.spawn_robot("bot", parse_urdf(text))
+    readings = run(e, entry, [(0.3, 0.6, 1.0)])
+    wheels = [r for r in readings if isinstance(r, JointStateReading) and r.topic == "joint_states"]
+    if not publish:
+        assert wheels == []
+        return
+    assert len(wheels) == pytest.approx(50, abs=2)  # 1 s at updateRate 50
+    last_one = wheels[-1]
+    assert last_one.names == ["left_wheel_joint", "right_wheel_joint"]
+    assert last_one.namespace == "/bot"
+    d = e.data
+    jid = [
+        mujoco.mj_name2id(e.model, mujoco.mjtObj.mjOBJ_JOINT, f"bot/{j}") for j in last_one.names
+    ]
+    # the last reading is at most one period (0.02 s) old: the wheels turn ~6-10 rad/s
+    now = d.qpos[e.model.jnt_qposadr[jid]]
+    np.testing.assert_allclose(last_one.position, now, atol=0.25)
+    assert min(now) > 3.0  # 1 s of rolling at ~0.3 m/s on 0.05 m wheels
+    left, right = last_one.velocity
+    assert right > left > 0.0  # turning left while driving forward

@@ -160,6 +160,10 @@ class Plugin:
             ignore=("robotNamespace", "alwaysOn", "always_on"),
         )
 
+    def companions(self) -> list[Plugin]:
+        """Plugins this one brings along (a diff drive's wheel joint states), made with it."""
+        return []
+
     def build(self, spec, engine) -> None:
         """Add what the plugin needs to the MuJoCo spec (actuators, cameras) before compiling."""
 

@@ -13,7 +13,7 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import mujoco
 import numba
@@ -30,6 +30,7 @@ from fleetsim.sim.plugins.base import (
     register,
     require_joint,
 )
+from fleetsim.sim.plugins.joint_state import JointStatePlugin
 
 _log = logging.getLogger("fleetsim.sim.drive")
 SERVO_TIME = 0.05  # s, time constant of the wheel speed servo (a motor controller's lag)
@@ -57,7 +58,9 @@ class DiffDriveParams:
     publishOdomTF: bool = param(True, help="broadcast odom -> base on /tf")
     publishTf: bool = param(True, help="legacy switch for publishOdomTF")
     publishWheelTF: bool = param(False, help="unused")
-    publishWheelJointState: bool = param(False, help="unused: use the joint state publisher")
+    publishWheelJointState: bool = param(
+        False, help="publish the two wheels' joint states on joint_states at updateRate"
+    )
     legacyMode: bool = param(True, help="unused (wheel sign convention)")
     updateRate: float = param(100.0, unit="Hz", range=(0.0, None), help="odometry rate")
     commandTimeout: float = param(
@@ -251,6 +254,22 @@ class DiffDrivePlugin(WheeledDrive):
         self.publish_tf = p.publishOdomTF and p.publishTf
         self._geometry_checked = False  # once: every spawn rebinds every plugin
         self._setup()
+
+    def companions(self) -> list:
+        """With ``publishWheelJointState``, a joint state publisher of the two wheels on
+        ``joint_states`` at ``updateRate``, as gazebo_ros_diff_drive's (which publishes their
+        positions; velocities and efforts come along here), so robot_state_publisher places
+        the wheels without a joint_state_publisher node (turtlebot3_gazebo's launch files)."""
+        p = self.params
+        if not p.publishWheelJointState:
+            return []
+        joints = {"jointName": f"{p.leftJoint}, {p.rightJoint}", "topicName": "joint_states"}
+        spec = replace(
+            self.spec,
+            name=f"{self.spec.name}/wheel_joint_states",
+            params={**joints, "updateRate": str(p.updateRate)},
+        )
+        return [JointStatePlugin(self.ctx, spec)]
 
     def bind(self, engine) -> None:
         super().bind(engine)

@@ -18,6 +18,7 @@ from rich.markup import escape
 from rich.table import Table
 from typer.core import TyperGroup
 
+from fleetsim.cli.launch import table_console
 from fleetsim.errors import BatchError
 
 console = Console(stderr=True)
@@ -141,9 +142,6 @@ def report_cmd(
             *g.key, str(g.rows), str(g.errors), rate, ci, f"{g.median_time:.1f}",
             f"{g.median_path:.2f}", *(f"{g.metrics[m]:.3f}" for m in metric_names),
         )  # fmt: skip
-    out_console = Console()
-    if not out_console.is_terminal:  # piped or captured: no terminal width to wrap to
-        out_console = Console(width=200)
-    out_console.print(t)
+    table_console(Console()).print(t)
     for f in files:
         console.print(f"wrote {f}")

@@ -22,6 +22,14 @@ from fleetsim.errors import LaunchError
 from fleetsim.launch.scenarios import resolve_launch_file, scenarios
 
 console = Console(stderr=True)
+PIPED_WIDTH = 200  # columns of a table written to a pipe or a file
+
+
+def table_console(c: Console) -> Console:
+    """``c``, or when it writes to a pipe or a file (``| tee``, CI logs), a console of
+    `PIPED_WIDTH` columns on the same stream: rich takes 80 there, and a wide results table
+    lost its last columns to wrapping."""
+    return c if c.is_terminal else Console(file=c.file, width=PIPED_WIDTH)
 
 
 def parse_launch_args(items: list[str]) -> dict[str, str]:
@@ -116,8 +124,9 @@ def results_notes(monitor) -> list[str]:
 
 
 def print_results(monitor, to: Console | None = None) -> None:
-    """The results table and its notes (`results_notes`), on ``to`` (default: stderr)."""
-    to = to or console
+    """The results table and its notes (`results_notes`), on ``to`` (default: stderr, wide
+    when piped)."""
+    to = to or table_console(console)
     to.print(results_table(monitor))
     for line in results_notes(monitor):
         to.print(line, markup=False, highlight=False)

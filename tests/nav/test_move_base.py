@@ -10,6 +10,7 @@ from fleetsim.errors import ParameterError
 from fleetsim.msgs import geometry_msgs, nav_msgs
 from fleetsim.msgs.actionlib_msgs import GoalStatus
 from fleetsim.nav.map_server import grid_msg_from_map
+from fleetsim.tf.patience import GRACE
 
 RADIUS = 0.2  # the test robot's footprint radius
 
@@ -94,7 +95,14 @@ def test_goal_before_the_map_waits_then_is_reached(caplog):
     h = w.client.send_goal(goal_msg(2.0, 1.0))
     w.rt.run(duration=2.0)
     assert h.status == GoalStatus.ACTIVE
-    assert "waiting for the costmaps" in caplog.text
+    assert "waiting" not in caplog.text  # a map that comes up late is waited for quietly
+    w.rt.run(duration=GRACE - 1.0)
+    assert h.status == GoalStatus.ACTIVE
+    said = [r.getMessage() for r in caplog.records]
+    assert sum("s for the costmaps (map and tf)" in m for m in said) == 1
+    assert sum("s for the map on /map" in m for m in said) == 1  # the global costmap
+    assert any("waiting 5.0 s for the costmaps" in m or "waiting 5.1 s for the costmaps" in m
+               for m in said)  # fmt: skip
     node = w.client.node
     pub = node.create_publisher(nav_msgs.OccupancyGrid, "/map", 1, latch=True)
     pub.publish(grid_msg_from_map(room_map(), "map"))

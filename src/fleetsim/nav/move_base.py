@@ -59,6 +59,7 @@ from fleetsim.nav.move_base_support import (
 )
 from fleetsim.runtime import Node, load_params, param
 from fleetsim.tf.names import normalize_frame
+from fleetsim.tf.patience import TransformPatience
 
 
 @dataclass(frozen=True)
@@ -131,6 +132,7 @@ class MoveBase(ExecuteCycle, Node):
         ns = self._raw_params()
         self.global_costmap = Costmap2DROS(self, "global_costmap")
         self.local_costmap = Costmap2DROS(self, "local_costmap")
+        self._unready = TransformPatience()  # an active goal waiting for them
         self.global_frame = self.global_costmap.global_frame
         self.planner_name, self.planner = global_planner(
             p.base_global_planner, ns, self.global_costmap, where
@@ -362,13 +364,19 @@ class MoveBase(ExecuteCycle, Node):
         if not self.server.is_active():
             return
         if not self.costmaps_ready():
-            self._warn(
-                "ready",
-                "waiting for the costmaps (map and tf) before acting on the goal; check the map "
-                f"topic(s) {self.global_costmap._map_topics()} and tf to {self.global_frame}",
-            )
+            # a goal sent as the robot comes up waits without a word, as ROS's move_base
+            # waits for its costmaps' transforms; said once it has waited the costmaps' 5 s
+            now = self.now()
+            if self._unready.missing_too_long("costmaps", now + 1e-9):
+                self._warn(
+                    "ready",
+                    f"waiting {self._unready.missing_for('costmaps', now):.1f} s for the "
+                    "costmaps (map and tf) before acting on the goal; check the map topic(s) "
+                    f"{self.global_costmap._map_topics()} and tf to {self.global_frame}",
+                )
             self._reset_clocks()
             return
+        self._unready.found("costmaps")
         if self.goal is None and self.goal_msg is not None:
             self.goal = self.to_global(self.goal_msg)
         if self.run_planner and (

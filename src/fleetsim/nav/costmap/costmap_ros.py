@@ -247,8 +247,14 @@ class Costmap2DROS:
         self.sources.warn_silent()
         self._place_maps()
         missing = [la.name for la in self._static_layers() if la.map_grid is None]
-        if missing:
-            self._warn("map", f"waiting for the map on {', '.join(self._map_topics())}")
+        if not missing:
+            self._patience.found("map")
+        elif self._patience.missing_too_long("map", self.node.now() + 1e-9):
+            # a map server that comes up late is waited for, as tf is (5 s)
+            waited = self._patience.missing_for("map", self.node.now())
+            self._warn(
+                "map", f"waiting {waited:.1f} s for the map on {', '.join(self._map_topics())}"
+            )
         self.layered.update_map(*pose)
         self.last_pose = pose
         self.update_count += 1

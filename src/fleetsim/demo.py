@@ -18,7 +18,7 @@ DEMO_LIMIT = 150.0
 
 def run_demo(out: str | Path = "out", limit: float = DEMO_LIMIT, progress: bool = True) -> bool:
     """Run the demo; returns True when every robot reached its goal without a collision."""
-    from fleetsim.cli.launch import print_results, run_launch
+    from fleetsim.cli.launch import PIPED_WIDTH, print_results, run_launch
     from fleetsim.viz.render import render
 
     console = Console(stderr=True)
@@ -34,7 +34,7 @@ def run_demo(out: str | Path = "out", limit: float = DEMO_LIMIT, progress: bool 
         progress=progress,
     )
     with (out / "results.txt").open("w") as f:
-        print_results(monitor, Console(file=f, width=100))
+        print_results(monitor, Console(file=f, width=PIPED_WIDTH))
     console.print("rendering the run from above ...")
     render(bag, out / "demo.mp4", fps=10, speed=4.0, progress=progress)
     render(bag, out / "demo.png")

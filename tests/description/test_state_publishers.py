@@ -79,6 +79,21 @@ def test_jsp_merges_source_list(rt):
     assert len(out) == pytest.approx(0.2 * 20, abs=1)
 
 
+def test_jsp_with_its_own_topic_as_a_source_reads_only_the_others(rt):
+    """source_list [joint_states] beside a diff drive publishing its wheels there (the
+    hunter): the node's own message, queued after a newer one from the drive, must not put
+    its older value back."""
+    jsp = JointStatePublisher(
+        rt, namespace="/lizi1", params={"source_list": ["joint_states"], "rate": 10}
+    )
+    drive = rt.graph.advertise("/lizi1/joint_states", sensor_msgs.JointState, False, None)
+    rt.run(0.05)
+    drive.publish(sensor_msgs.JointState(name=["arm_joint"], position=np.array([0.7])))
+    jsp.publish()  # its 0.0, sent before it read the drive's 0.7
+    rt.run(0.01)
+    assert jsp.position["arm_joint"] == 0.7
+
+
 def test_robot_description_must_be_urdf_text(rt):
     rt.params.set("/lizi1/robot_description", "/path/to/lizi.urdf")
     with pytest.raises(ParameterError, match=r"/lizi1/robot_description must hold URDF XML text"):

@@ -68,9 +68,24 @@ class JointStatePublisher(Node):
         self.reported: set[str] = set()
         self.pub = self.create_publisher(sensor_msgs.JointState, "joint_states", queue_size=10)
         for topic in p.source_list:
-            self.create_subscription(sensor_msgs.JointState, str(topic), self.on_source)
+            name = self.resolve_name(str(topic))
+            if name == self.pub.topic.name:
+                # its own output as a source (the manual's [/joint_states], beside a drive
+                # that publishes its wheels there): its own messages are not read back, or a
+                # stale value of its own could overwrite a newer one from the simulator
+                sub = self.runtime.graph.subscribe(
+                    name, sensor_msgs.JointState, self._on_shared_topic, 10, self, True
+                )
+                self._subscriptions.append(sub)
+            else:
+                self.create_subscription(sensor_msgs.JointState, name, self.on_source)
         if p.rate > 0:
             self.create_timer(1.0 / p.rate, self.publish)
+
+    def _on_shared_topic(self, item) -> None:
+        msg, publisher = item  # a with_publisher subscription's (msg, publisher)
+        if publisher is not self.pub:
+            self.on_source(msg)
 
     def on_source(self, msg) -> None:
         for k, name in enumerate(msg.name):

@@ -337,6 +337,7 @@ class MoveBase(ExecuteCycle, Node):
             self.local_costmap.start()
         self.goal_msg = goal.target_pose
         self.goal = self.to_global(self.goal_msg)
+        self._unready.found("costmaps")  # a new goal's wait starts now, not at an older one's
         self.recovery_index = 0
         self.recovery_trigger = PLANNING_R
         self._reset_rotations()
@@ -367,7 +368,7 @@ class MoveBase(ExecuteCycle, Node):
             # a goal sent as the robot comes up waits without a word, as ROS's move_base
             # waits for its costmaps' transforms; said once it has waited the costmaps' 5 s
             now = self.now()
-            if self._unready.missing_too_long("costmaps", now + 1e-9):
+            if self._unready.missing_too_long("costmaps", now):
                 self._warn(
                     "ready",
                     f"waiting {self._unready.missing_for('costmaps', now):.1f} s for the "

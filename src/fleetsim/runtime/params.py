@@ -226,7 +226,7 @@ def load_params(
             )
         elif key not in infos:
             if key not in ignore:
-                known = [*infos, *alias_of, *also_known]
+                known = [k for k in (*infos, *alias_of, *also_known) if k != key]
                 log.warning(
                     "%sunknown parameter '%s'%s%s",
                     prefix,

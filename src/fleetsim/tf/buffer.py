@@ -369,9 +369,12 @@ class Buffer(TreeIntrospection):
         target = normalize_frame(target_frame)
         source = normalize_frame(source_frame)
         frames = self._frames
-        for name, role in ((target, "target_frame"), (source, "source_frame")):
+        for name, role, other in (
+            (target, "target_frame", source),
+            (source, "source_frame", target),
+        ):
             if name not in frames:
-                raise self._not_found(name, role)
+                raise self._not_found(name, role, other)
         chain_t = self._ancestors(target)
         chain_s = self._ancestors(source)
         index_s = {name: i for i, name in enumerate(chain_s)}
@@ -382,19 +385,21 @@ class Buffer(TreeIntrospection):
                 up = [frames[n] for n in chain_s[:i]]
                 self._paths[(target_frame, source_frame)] = (self._version, down, up)
                 return down, up
-        twins = self._prefixed_twins(source) or self._prefixed_twins(target)
         raise ConnectivityError(
             f"cannot transform {source!r} into {target!r}: they are in disconnected tf trees "
             f"({target!r} is under root {chain_t[-1]!r}, {source!r} under root {chain_s[-1]!r}); "
             f"a transform linking {chain_t[-1]!r} and {chain_s[-1]!r} (e.g. from a localization "
-            f"node or a static_transform_publisher) would connect them{twins}"
+            "node or a static_transform_publisher) would connect them"
         )
 
-    def _prefixed_twins(self, name: str) -> str:
-        """A hint when ``name`` is bare and frames of that name under a tf_prefix exist
-        (``lizi1/odom`` for ``odom``): robots in namespaces without a ``tf_prefix`` parameter,
-        whose simulated frames take the namespace while their nodes' frames stay bare."""
-        if "/" in name:
+    def _prefixed_twins(self, name: str, other: str) -> str:
+        """A hint when ``name`` is missing, it and ``other`` (the lookup's other frame) are
+        bare, as a node without a tf_prefix asks for, and frames of that name under a tf_prefix
+        exist (``lizi1/odom`` for ``odom``): robots in namespaces without a ``tf_prefix``
+        parameter, whose simulated frames take the namespace while their nodes' stay bare. A
+        lookup from a prefixed frame (``map`` -> ``hunter1/base_link`` while each hunter's
+        gmapping publishes ``hunterN/map``) is another matter and gets no such hint."""
+        if "/" in name or "/" in other:
             return ""
         twins = sorted(f for f in self._frames if f.rpartition("/")[2] == name and "/" in f)
         if not twins:
@@ -418,12 +423,12 @@ class Buffer(TreeIntrospection):
             f = self._frames[f.parent]
         return chain
 
-    def _not_found(self, name: str, role: str) -> FrameNotFound:
+    def _not_found(self, name: str, role: str, other: str = "/") -> FrameNotFound:
         known = sorted(self._frames)
         listed = ", ".join(known[:_MAX_LISTED_FRAMES]) or "none"
         if len(known) > _MAX_LISTED_FRAMES:
             listed += f" ... and {len(known) - _MAX_LISTED_FRAMES} more"
-        hint = self._prefixed_twins(name) or did_you_mean(name, known)
+        hint = self._prefixed_twins(name, other) or did_you_mean(name, known)
         tail = name.rpartition("/")[2]
         if "/" in name and tail in self._frames:
             # a frame parameter written without its leading slash took a tf_prefix (ROS 1's

@@ -120,6 +120,13 @@ def test_misspelled_pre_hydro_layer_key_is_offered_the_layer_key(caplog):
         "global_costmap: unknown parameter 'inflation_raduis' (did you mean 'inflation_radius'?)"
     ]
     assert c.layer("inflation_layer").params.inflation_radius != 0.7  # not read, as in ROS
+    # a key the chosen stack does not read (z_voxels without map_type voxel) is not offered
+    # itself (found in review)
+    caplog.clear()
+    with caplog.at_level(logging.WARNING):
+        LayeredCostmap.from_params({"z_voxels": 10, "observation_sources": ""}, "local_costmap")
+    assert "unknown parameter 'z_voxels'" in caplog.text
+    assert "did you mean 'z_voxels'" not in caplog.text
 
 
 def test_static_layer_values_and_map_resize():

@@ -259,12 +259,28 @@ def test_centre_only_batches_score_as_the_general_pose_cost(seed):
     each = np.array([[k.pose_cost(*grid, *poses[b, t, :2], *headings[b, t]) for t in range(12)]
                      for b in range(64)])  # fmt: skip
     collides = each == k.COLLISION
-    first_hit = np.where(collides.any(axis=1), collides.argmax(axis=1), 12)
     assert 0 < collides.any(axis=1).sum() < 64
-    expected = [np.where(each[b, :first_hit[b]] >= 200, 300.0, each[b, :first_hit[b]]).sum() / 12
-                for b in range(64)]  # fmt: skip
+    # the kernels' sums, pose by pose in their order, in Python's floats (the same IEEE
+    # doubles: the results must be equal bit for bit, not merely close)
+    terms, critical, repulsive = [], [], []
+    for b in range(64):
+        acc = crit = rep = 0.0
+        for c in each[b]:
+            if c == k.COLLISION:
+                break
+            acc += 300.0 if c >= 200.0 else c
+            if c > 0.0:
+                dist = (10.0 * 0.2 - math.log(min(c, 253.0)) + math.log(253.0)) / 10.0
+                if dist < 0.1:
+                    crit += 0.1 - dist
+                else:
+                    rep += max(0.5 - dist, 0.0)
+        terms.append(acc / 12)
+        critical.append(crit)
+        repulsive.append(rep / 12)
     term, hit = k.cost_terms(poses, headings, *grid, 1, 200.0, 300.0, False)
     assert np.array_equal(hit, collides.any(axis=1))
-    assert np.allclose(term, expected, rtol=0, atol=1e-12)
-    _, _, obstacle_hit = k.obstacle_terms(poses, headings, *grid, 0.2, 10.0, 0.1, 0.5, False)
-    assert np.array_equal(obstacle_hit, collides.any(axis=1))
+    assert np.array_equal(term, terms)
+    got = k.obstacle_terms(poses, headings, *grid, 0.2, 10.0, 0.1, 0.5, False)
+    assert np.array_equal(got[2], collides.any(axis=1))
+    assert np.array_equal(got[0], critical) and np.array_equal(got[1], repulsive)

@@ -249,7 +249,7 @@ class Costmap2DROS:
         missing = [la.name for la in self._static_layers() if la.map_grid is None]
         if not missing:
             self._patience.found("map")
-        elif self._patience.missing_too_long("map", self.node.now() + 1e-9):
+        elif self._patience.missing_too_long("map", self.node.now()):
             # a map server that comes up late is waited for, as tf is (5 s)
             waited = self._patience.missing_for("map", self.node.now())
             self._warn(

@@ -116,8 +116,7 @@ def _layer_specs(ns: dict[str, Any], p: CostmapParams) -> tuple[list[tuple[str, 
         # a common file loaded into both costmaps (the manual's nav_stack.launch) leaves the
         # pre-Hydro form's keys beside a plugins list; ROS's layers read their own namespaces
         # and leave those unread without a word: said once, not warned about as unknown
-        old = {"map_type", "observation_sources", *_MOVED_STATIC, *_MOVED_VOXEL}
-        old |= {*_MOVED_OBSTACLE, *_MOVED_INFLATION}
+        old = {"map_type", *_PRE_HYDRO_KEYS}
         old |= set(str(ns.get("observation_sources", "")).split())
         unread = sorted(k for k in old if k in ns and k not in _SEARCHED)
         if unread:
@@ -212,7 +211,7 @@ class LayeredCostmap:
         sub_namespaces = {n for n, _ in specs} | plugin_names
         ignore = frozenset(sub_namespaces | consumed | _SEARCHED)
         # the pre-Hydro form's layer keys are read at this level too: a misspelled one
-        # (``inflation_raduis``) is offered its layer's name
+        # (``inflation_raduis``) is offered the key its layer reads
         layer_keys = () if first.plugins is not None else _PRE_HYDRO_KEYS
         params = load_params(
             CostmapParams, ns, name, ignore=ignore, logger=_log, also_known=layer_keys

@@ -26,6 +26,7 @@ from fleetsim.sim.drives import rotor_armature
 from fleetsim.sim.plugins.base import (
     DrivePlugin,
     OdometryReading,
+    Plugin,
     joint_addresses,
     register,
     require_joint,
@@ -255,7 +256,7 @@ class DiffDrivePlugin(WheeledDrive):
         self._geometry_checked = False  # once: every spawn rebinds every plugin
         self._setup()
 
-    def companions(self) -> list:
+    def companions(self) -> list[Plugin]:
         """With ``publishWheelJointState``, a joint state publisher of the two wheels on
         ``joint_states`` at ``updateRate``, as gazebo_ros_diff_drive's (which publishes their
         positions; velocities and efforts come along here), so robot_state_publisher places

@@ -53,7 +53,7 @@ def centre_cost(costs, ox, oy, res, x, y):
     The critics' loops take it for those poses: through `pose_cost` (as a call) each pose
     cost ~60 ns, here ~8 (2000 samples x 28 poses of a lizi's CostCritic, 3.5 ms -> 0.4 ms a
     cycle). `pose_cost` and `strict_pose_cost` are inlined into the loops too (the footprint
-    case 10.4 -> 7.8 ms a cycle in `benchmarks/mppi_cycle.py`)."""
+    case 10.4 -> 7.7 ms a cycle in `benchmarks/mppi_cycle.py`)."""
     h, w = costs.shape
     fx = (x - ox) / res
     fy = (y - oy) / res

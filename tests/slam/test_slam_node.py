@@ -261,3 +261,20 @@ def test_a_waiting_scan_is_retried_on_its_own_robots_odometry_only():
     send_odom(1.0)
     rt.run(duration=0.05)
     assert slam.tries == 2 and slam.filter is not None and slam.filter.updates == 1
+
+
+def test_no_scan_for_10_s_is_said_naming_where_scans_are(caplog):
+    """gmapping reading 'scan' while the laser publishes on 'base_scan' (the lizi): said after
+    10 s, with the topic that has scans, instead of no map and no word."""
+    rt = Runtime(seed=0)
+    laser = Node(rt, "laser", "/lizi1").create_publisher(sensor_msgs.LaserScan, "base_scan", 1)
+    assert laser.topic.name == "/lizi1/base_scan"
+    SlamGmapping(rt, "slam_gmapping", "/lizi1")
+    with caplog.at_level(logging.WARNING):
+        rt.run(duration=9.5)
+        assert "no scan" not in caplog.text
+        rt.run(duration=1.0)
+    assert (
+        "no scan received on /lizi1/scan in 10 s (no publisher; LaserScan is published on "
+        "/lizi1/base_scan): no map until one comes (remap 'scan' to the laser's topic)"
+    ) in caplog.text

@@ -39,3 +39,24 @@ def test_bad_values_name_the_parameter():
         gmapping_params({"xmin": 5.0, "xmax": 1.0})
     with pytest.raises(ParameterError, match="parameter 'climb_skip' = -1 is out of range"):
         gmapping_params({"climb_skip": -1})
+
+
+def test_a_value_from_a_yaml_file_is_named_with_its_file_and_line(tmp_path, caplog):
+    """A user's gmapping.yaml loaded by <rosparam>: the error and the warning say where the
+    value was set, as amcl's and explore's do (the origins were dropped by a plain dict)."""
+    from fleetsim.runtime import ParamTree
+
+    yaml_file = tmp_path / "gmapping.yaml"
+    yaml_file.write_text("particles: 30\ndelta: -0.05\n")
+    tree = ParamTree()
+    tree.load_file(yaml_file, "/slam_gmapping")
+    with pytest.raises(ParameterError, match=rf"set at {yaml_file}:2"):
+        gmapping_params(tree.get("/slam_gmapping"), "/slam_gmapping")
+    yaml_file.write_text("particles: 30\nparticels: 40\n")
+    tree = ParamTree()
+    tree.load_file(yaml_file, "/slam_gmapping")
+    with caplog.at_level(logging.WARNING):
+        gmapping_params(tree.get("/slam_gmapping"), "/slam_gmapping")
+    assert f"unknown parameter 'particels' (did you mean 'particles'?) (set at {yaml_file}:2)" in (
+        caplog.text
+    )

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from fleetsim.errors import ParameterError
-from fleetsim.runtime.params import load_params, param
+from fleetsim.runtime.params import ParamDict, load_params, param
 
 #: accepted, but gmapping never uses them on the path slam_gmapping runs
 NO_EFFECT = ("llsamplerange", "llsamplestep", "lasamplerange", "lasamplestep")
@@ -171,7 +171,7 @@ def gmapping_params(
 ) -> GmappingParams:
     """Validated `GmappingParams` from a ROS mapping; -1 means unset where ROS says so."""
     log = logger or logging.getLogger("fleetsim.slam")
-    values = dict(mapping or {})
+    values = ParamDict.copy_of(mapping)  # keeps where each value was set, for messages
     for key in UNSET_WHEN_NEGATIVE:
         v = values.get(key)
         if isinstance(v, int | float) and not isinstance(v, bool) and v < 0:

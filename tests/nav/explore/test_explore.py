@@ -55,7 +55,35 @@ def test_without_move_base_it_waits_and_a_closed_map_stops_it(caplog):
     # everything known: no frontier left, exploration stops
     ex.grid.data = np.zeros(600, dtype=np.int8)
     rt.run(duration=1.0)
-    assert ex.finished
+    assert ex.finished and ex.succeeded
+
+
+def test_a_costmap_without_unknown_space_is_said_and_not_explored(caplog):
+    """A costmap not tracking unknown space (track_unknown_space false) has no frontier: it
+    is named and exploration fails, rather than stopping at once as if all were explored."""
+    rt = Runtime(seed=0)
+    FakeWorld(rt, np.zeros((20, 30), dtype=np.int8))
+    ex = Explore(rt)
+    with caplog.at_level(logging.WARNING):
+        rt.run(duration=2.5)
+    assert ex.finished and not ex.succeeded and ex.goals_sent == 0
+    assert "the costmap on /costmap has no unknown cell" in caplog.text
+    assert "track_unknown_space: true" in caplog.text
+
+
+def test_a_costmap_topic_nobody_publishes_is_named(caplog):
+    rt = Runtime(seed=0)
+    rt.params.set("/explore/costmap_topic", "costmap_typo")
+    FakeWorld(rt, np.full((20, 30), -1, dtype=np.int8))
+    Explore(rt)
+    with caplog.at_level(logging.WARNING):
+        rt.run(duration=9.0)
+        assert "no costmap" not in caplog.text
+        rt.run(duration=2.0)
+    assert "no costmap on /costmap_typo in 10 s (no publisher; OccupancyGrid is published on " in (
+        caplog.text
+    )
+    assert "/costmap" in caplog.text
 
 
 @pytest.mark.scenario

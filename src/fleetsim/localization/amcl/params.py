@@ -20,7 +20,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from fleetsim.errors import ParameterError, did_you_mean
-from fleetsim.runtime.params import load_params, param
+from fleetsim.runtime.params import ParamDict, load_params, param
 
 ODOM_MODEL_TYPES = ("diff", "omni", "diff-corrected", "omni-corrected")
 LASER_MODEL_TYPES = ("likelihood_field", "beam", "likelihood_field_prob")
@@ -223,7 +223,7 @@ def params_from_mapping(
     `fleetsim.runtime.load_params` (unknown keys warned about with a suggestion, old names
     accepted, ``source`` named in every error).
     """
-    values = dict(mapping or {})
+    values = ParamDict.copy_of(mapping)  # keeps where each value was set, for messages
     for key in UNSET_WHEN_NEGATIVE:
         v = values.get(key)
         if isinstance(v, int | float) and not isinstance(v, bool) and v < 0:

@@ -59,6 +59,7 @@ from fleetsim.errors import FleetsimError
 from fleetsim.msgs import move_base_msgs, nav_msgs, std_msgs, visualization_msgs
 from fleetsim.nav.move_base_support import pose_stamped
 from fleetsim.runtime import Node
+from fleetsim.runtime.node import SILENT_AFTER, SILENT_REPEAT
 from fleetsim.tf.names import resolve_frame_once
 
 from .frontier_search import Frontier, frontiers_from_grid, known_window
@@ -114,7 +115,11 @@ class Explore(Node):
         self.frontiers: list[Frontier] = []
         self.link = PeerLink(self, p)  # what it tells its peers, and what they tell it
         _ = self.tf_buffer  # subscribe the runtime's buffer to /tf now
-        self.create_subscription(nav_msgs.OccupancyGrid, p.costmap_topic, self.on_costmap, 1)
+        self._costmap_sub = self.create_subscription(
+            nav_msgs.OccupancyGrid, p.costmap_topic, self.on_costmap, 1
+        )
+        self._started = self.now()
+        self._seen_unknown = False  # a costmap it read had unknown space (see make_plan)
         self.move_base = self.create_action_client(move_base_msgs.MoveBase, "move_base")
         self.marker_pub = (
             self.create_publisher(visualization_msgs.MarkerArray, "~frontiers", 1)
@@ -193,7 +198,21 @@ class Explore(Node):
 
     def make_plan(self) -> None:
         """explore_lite's makePlan: pick the best frontier, watch progress, send the goal."""
-        if self.finished or self.grid is None:
+        if self.finished:
+            return
+        if self.grid is None:
+            waited = self.now() - self._started
+            if waited >= SILENT_AFTER:
+                # explore_lite says "Waiting for costmap to become available"; a costmap_topic
+                # nobody publishes (the default 'costmap' beside move_base's) had waited unsaid
+                sub = self._costmap_sub
+                self._warn(
+                    "no costmap",
+                    f"no costmap on {sub.topic.name} in {waited:.0f} s"
+                    f"{self.unpublished_hint(sub)}: not exploring until one comes (set "
+                    "costmap_topic, e.g. move_base/global_costmap/costmap)",
+                    SILENT_REPEAT,
+                )
             return
         grid = self.grid
         frame = grid.header.frame_id
@@ -203,6 +222,18 @@ class Explore(Node):
         info = grid.info
         data = np.asarray(grid.data, dtype=np.int8).reshape(info.height, info.width)
         p = self.params
+        self._seen_unknown = self._seen_unknown or bool((data == -1).any())
+        if not self._seen_unknown:
+            # a costmap without unknown space has no frontier from the start: explore_lite
+            # would stop at once as if the world were explored, and the run had looked done
+            self._warn_once(
+                "no unknown",
+                f"the costmap on {self._costmap_sub.topic.name} has no unknown cell: there is no "
+                "frontier to explore; the costmap must keep unknown space (track_unknown_space: "
+                "true, as explore_lite requires)",
+            )
+            self.stop("stopping: nothing unknown to explore", failed=True)
+            return
         positions = self._peer_positions(frame)
         # the grid's known part, not gmapping's whole xmin..ymax (known_window says why)
         data, origin = known_window(
@@ -392,13 +423,14 @@ class Explore(Node):
         self.link.announce(None)
         self.runtime.call_later(0.0, self.make_plan)  # explore_lite replans on reaching a goal
 
-    def stop(self, why: str, observed: int = 0) -> None:
+    def stop(self, why: str, observed: int = 0, failed: bool = False) -> None:
         """Stop exploring; ``observed`` of the frontiers left were observed as far as they can
-        be (view_points), the rest are blacklisted: given up."""
+        be (view_points), the rest are blacklisted: given up (``failed``: given up whatever
+        is left, e.g. a costmap with nothing unknown)."""
         self.finished = True
         self.observed = observed
         given_up = len(self.frontiers) - observed
-        self.gave_up = given_up > 0
+        self.gave_up = given_up > 0 or failed
         if observed:
             why += f" ({observed} frontiers left observed as far as they can be)"
         if self.gave_up:

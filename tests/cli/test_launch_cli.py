@@ -37,7 +37,24 @@ def test_until_goals_exits_nonzero_when_a_goal_fails(tmp_path: Path, capsys):
     )
     code = main(["launch", str(top), "--until-goals", "--duration", "90", "--no-bridge"])
     assert code == 1
-    assert "is in an obstacle" in capsys.readouterr().err.replace("\n", " ")
+    err = capsys.readouterr().err
+    assert "is in an obstacle" in err.replace("\n", " ")
+    # the exit status comes with its reasons
+    assert "--until-goals: exit status 1:\n  /pioneer1: 0/1 goals reached; 1 failed\n" in err
+
+
+def test_until_goals_with_no_goal_at_all_says_so(tmp_path: Path, capsys):
+    quiet = tmp_path / "no_goals.launch"
+    quiet.write_text(
+        "<launch>\n"
+        '  <node pkg="map_server" type="map_server" name="map_server"\n'
+        '        args="$(find fleetsim_maps)/office.yaml"/>\n'
+        "</launch>\n"
+    )
+    code = main(["launch", str(quiet), "--until-goals", "--duration", "1", "--no-bridge"])
+    assert code == 1
+    err = capsys.readouterr().err
+    assert "--until-goals: exit status 1:\n  no goal was sent (no move_base goal, no goal " in err
 
 
 @pytest.mark.parametrize(

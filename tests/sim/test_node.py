@@ -63,6 +63,29 @@ def test_two_namespaces_do_not_share_commands(sim):
     assert clock and clock[-1].clock.to_sec() == pytest.approx(rt.now(), abs=0.011)
 
 
+def test_a_robot_spawned_where_another_is_is_warned_about(sim, caplog):
+    """Two robots in one namespace (both spawned in '/'), or two namespaces with one
+    tf_prefix: Gazebo spawns them, and their topics or frames are shared without a word."""
+    import logging
+
+    rt, s, probe = sim
+    rt.params.set("/b/tf_prefix", "a")
+    with caplog.at_level(logging.WARNING):
+        assert spawn(probe, "a", (22.0, 15.0), ns="/a").success
+        assert spawn(probe, "b", (24.0, 15.0), ns="/b").success
+        assert spawn(probe, "c", (22.0, 17.0), ns="/c").success
+        assert spawn(probe, "d", (24.0, 17.0), ns="/c").success
+    said = [r.getMessage() for r in caplog.records if r.levelno >= logging.WARNING]
+    assert said == [
+        "[0.000] [/gazebo] 'b' is spawned with tf_prefix 'a', as 'a' is: the two publish the same "
+        "tf frames; give each robot its own <group ns> and tf_prefix (spawn_model inside the "
+        "group)",
+        "[0.000] [/gazebo] 'd' is spawned in namespace /c, as 'c' is: the two share their topics "
+        "(cmd_vel, odom, the sensors'), each hearing the other's; give each robot its own "
+        "<group ns> and tf_prefix (spawn_model inside the group)",
+    ]
+
+
 def test_odometry_tf_arrives_before_the_scan_of_the_same_time(sim):
     from fleetsim.msgs import sensor_msgs, tf2_msgs
 

@@ -261,4 +261,8 @@ def register(app: typer.Typer) -> None:
             connect=connect,
         )
         if until_goals and not monitor.success():
+            # the exit status alone had not said which goal, sender or robot failed
+            console.print("--until-goals: exit status 1:", markup=False, highlight=False)
+            for line in monitor.failures() or ["the run did not succeed"]:
+                console.print(f"  {line}", markup=False, highlight=False)
             raise typer.Exit(1)

@@ -353,9 +353,44 @@ class RunMonitor:
             r.localization_error = self._localization_error(ns, truth)
         return [self.robots[k] for k in sorted(self.robots)]
 
+    def failures(self) -> list[str]:
+        """Why `success` is False, one line per reason (empty when it is True)."""
+        results = self.results()
+        rs = [r for r in results if r.goals_sent > 0]
+        out = []
+        if not rs and not self.senders:
+            out.append("no goal was sent (no move_base goal, no goal sender in the run)")
+        handled = self._handled_goals()
+        for r in rs:
+            if r.ok_but_for(handled):
+                continue
+            why = []
+            failed = [i for i in r.failed_ids if i not in handled]
+            if failed:
+                why.append(f"{len(failed)} failed")
+            if r.goals_unconfirmed:
+                why.append(f"{r.goals_unconfirmed} reported reached but not confirmed")
+            if not r.all_done:
+                finished = r.goals_reached + r.goals_failed + r.goals_unconfirmed
+                why.append(f"{r.goals_sent - finished} not finished when the run ended")
+            if why:
+                out.append(
+                    f"{r.namespace}: {r.goals_reached}/{r.goals_sent} goals reached; "
+                    + ", ".join(why)
+                )
+        for name in self.senders_failed():
+            sender = next(s for s in self.senders if _sender_name(s) == name)
+            state = "gave up" if sender.done else "had not finished when the run ended"
+            out.append(f"goal sender {name} {state}")
+        for r in results:
+            if r.collisions:
+                out.append(f"{r.namespace}: {r.collisions} collision(s)")
+        return out
+
     def success(self) -> bool:
         """Every goal reached (confirmed by ground truth), every goal sender done and
-        succeeded, no collision; a run with neither goals nor senders did not succeed."""
+        succeeded, no collision; a run with neither goals nor senders did not succeed
+        (`failures` says which failed)."""
         rs = [r for r in self.results() if r.goals_sent > 0]
         handled = self._handled_goals()
         return (

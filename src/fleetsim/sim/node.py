@@ -112,10 +112,33 @@ class Simulator(Node):
     ) -> ModelEntry:
         """Spawn a robot and wire its drive commands (see ``Engine.spawn_robot``)."""
         ns = rnames.validate_namespace(namespace if namespace else f"/{name}")
-        entry = self.engine.spawn_robot(name, robot, pose, ns, self.tf_prefix_for(ns))
+        prefix = self.tf_prefix_for(ns)
+        self._warn_shared(name, ns, prefix)
+        entry = self.engine.spawn_robot(name, robot, pose, ns, prefix)
         self._wire(entry)
         self.get_logger().info("spawned '%s' in namespace %s", name, ns)
         return entry
+
+    def _warn_shared(self, name: str, ns: str, prefix: str) -> None:
+        """Warn when a robot is spawned in the namespace, or with the tf_prefix, of one already
+        here: Gazebo spawns it, and the two then share topics (cmd_vel, odom, the laser's) or
+        frames, one robot's messages overwriting the other's without a word."""
+        for other in self.engine.models.values():
+            if other.kind != "robot":
+                continue
+            if other.namespace == ns:
+                shared = f"in namespace {ns}, as '{other.name}' is: the two share their topics "
+                shared += "(cmd_vel, odom, the sensors'), each hearing the other's"
+            elif other.tf_prefix == prefix:
+                shared = f"with tf_prefix '{prefix}', as '{other.name}' is: the two publish the "
+                shared += "same tf frames"
+            else:
+                continue
+            self.get_logger().warning(
+                f"'{name}' is spawned {shared}; give each robot its own <group ns> and "
+                "tf_prefix (spawn_model inside the group)"
+            )
+            return
 
     def _wire(self, entry: ModelEntry) -> None:
         subs = []

@@ -87,8 +87,13 @@ class RecordingError(FleetsimError):
 
 
 def did_you_mean(word: str, choices: Iterable[str]) -> str:
-    """Return ``" (did you mean 'x'?)"`` for the closest choice, or ``""`` when none is close."""
-    close = difflib.get_close_matches(word, list(choices), n=1, cutoff=0.6)
+    """Return ``" (did you mean 'x'?)"`` for the closest choice, or ``""`` when none is close.
+
+    A choice differing only in case comes first (``maxURange`` is gmapping's ``maxUrange``,
+    which difflib ranks below ``maxRange``)."""
+    choices = list(choices)
+    same = [c for c in choices if c.lower() == word.lower() and c != word]
+    close = same or difflib.get_close_matches(word, choices, n=1, cutoff=0.6)
     return f" (did you mean '{close[0]}'?)" if close else ""
 
 

@@ -159,6 +159,15 @@ def test_map_saver_argument_errors(tokens, match):
         saver_options(tokens)
 
 
+def test_map_saver_into_a_missing_directory_is_refused_at_start(tmp_path):
+    """Not when the map comes, or at shutdown after a whole SLAM run (found by a new user)."""
+    out = tmp_path / "no_such_dir" / "mymap"
+    with pytest.raises(
+        MapError, match=rf"/map_saver: -f {out}: the directory {out.parent} does not exist"
+    ):
+        MapSaver(Runtime(), args=["-f", str(out)])
+
+
 def test_map_saver_defaults():
     assert saver_options([]) == ("map", 65, 25)
 

@@ -60,3 +60,10 @@ def test_a_value_from_a_yaml_file_is_named_with_its_file_and_line(tmp_path, capl
     assert f"unknown parameter 'particels' (did you mean 'particles'?) (set at {yaml_file}:2)" in (
         caplog.text
     )
+
+
+def test_a_parameter_in_the_wrong_case_is_offered_its_own_name(caplog):
+    """maxURange: difflib alone offered maxRange (another parameter) before maxUrange."""
+    with caplog.at_level(logging.WARNING):
+        gmapping_params({"maxURange": 8.0})
+    assert "unknown parameter 'maxURange' (did you mean 'maxUrange'?)" in caplog.text

@@ -218,6 +218,13 @@ class MapSaver(Node):
     def __init__(self, runtime, name: str = "map_saver", namespace: str = "/", **kw: Any) -> None:
         super().__init__(runtime, name, namespace, **kw)
         self.map_name, self.occupied, self.free = saver_options(_tokens(self.args), self.full_name)
+        folder = Path(self.map_name).parent
+        if not folder.is_dir():
+            # said now, not when the map comes (or at shutdown, after a whole exploration)
+            raise MapError(
+                f"{self.full_name}: -f {self.map_name}: the directory {folder} does not exist "
+                "(map_saver does not create it)"
+            )
         self.saved: tuple[Path, Path] | None = None
         self._latest: nav_msgs.OccupancyGrid | None = None
         self._sub = self.create_subscription(nav_msgs.OccupancyGrid, "map", self.on_map, 1)

@@ -1,5 +1,6 @@
 """move_base closed loop on the room world: goals, aborts with reasons, preemption, cancel."""
 
+import logging
 import math
 
 import numpy as np
@@ -123,6 +124,25 @@ def test_a_new_goal_waits_afresh_for_the_costmaps(caplog):
     w.rt.run(duration=20.0, until=lambda: h.done)
     assert h.status == GoalStatus.SUCCEEDED
     assert "for the costmaps" not in caplog.text
+
+
+def test_a_goal_in_the_shared_map_for_a_robot_with_its_own_map_is_named(caplog):
+    """gmapping in the robot's namespace makes its map lizi1/map; a goal sent in 'map'
+    (send_goals' default) cannot be placed: said after tf's 5 s, not at the planner's
+    patience, with the frame to send it in (found by a new user)."""
+    w = nav_world()
+    w.rt.run(duration=1.0)
+    w.mb.global_frame = "lizi1/map"  # as a global costmap in a SLAM robot's own map
+    goal = goal_msg(2.0, 1.0).target_pose
+    with caplog.at_level(logging.WARNING):
+        assert w.mb.to_global(goal) is None
+        w.rt.run(duration=4.9)
+        assert w.mb.to_global(goal) is None
+        assert "Failed to transform the goal pose" not in caplog.text
+        w.rt.run(duration=0.2)
+        assert w.mb.to_global(goal) is None
+    assert "Failed to transform the goal pose from map into the lizi1/map frame: " in caplog.text
+    assert "this robot's map is lizi1/map: send the goal in that frame" in caplog.text
 
 
 def test_speed_limit_and_shutdown_costmaps():

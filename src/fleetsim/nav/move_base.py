@@ -133,6 +133,7 @@ class MoveBase(ExecuteCycle, Node):
         self.global_costmap = Costmap2DROS(self, "global_costmap")
         self.local_costmap = Costmap2DROS(self, "local_costmap")
         self._unready = TransformPatience()  # an active goal waiting for them
+        self._goal_tf = TransformPatience()  # a goal whose frame tf cannot place yet
         self.global_frame = self.global_costmap.global_frame
         self.planner_name, self.planner = global_planner(
             p.base_global_planner, ns, self.global_costmap, where
@@ -297,7 +298,18 @@ class MoveBase(ExecuteCycle, Node):
                 f"Failed to transform the goal pose from {frame} into the {self.global_frame} "
                 f"frame: {err}"
             )
+            if self.global_frame.rpartition("/")[2] == frame:
+                # a goal in the shared 'map' for a robot whose map is its own (gmapping in
+                # its namespace: lizi1/map): said at once, not at the planner's patience
+                self._goal_error += (
+                    f"; this robot's map is {self.global_frame}: send the goal in that frame "
+                    f"(send_goals' frame_id, fleetsim goal's --frame), or publish a transform "
+                    f"linking {frame} and {self.global_frame}"
+                )
+            if self._goal_tf.missing_too_long("goal", self.now()):
+                self._warn("goal_tf", self._goal_error)
             return None
+        self._goal_tf.found("goal")
         c, s = math.cos(tyaw), math.sin(tyaw)
         return tx + c * x - s * y, ty + s * x + c * y, math.remainder(tyaw + yaw, 2 * math.pi)
 
@@ -338,6 +350,7 @@ class MoveBase(ExecuteCycle, Node):
         self.goal_msg = goal.target_pose
         self.goal = self.to_global(self.goal_msg)
         self._unready.found("costmaps")  # a new goal's wait starts now, not at an older one's
+        self._goal_tf.found("goal")
         self.recovery_index = 0
         self.recovery_trigger = PLANNING_R
         self._reset_rotations()

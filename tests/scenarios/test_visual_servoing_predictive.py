@@ -8,7 +8,9 @@ the camera is the launch's 640x360 at 10 Hz.
 
 from __future__ import annotations
 
+import logging
 import math
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -168,3 +170,22 @@ def test_marker_out_of_view_it_falls_back_to_exploring_and_then_follows():
         after = [t for t, seen, _, _ in w.frames if seen and t >= first_seen]
         assert np.diff([*after, s.runtime.now()]).max() < 4.0  # followed, not lost again
         no_mujoco_warnings(s)
+
+
+def test_a_marker_id_the_marker_does_not_carry_is_said_as_the_tutorials_follower_does(caplog):
+    """marker_id 7 while karl carries marker 0: the predictive follower explores, and after
+    10 s of seeing only marker 0 says so (it had said nothing; found by a new user)."""
+    plan = load_plan(resolve_launch_file("visual_servoing"), {"gui": "false",
+                                                              "follower": "predictive",
+                                                              **BEHIND_KARL})  # fmt: skip
+    plan.params = [
+        replace(p, value=7) if p.name == "/predictive_follower/marker_id" else p
+        for p in plan.params
+    ]
+    with LaunchSession(plan, seed=1) as s, caplog.at_level(logging.WARNING):
+        assert s.nodes["/predictive_follower"].params.marker_id == 7
+        s.runtime.run(duration=13.0)
+        assert s.nodes["/predictive_follower"].sightings == 0
+    said = [r.getMessage() for r in caplog.records if "seen only marker ids" in r.getMessage()]
+    assert len(said) == 1
+    assert "following marker_id 7, but for 10 s the camera has seen only marker ids 0" in said[0]

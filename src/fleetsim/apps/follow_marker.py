@@ -44,6 +44,44 @@ from fleetsim.tf.transforms import compose_transforms
 UPDATE_TIMEOUT = 4.0
 #: s of image time with other markers seen and ours never before that is warned about
 OTHERS_ONLY_TIME = 10.0
+
+
+class OtherMarkersWatch:
+    """Warns once when `OTHERS_ONLY_TIME` s of image time after the camera first saw a marker
+    it has still not seen the followed ``marker_id`` (an id the marker does not carry, or one
+    outside the detector's dictionary, which a follower cannot check: it only explores).
+    Shared by the tutorial's follower and the predictive one."""
+
+    def __init__(self, node: Node, marker_id: int) -> None:
+        self.node = node
+        self.marker_id = marker_id
+        self.others: set[int] = set()  # ids seen while ours never was
+        self.since: float | None = None
+        self.ours_seen = False
+
+    def saw(self, msg: fiducial_msgs.FiducialTransformArray, stamp: float, ours: bool) -> None:
+        """One detection message, at image time ``stamp``; ``ours``: it holds ``marker_id``."""
+        if ours:
+            self.ours_seen = True
+        if self.ours_seen:
+            return
+        ids = {t.fiducial_id for t in msg.transforms}
+        if ids:
+            self.others |= ids
+            if self.since is None:
+                self.since = stamp
+        # judged on every image, with markers or none: a follower exploring for its marker
+        # turns away from the one it saw (the predictive follower never saw it again)
+        if self.since is not None and stamp - self.since >= OTHERS_ONLY_TIME:
+            seen = ", ".join(str(i) for i in sorted(self.others))
+            self.node._warn_once(
+                "others",
+                f"following marker_id {self.marker_id}, but for {stamp - self.since:.0f} s the "
+                f"camera has seen only marker ids {seen}; is ~marker_id the id the marker "
+                "carries?",
+            )
+
+
 #: period of the move_base/clear_costmaps calls (s)
 CLEAR_COSTMAPS_PERIOD = 5.0
 #: the fixed re-orientation of the ArUco frame: x into the face, z up
@@ -94,9 +132,7 @@ class FollowMarker(Node):
         self.map_frame = "map"
         self.last_update: float = 0.0  # image time of the last update (ros::Time(0) at start)
         self.goals_sent = 0
-        self._others_seen: set[int] = set()  # ids seen while ours never was (_others_only)
-        self._others_since: float | None = None
-        self._ours_seen = False
+        self.others_watch = OtherMarkersWatch(self, self.params.marker_id)
         self._patience = TransformPatience()  # tf failures are reported once they last
         self.goal_pub = self.create_publisher(geometry_msgs.PoseStamped, "move_base_simple/goal")
         self.tf_pub = TransformBroadcaster(self)
@@ -106,25 +142,6 @@ class FollowMarker(Node):
             fiducial_msgs.FiducialTransformArray, "fiducial_transforms", self.on_fiducials, 1
         )
         self.create_timer(CLEAR_COSTMAPS_PERIOD, self.clear_costmaps)
-
-    def _others_only(self, msg: fiducial_msgs.FiducialTransformArray, stamp: float) -> None:
-        """Warn once when for `OTHERS_ONLY_TIME` s of image time the camera has seen markers,
-        but never ``~marker_id`` (a marker_id the marker does not carry, or one outside the
-        detector's dictionary, which the follower cannot check: it only explores)."""
-        ids = {t.fiducial_id for t in msg.transforms}
-        if not ids:
-            return
-        self._others_seen |= ids
-        if self._others_since is None:
-            self._others_since = stamp
-        elif stamp - self._others_since >= OTHERS_ONLY_TIME and not self._ours_seen:
-            seen = ", ".join(str(i) for i in sorted(self._others_seen))
-            self._warn_once(
-                "others",
-                f"following marker_id {self.params.marker_id}, but for "
-                f"{stamp - self._others_since:.0f} s the camera has seen only marker ids {seen}; "
-                "is ~marker_id the id the marker carries?",
-            )
 
     def _lookup(self, key: str, target: str, source: str, stamp: Any):
         """``target <- source`` at ``stamp``, or None (warned about once the failure has lasted
@@ -148,12 +165,11 @@ class FollowMarker(Node):
     def on_fiducials(self, msg: fiducial_msgs.FiducialTransformArray) -> None:
         stamp = msg.header.stamp.to_sec()
         found = next((t for t in msg.transforms if t.fiducial_id == self.params.marker_id), None)
+        self.others_watch.saw(msg, stamp, found is not None)
         if found is None:
-            self._others_only(msg, stamp)
             if stamp - self.last_update > UPDATE_TIMEOUT:
                 self.exploration.start()
             return
-        self._ours_seen = True
         if self.exploration.is_exploring():
             self.exploration.cancel()
             self.last_update = stamp

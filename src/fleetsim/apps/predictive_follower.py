@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from fleetsim.apps.exploration import Exploration, pose_stamped
-from fleetsim.apps.follow_marker import MARKER_TO_MARKER
+from fleetsim.apps.follow_marker import MARKER_TO_MARKER, OtherMarkersWatch
 from fleetsim.apps.follower_mpc import costs_without_target, rollout_costs, velocity_samples
 from fleetsim.apps.predictive_follower_params import PredictiveFollowerParams
 from fleetsim.apps.target_tracker import TargetTracker, TrackerParams
@@ -111,6 +111,7 @@ class PredictiveFollower(Node):
         self.trail: deque[tuple[float, float, float]] = deque()  # stamp, x, y in map
         self.infeasible_cycles = 0
         self._patience = TransformPatience()
+        self.others_watch = OtherMarkersWatch(self, self.params.marker_id)
         self.cmd_pub = self.create_publisher(geometry_msgs.Twist, "cmd_vel", 1)
         self.pose_pub = self.create_publisher(
             geometry_msgs.PoseWithCovarianceStamped, "~target_pose", 1
@@ -130,6 +131,7 @@ class PredictiveFollower(Node):
 
     def on_fiducials(self, msg: fiducial_msgs.FiducialTransformArray) -> None:
         found = next((t for t in msg.transforms if t.fiducial_id == self.params.marker_id), None)
+        self.others_watch.saw(msg, msg.header.stamp.to_sec(), found is not None)
         if found is None:
             return
         tr, q = found.transform.translation, found.transform.rotation

@@ -156,6 +156,26 @@ def test_launch_level_remaps_apply_to_later_nodes(tmp_path):
     assert plan.nodes[0].remaps == {} and plan.nodes[1].remaps == {"scan": "base_scan"}
 
 
+def test_remaps_and_private_params_in_args_are_read_as_ros_init_does(tmp_path):
+    """``map_saver -f x map:=/robot1/map`` as a node's args (a new user's probe: refused as
+    an unknown argument): ``from:=to`` remaps, ``_param:=value`` sets ~param (as YAML), a later
+    <remap> wins, and the rest stay arguments."""
+    p = write(
+        tmp_path,
+        '<node pkg="map_server" type="map_saver" name="saver" ns="r1"\n'
+        '      args="-f out/map map:=/robot1/map scan:=base_scan _rate:=2.5 _frame:=odom __log:=x">'
+        '<remap from="scan" to="front/scan"/></node>',
+    )
+    plan = load_xml(p)
+    (node,) = plan.nodes
+    assert node.args == ["-f", "out/map", "__log:=x"]
+    assert node.remaps == {"map": "/robot1/map", "scan": "front/scan"}
+    tree = plan.param_tree()
+    assert tree.get("/r1/saver/rate") == 2.5 and tree.get("/r1/saver/frame") == "odom"
+    with pytest.raises(FleetsimError, match=r"invalid name 'a//b'"):
+        load_xml(write(tmp_path, '<node pkg="a" type="b" name="c" args="a//b:=c"/>'))
+
+
 @pytest.mark.parametrize(
     ("body", "match"),
     [

@@ -15,6 +15,8 @@ import socket
 from functools import cache
 from typing import Any
 
+import yaml
+
 from fleetsim.errors import LaunchError
 from fleetsim.launch.model import NodeSpec, ParamOp
 from fleetsim.runtime import names
@@ -80,6 +82,7 @@ class NodeElements:
             args = shlex.split(attrs.get("args", ""))
         except ValueError as e:
             raise LaunchError(f"{where}: args do not parse: {e}") from None
+        args, arg_remaps, arg_params = _command_line_names(args, where)
         if attrs.get("launch-prefix", "").strip():
             raise LaunchError(
                 f"{self._where(scope, el, 'launch-prefix')}: fleetsim runs nodes in this "
@@ -108,7 +111,8 @@ class NodeElements:
             name=attrs["name"],
             namespace=ns,
             args=args,
-            remaps=dict(scope.remaps),
+            # roslaunch puts <remap>s after args on the command line: they win
+            remaps={**scope.remaps, **arg_remaps},
             output=output,
             respawn=respawn,
             respawn_delay=self._float(el, attrs, scope, "respawn_delay", 0.0),
@@ -131,6 +135,10 @@ class NodeElements:
             full = names.resolve(name.lstrip("~"), private, where=f" ({pwhere})")
             self.plan.params.append(ParamOp("set", full, value, pwhere))
         self.plan.params.extend(inner.pending)
+        # _param:=value on the command line: set by the node itself as it starts, after all
+        # of the launch file's parameters
+        for key, value in arg_params:
+            self.plan.params.append(ParamOp("set", names.join(private, key), value, where))
         self.plan.nodes.append(node)
 
     def _test(self, el, attrs, scope) -> None:
@@ -182,3 +190,31 @@ class NodeElements:
         self.machines[attrs["name"]] = attrs["address"]
         if default == "true":
             self.default_machine = attrs["name"]
+
+
+def _command_line_names(
+    args: list[str], where: str
+) -> tuple[list[str], dict[str, str], list[tuple[str, Any]]]:
+    """Split a node's ``args`` as ros::init / rospy.init_node do: ``from:=to`` is a remapping,
+    ``_param:=value`` a private parameter (its value read as YAML); the rest stay arguments
+    (``__name:=`` and the other special keys included). ``map_saver -f x map:=/robot1/map``
+    is the usual way to save a namespaced map."""
+    rest: list[str] = []
+    remaps: dict[str, str] = {}
+    params: list[tuple[str, Any]] = []
+    for tok in args:
+        key, sep, value = tok.partition(":=")
+        if not sep or not key or key.startswith("__") or "=" in key or tok.startswith("-"):
+            rest.append(tok)
+        elif key.startswith("_"):
+            try:
+                params.append((key[1:], yaml.safe_load(value) if value else ""))
+            except yaml.YAMLError as e:
+                raise LaunchError(
+                    f"{where}: args: {tok!r}: the value does not parse: {e}"
+                ) from None
+        else:
+            names.validate_name(key, f" ({where}: args {tok!r})")
+            names.validate_name(value, f" ({where}: args {tok!r})")
+            remaps[key] = value
+    return rest, remaps, params

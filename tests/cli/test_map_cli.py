@@ -101,6 +101,8 @@ def test_save_from_a_running_simulation(tmp_path):
         assert np.array_equal(load_map(tmp_path / "live.yaml").data, occ.data)
         r = runner.invoke(app, ["save", "--connect", ep, "--topic", "/nomap"])
         assert r.exit_code == 1 and "has no topic /nomap" in r.output
+        # the grids there are, named (a SLAM robot's map is in its namespace)
+        assert "OccupancyGrids are on /map" in " ".join(r.output.split())
     finally:
         stop.set()
         thread.join(10)

@@ -61,6 +61,14 @@ def test_topic_type_conflicts_are_errors():
     n.create_publisher(Num, "x")
     with pytest.raises(GraphError, match=r"topic /x already carries test_msgs/msg/Num.*Text"):
         n.create_subscription(Text, "x", print)
+    # the node holding the topic is named too, not only the one that came second
+    Node(rt, "slam").create_subscription(Num, "odom", print)
+    with pytest.raises(
+        GraphError,
+        match=r"topic /odom already carries test_msgs/msg/Num \(subscriber in /slam\); publisher "
+        r"in /n asked for test_msgs/msg/Text; check the remaps of both",
+    ):
+        n.create_publisher(Text, "odom")
     pub = n.create_publisher(Num, "x")
     with pytest.raises(GraphError, match="cannot publish test_msgs/msg/Text"):
         pub.publish(Text())

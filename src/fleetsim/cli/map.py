@@ -83,8 +83,15 @@ def grid_from_simulation(topic: str, connect: str | None, timeout: float) -> Any
     with SimulationClient(connect, timeout=min(timeout, 5.0)) as client:
         have = client.topic_type(topic)
         if have is None:
+            # a SLAM robot's map is in its namespace (/lizi1/map): name the grids there are
+            grids = sorted(
+                name
+                for name, info in client.graph()["topics"].items()
+                if "OccupancyGrid" in info["type"]
+            )
+            there = f"; OccupancyGrids are on {', '.join(grids[:6])}" if grids else ""
             raise MapError(
-                f"the simulation at {client.endpoint} has no topic {topic}; is map_server "
+                f"the simulation at {client.endpoint} has no topic {topic}{there}; is map_server "
                 "running? (choose another topic with --topic)"
             )
         if "OccupancyGrid" not in have:

@@ -207,9 +207,21 @@ class Graph:
         if topic is None:
             topic = self.topics[name] = Topic(name, msg_type)
         elif topic.type is not msg_type:
+            # name who holds it with the other type: a remap gone wrong in one of them (slam's
+            # scan remapped to odom) had been blamed on the node that came second
+            holders = [
+                f"{kind} in {end.node.full_name}"
+                for kind, ends in (
+                    ("publisher", topic.publishers),
+                    ("subscriber", topic.subscriptions),
+                )
+                for end in ends
+                if end.node is not None
+            ]
+            held = f" ({', '.join(sorted(set(holders))[:4])})" if holders else ""
             raise GraphError(
-                f"topic {name} already carries {_type_name(topic.type)}; {who} asked for "
-                f"{_type_name(msg_type)}"
+                f"topic {name} already carries {_type_name(topic.type)}{held}; {who} asked for "
+                f"{_type_name(msg_type)}; check the remaps of both"
             )
         return topic
 

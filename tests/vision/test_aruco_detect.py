@@ -210,11 +210,16 @@ def test_no_images_at_all_are_reported_and_the_report_stops_with_the_first(caplo
     once an image has come, never again."""
     bare = Runtime()
     ArucoDetect(bare, params={"dictionary": 0})  # nothing publishes /camera
+    # a camera elsewhere is named (a typo in the remap, or another robot's camera)
+    Node(bare, "cam").create_publisher(sensor_msgs.Image, "/robot2/camera/rgb/image_raw")
     with caplog.at_level("WARNING"):
         bare.run(duration=40.0)
     said = [r.getMessage() for r in caplog.records if "no image on" in r.getMessage()]
     assert len(said) == 2, said  # at 5 s and at 35 s
-    assert "no image on /camera for 5 s: does this robot have a camera" in said[0]
+    assert (
+        "no image on /camera for 5 s (no publisher; Image is published on "
+        "/robot2/camera/rgb/image_raw): does this robot have a camera" in said[0]
+    )
     assert "for 35 s" in said[1]
     caplog.clear()
     hn = Harness()  # a publisher is there: the first image ends the reports

@@ -104,12 +104,12 @@ class ArucoDetect(Node):
         base = self.resolve_name("camera")
         if p.image_transport == "compressed":
             self.image_topic = self.resolve_name(f"{base}/compressed")
-            self.create_subscription(
+            self._image_sub = self.create_subscription(
                 sensor_msgs.CompressedImage, self.image_topic, self.on_compressed, 1
             )
         else:
             self.image_topic = base
-            self.create_subscription(sensor_msgs.Image, base, self.on_image, 1)
+            self._image_sub = self.create_subscription(sensor_msgs.Image, base, self.on_image, 1)
         self.info_topic = self.resolve_name("camera_info")
         self.create_subscription(sensor_msgs.CameraInfo, self.info_topic, self.on_camera_info, 1)
         self.create_subscription(std_msgs.String, "ignore_fiducials", self.on_ignore, 1)
@@ -138,8 +138,9 @@ class ArucoDetect(Node):
         if (self._no_image_ticks - 1) % round(NO_IMAGES_AGAIN / NO_IMAGES_TIME):
             return
         self.get_logger().warning(
-            f"no image on {self.image_topic} for {self._no_image_ticks * NO_IMAGES_TIME:.0f} s: "
-            "does this robot have a camera, and do the remaps (and ~image_transport) lead to it?"
+            f"no image on {self.image_topic} for {self._no_image_ticks * NO_IMAGES_TIME:.0f} s"
+            f"{self.unpublished_hint(self._image_sub)}: does this robot have a camera, and do the "
+            "remaps (and ~image_transport) lead to it?"
         )
 
     # -- inputs --------------------------------------------------------------------------------

@@ -37,6 +37,8 @@ def test_bad_values_name_the_parameter():
         gmapping_params({"sigma": "wide"})
     with pytest.raises(ParameterError, match="xmin < xmax"):
         gmapping_params({"xmin": 5.0, "xmax": 1.0})
+    with pytest.raises(ParameterError, match=r"^/lizi1/slam_gmapping: the map extent xmin"):
+        gmapping_params({"xmin": 5.0, "xmax": 1.0}, "/lizi1/slam_gmapping")
     with pytest.raises(ParameterError, match="parameter 'climb_skip' = -1 is out of range"):
         gmapping_params({"climb_skip": -1})
 

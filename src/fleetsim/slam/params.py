@@ -194,4 +194,11 @@ def gmapping_params(
                 "them" if len(keys) > 1 else "it",
                 "them" if len(keys) > 1 else "it",
             )
-    return load_params(GmappingParams, values, where=where, logger=log)
+    try:
+        return load_params(GmappingParams, values, where=where, logger=log)
+    except ParameterError as err:
+        # __post_init__'s checks do not know the node: name it, as the others do
+        text = str(err)
+        if text.startswith("slam_gmapping: "):
+            text = f"{where}: {text.removeprefix('slam_gmapping: ')}"
+        raise ParameterError(text) from None

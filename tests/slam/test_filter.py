@@ -96,6 +96,20 @@ def test_map_grows_when_the_robot_leaves_it():
     assert data.shape == f.counts.shape_cells and tuple(geom[:2]) == (x0, y0)
 
 
+def test_the_map_grows_by_the_usable_range_not_the_lasers():
+    """maxUrange 4 m on a 30 m laser: gmapping enlarges its map for end points clipped to
+    the usable range (computeActiveArea), so the map stays within 4 m (+ the enlarge step)
+    of the robot; by maxRange it had grown ~30 m each way."""
+    rng = np.random.default_rng(4)
+    params = GmappingParams(particles=3, xmin=-1, ymin=-1, xmax=1, ymax=1)
+    f = GmappingFilter(params, rng, LASER, 29.99, 4.0)
+    f.process(np.zeros(3), 0.0, beams_at(np.zeros(3), rng, max_range=29.99))
+    x0, y0, x1, y1 = f.maps.bounds
+    reach = 4.0 + abs(LASER[0]) + slam_filter.ENLARGE_STEP
+    assert -reach - 1.0 <= x0 <= -4.0 and 4.0 <= x1 <= reach + 1.0
+    assert -reach - 1.0 <= y0 <= -4.0 and 4.0 <= y1 <= reach + 1.0
+
+
 def test_a_forward_laser_does_not_drift_while_the_robot_turns():
     # the hunter's 180-degree laser on a robot driving small squares (turning on the spot at
     # each corner, as an exploring robot does): every match used to pull the pose a few mm

@@ -156,8 +156,12 @@ class GmappingFilter:
         self.counts.resample(idx)
 
     def _grow_for(self, ranges: np.ndarray, angles: np.ndarray) -> None:
-        """Enlarge every map when this scan (from any particle) reaches beyond it."""
-        reach = max(self.max_range, 0.0) + float(np.hypot(*self.laser[:2]))
+        """Enlarge every map when this scan (from any particle) reaches beyond it: as far as
+        a beam writes, ``maxUrange`` (gmapping's ScanMatcher::computeActiveArea clips its
+        end points to the usable range and skips beams beyond ``maxRange``). By ``maxRange``,
+        a hunter's map (maxUrange 16 m, a 30 m laser) had grown ~5x the cells it needed."""
+        usable = min(self.max_range, self.usable_range)
+        reach = max(usable, 0.0) + float(np.hypot(*self.laser[:2]))
         x, y = self.poses[:, 0], self.poses[:, 1]
         pads = self.maps.growth_for(
             x.min() - reach, y.min() - reach, x.max() + reach, y.max() + reach, ENLARGE_STEP

@@ -7,7 +7,7 @@ import pytest
 
 from fleetsim.apps.follow_marker import FollowMarker
 from fleetsim.errors import ParameterError
-from fleetsim.runtime import Runtime
+from fleetsim.runtime import Node, Runtime
 
 from .follow_world import FollowWorld
 
@@ -177,3 +177,24 @@ def test_clear_costmaps_every_5_s():
 def test_bad_parameters_name_the_parameter(params, match):
     with pytest.raises(ParameterError, match=match):
         FollowMarker(Runtime(), params=params)
+
+
+def test_a_glimpse_of_another_marker_while_exploring_is_no_wrong_marker_id(caplog):
+    """The watch both followers share: one image of another robot's marker, then 12 s of
+    images with none, is not a wrong marker_id (found in review); ten such images are."""
+    from fleetsim.apps.follow_marker import OtherMarkersWatch
+    from fleetsim.msgs import fiducial_msgs as fm
+
+    def frame(*ids):
+        return fm.FiducialTransformArray(
+            transforms=[fm.FiducialTransform(fiducial_id=i) for i in ids]
+        )
+
+    for glimpses, warned in ((1, 0), (10, 1)):
+        watch = OtherMarkersWatch(Node(Runtime(seed=0), "follower"), 7)
+        caplog.clear()
+        with caplog.at_level("WARNING"):
+            for k in range(130):
+                watch.saw(frame(0) if k < glimpses else frame(), 0.1 * k, ours=False)
+        said = [r.getMessage() for r in caplog.records if "seen only marker ids" in r.getMessage()]
+        assert len(said) == warned, (glimpses, said)

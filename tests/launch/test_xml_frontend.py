@@ -158,22 +158,29 @@ def test_launch_level_remaps_apply_to_later_nodes(tmp_path):
 
 def test_remaps_and_private_params_in_args_are_read_as_ros_init_does(tmp_path):
     """``map_saver -f x map:=/robot1/map`` as a node's args (a new user's probe: refused as
-    an unknown argument): ``from:=to`` remaps, ``_param:=value`` sets ~param (as YAML), a later
-    <remap> wins, and the rest stay arguments."""
+    an unknown argument): ``from:=to`` remaps, ``_param:=value`` sets ~param (as YAML), the
+    special ``__log:=`` is taken out, every <remap> (the group's too) wins over the args, and
+    the rest stay arguments."""
     p = write(
         tmp_path,
+        '<group><remap from="odom" to="ground_truth"/>'
         '<node pkg="map_server" type="map_saver" name="saver" ns="r1"\n'
-        '      args="-f out/map map:=/robot1/map scan:=base_scan _rate:=2.5 _frame:=odom __log:=x">'
-        '<remap from="scan" to="front/scan"/></node>',
+        '      args="-f out/map map:=/robot1/map scan:=base_scan odom:=wheel_odom _rate:=2.5 '
+        '_frame:=odom __log:=x"><remap from="scan" to="front/scan"/></node></group>',
     )
     plan = load_xml(p)
     (node,) = plan.nodes
-    assert node.args == ["-f", "out/map", "__log:=x"]
-    assert node.remaps == {"map": "/robot1/map", "scan": "front/scan"}
+    assert node.args == ["-f", "out/map"]
+    assert node.remaps == {"map": "/robot1/map", "scan": "front/scan", "odom": "ground_truth"}
     tree = plan.param_tree()
     assert tree.get("/r1/saver/rate") == 2.5 and tree.get("/r1/saver/frame") == "odom"
-    with pytest.raises(FleetsimError, match=r"invalid name 'a//b'"):
-        load_xml(write(tmp_path, '<node pkg="a" type="b" name="c" args="a//b:=c"/>'))
+    for bad, match in (
+        ("a//b:=c", r"invalid name 'a//b'"),
+        ("map:=", r"invalid remap 'map:='"),
+        ("_:=3", r"args '_:=3': the private parameter has no name"),
+    ):
+        with pytest.raises(FleetsimError, match=match):
+            load_xml(write(tmp_path, f'<node pkg="a" type="b" name="c" args="{bad}"/>'))
 
 
 @pytest.mark.parametrize(

@@ -142,7 +142,7 @@ def test_a_goal_in_the_shared_map_for_a_robot_with_its_own_map_is_named(caplog):
         w.rt.run(duration=0.2)
         assert w.mb.to_global(goal) is None
     assert "Failed to transform the goal pose from map into the lizi1/map frame: " in caplog.text
-    assert "this robot's map is lizi1/map: send the goal in that frame" in caplog.text
+    assert "this robot's global frame is lizi1/map: send the goal in that frame" in caplog.text
 
 
 def test_speed_limit_and_shutdown_costmaps():

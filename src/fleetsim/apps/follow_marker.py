@@ -44,6 +44,9 @@ from fleetsim.tf.transforms import compose_transforms
 UPDATE_TIMEOUT = 4.0
 #: s of image time with other markers seen and ours never before that is warned about
 OTHERS_ONLY_TIME = 10.0
+#: images with other markers needed for that warning: a glimpse of another robot's marker
+#: while the follower explores for its own is no sign of a wrong marker_id
+OTHERS_MIN_IMAGES = 10
 
 
 class OtherMarkersWatch:
@@ -56,6 +59,7 @@ class OtherMarkersWatch:
         self.node = node
         self.marker_id = marker_id
         self.others: set[int] = set()  # ids seen while ours never was
+        self.images = 0  # images that showed them
         self.since: float | None = None
         self.ours_seen = False
 
@@ -68,11 +72,16 @@ class OtherMarkersWatch:
         ids = {t.fiducial_id for t in msg.transforms}
         if ids:
             self.others |= ids
+            self.images += 1
             if self.since is None:
                 self.since = stamp
         # judged on every image, with markers or none: a follower exploring for its marker
         # turns away from the one it saw (the predictive follower never saw it again)
-        if self.since is not None and stamp - self.since >= OTHERS_ONLY_TIME:
+        if (
+            self.since is not None
+            and stamp - self.since >= OTHERS_ONLY_TIME
+            and self.images >= OTHERS_MIN_IMAGES
+        ):
             seen = ", ".join(str(i) for i in sorted(self.others))
             self.node._warn_once(
                 "others",

@@ -378,10 +378,11 @@ class RunMonitor:
                     f"{r.namespace}: {r.goals_reached}/{r.goals_sent} goals reached; "
                     + ", ".join(why)
                 )
-        for name in self.senders_failed():
-            sender = next(s for s in self.senders if _sender_name(s) == name)
-            state = "gave up" if sender.done else "had not finished when the run ended"
-            out.append(f"goal sender {name} {state}")
+        for s in self.senders:
+            if not s.done:
+                out.append(f"goal sender {_sender_name(s)} had not finished when the run ended")
+            elif not getattr(s, "succeeded", True):
+                out.append(f"goal sender {_sender_name(s)} gave up")
         for r in results:
             if r.collisions:
                 out.append(f"{r.namespace}: {r.collisions} collision(s)")

@@ -111,8 +111,9 @@ class NodeElements:
             name=attrs["name"],
             namespace=ns,
             args=args,
-            # roslaunch puts <remap>s after args on the command line: they win
-            remaps={**scope.remaps, **arg_remaps},
+            # roslaunch puts every <remap> (the group's and the node's) after the args on the
+            # command line: they win
+            remaps={**arg_remaps, **scope.remaps},
             output=output,
             respawn=respawn,
             respawn_delay=self._float(el, attrs, scope, "respawn_delay", 0.0),
@@ -196,25 +197,28 @@ def _command_line_names(
     args: list[str], where: str
 ) -> tuple[list[str], dict[str, str], list[tuple[str, Any]]]:
     """Split a node's ``args`` as ros::init / rospy.init_node do: ``from:=to`` is a remapping,
-    ``_param:=value`` a private parameter (its value read as YAML); the rest stay arguments
-    (``__name:=`` and the other special keys included). ``map_saver -f x map:=/robot1/map``
-    is the usual way to save a namespaced map."""
+    ``_param:=value`` a private parameter (its value read as YAML, as rospy does), and the
+    special ``__name:=``, ``__ns:=``, ``__log:=``, ... are taken out (roslaunch's own name and
+    namespace win); the rest stay arguments. ``map_saver -f x map:=/robot1/map`` is the usual
+    way to save a namespaced map."""
     rest: list[str] = []
     remaps: dict[str, str] = {}
     params: list[tuple[str, Any]] = []
     for tok in args:
         key, sep, value = tok.partition(":=")
-        if not sep or not key or key.startswith("__") or "=" in key or tok.startswith("-"):
+        if not sep or not key or "=" in key or tok.startswith("-"):
             rest.append(tok)
+        elif key.startswith("__"):
+            continue
         elif key.startswith("_"):
+            if len(key) < 2:  # roscpp skips it; here it would set the whole ~namespace
+                raise LaunchError(f"{where}: args {tok!r}: the private parameter has no name")
+            names.validate_name(key[1:], f" ({where}: args {tok!r})")
             try:
                 params.append((key[1:], yaml.safe_load(value) if value else ""))
             except yaml.YAMLError as e:
-                raise LaunchError(
-                    f"{where}: args: {tok!r}: the value does not parse: {e}"
-                ) from None
+                raise LaunchError(f"{where}: args {tok!r}: the value does not parse: {e}") from None
         else:
-            names.validate_name(key, f" ({where}: args {tok!r})")
-            names.validate_name(value, f" ({where}: args {tok!r})")
-            remaps[key] = value
+            src, dst = names.parse_remap(tok, f" ({where}: args)")
+            remaps[src] = dst
     return rest, remaps, params

@@ -282,8 +282,11 @@ class MoveBase(ExecuteCycle, Node):
         self.run_planner = True
         self.next_plan_time = self.now()
 
-    def to_global(self, ps: geometry_msgs.PoseStamped) -> tuple[float, float, float] | None:
-        """A PoseStamped as (x, y, yaw) in the global frame (newest tf), or None (reason kept)."""
+    def to_global(
+        self, ps: geometry_msgs.PoseStamped, warn: bool = True
+    ) -> tuple[float, float, float] | None:
+        """A PoseStamped as (x, y, yaw) in the global frame (newest tf), or None (reason kept;
+        with ``warn``, the active goal's: warned once it has failed for tf's 5 s)."""
         x, y, yaw = pose_of(ps.pose)
         if not ps.header.frame_id:
             self._warn("frame", f"a pose with an empty frame_id is taken in '{self.global_frame}'")
@@ -302,14 +305,15 @@ class MoveBase(ExecuteCycle, Node):
                 # a goal in the shared 'map' for a robot whose map is its own (gmapping in
                 # its namespace: lizi1/map): said at once, not at the planner's patience
                 self._goal_error += (
-                    f"; this robot's map is {self.global_frame}: send the goal in that frame "
-                    f"(send_goals' frame_id, fleetsim goal's --frame), or publish a transform "
-                    f"linking {frame} and {self.global_frame}"
+                    f"; this robot's global frame is {self.global_frame}: send the goal in that "
+                    f"frame (send_goals' frame_id, fleetsim goal's --frame), or publish a "
+                    f"transform linking {frame} and {self.global_frame}"
                 )
-            if self._goal_tf.missing_too_long("goal", self.now()):
+            if warn and self._goal_tf.missing_too_long("goal", self.now()):
                 self._warn("goal_tf", self._goal_error)
             return None
-        self._goal_tf.found("goal")
+        if warn:
+            self._goal_tf.found("goal")
         c, s = math.cos(tyaw), math.sin(tyaw)
         return tx + c * x - s * y, ty + s * x + c * y, math.remainder(tyaw + yaw, 2 * math.pi)
 
@@ -347,10 +351,10 @@ class MoveBase(ExecuteCycle, Node):
         if self.params.shutdown_costmaps:
             self.global_costmap.start()
             self.local_costmap.start()
-        self.goal_msg = goal.target_pose
-        self.goal = self.to_global(self.goal_msg)
         self._unready.found("costmaps")  # a new goal's wait starts now, not at an older one's
         self._goal_tf.found("goal")
+        self.goal_msg = goal.target_pose
+        self.goal = self.to_global(self.goal_msg)
         self.recovery_index = 0
         self.recovery_trigger = PLANNING_R
         self._reset_rotations()

@@ -99,7 +99,7 @@ class MoveBaseServices:
         mb = self.mb
         if not mb.global_costmap.initialized:
             raise ServiceError("the global costmap is not ready yet (no map or no tf)")
-        start = mb.to_global(req.start) if req.start.header.frame_id else None
+        start = mb.to_global(req.start, warn=False) if req.start.header.frame_id else None
         if not req.start.header.frame_id:
             start = mb.global_costmap.robot_pose()
         if start is None:
@@ -107,7 +107,7 @@ class MoveBaseServices:
                 "Unable to get starting pose of robot, unable to create global plan"
                 + (f": {mb._goal_error}" if req.start.header.frame_id else "")
             )
-        goal = mb.to_global(req.goal)
+        goal = mb.to_global(req.goal, warn=False)
         if goal is None:
             raise ServiceError(mb._goal_error)
         return start, goal

@@ -124,7 +124,7 @@ class Simulator(Node):
         here: Gazebo spawns it, and the two then share topics (cmd_vel, odom, the laser's) or
         frames, one robot's messages overwriting the other's without a word."""
         for other in self.engine.models.values():
-            if other.kind != "robot":
+            if other.kind != "robot" or other.name == name:  # a taken name is refused below
                 continue
             if other.namespace == ns:
                 shared = f"in namespace {ns}, as '{other.name}' is: the two share their topics "

@@ -124,6 +124,10 @@ class GmappingFilter:
                 idx = systematic_resample(norm, self.rng)
                 self._resample(idx)
                 result.resampled = True
+        # the scan is written from the matched poses, which the hill climber moved (up to
+        # ~0.4 m): the maps grow for them too (gmapping's computeActiveArea runs at
+        # registerScan, after matching); the writes do not check bounds
+        self._grow_for(ranges, angles)
         # the first scan: every particle is at the same pose, register it once and share it
         poses = self.poses[:1] if first else self.poses
         cells, hits = endpoint_cells(poses, self.laser, ranges, angles, self.maps.geom)

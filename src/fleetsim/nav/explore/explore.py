@@ -229,8 +229,8 @@ class Explore(Node):
             self._warn_once(
                 "no unknown",
                 f"the costmap on {self._costmap_sub.topic.name} has no unknown cell: there is no "
-                "frontier to explore; the costmap must keep unknown space (track_unknown_space: "
-                "true, as explore_lite requires)",
+                "frontier to explore; unless the map is known already, the costmap does not keep "
+                "unknown space (set track_unknown_space: true, as explore_lite requires)",
             )
             self.stop("stopping: nothing unknown to explore", failed=True)
             return
@@ -433,7 +433,7 @@ class Explore(Node):
         self.gave_up = given_up > 0 or failed
         if observed:
             why += f" ({observed} frontiers left observed as far as they can be)"
-        if self.gave_up:
+        if given_up > 0:
             why += f" (gave up: {given_up} frontiers left, blacklisted)"
         self._withdraw_goal()
         self.timer.cancel()

@@ -43,8 +43,12 @@ def test_each_namespace_gets_a_controller_manager_and_joint_states(hunters):
         }
         arm = next(c for c in res.controller if c.name == "arm_group_controller")
         assert arm.claimed_resources[0].resources == ARM
-    assert js[-1].name == ARM
-    assert 20 <= len(js) <= 26  # publish_rate 50 Hz over 0.5 s
+    # joint_state_controller's arm, and the diff drive's wheels (publishWheelJointState,
+    # updateRate 20 Hz) on the same topic, as in Gazebo
+    arm_states = [m for m in js if m.name == ARM]
+    wheel_states = [m for m in js if m.name != ARM]
+    assert 20 <= len(arm_states) <= 26  # publish_rate 50 Hz over 0.5 s
+    assert 8 <= len(wheel_states) <= 12 and all(len(m.name) == 2 for m in wheel_states)
     types = hunters.rt.graph.call_service(
         "/hunter1/controller_manager/list_controller_types", cmm.ListControllerTypes
     ).types

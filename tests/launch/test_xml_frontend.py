@@ -166,7 +166,8 @@ def test_remaps_and_private_params_in_args_are_read_as_ros_init_does(tmp_path):
         '<group><remap from="odom" to="ground_truth"/>'
         '<node pkg="map_server" type="map_saver" name="saver" ns="r1"\n'
         '      args="-f out/map map:=/robot1/map scan:=base_scan odom:=wheel_odom _rate:=2.5 '
-        '_frame:=odom __log:=x"><remap from="scan" to="front/scan"/></node></group>',
+        '_frame:=odom __log:=x"><remap from="scan" to="front/scan"/></node></group>'
+        '<param name="r1/saver/rate" value="9.0"/>',  # set later in the file: the args win
     )
     plan = load_xml(p)
     (node,) = plan.nodes

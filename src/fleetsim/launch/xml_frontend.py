@@ -119,12 +119,16 @@ class XmlLoader(ParamElements, NodeElements):
         #: declared machines: name -> address; and the current default machine
         self.machines: dict[str, str] = {}
         self.default_machine = ""
+        #: ``_param:=value`` of nodes' args: set after every parameter of the launch, as the
+        #: node sets them itself when it starts (ros::init), after roslaunch set the rest
+        self.arg_params: list = []
 
     # -- entry ----------------------------------------------------------------------------
     def load(self, path: Path, args: dict[str, str]) -> LaunchPlan:
         ctx = Context({}, self.find, path, seed=self.seed, kinds=ROS1_KINDS)
         scope = _Scope("/", {}, ctx, Path(path))
         self._file(Path(path), dict(args), scope, top=True)
+        self.plan.params.extend(self.arg_params)
         return self.plan
 
     def _where(self, scope: _Scope, el, attr: str | None = None) -> str:

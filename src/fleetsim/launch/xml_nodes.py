@@ -137,9 +137,9 @@ class NodeElements:
             self.plan.params.append(ParamOp("set", full, value, pwhere))
         self.plan.params.extend(inner.pending)
         # _param:=value on the command line: set by the node itself as it starts, after all
-        # of the launch file's parameters
+        # of the launch file's parameters (XmlLoader.load appends them last)
         for key, value in arg_params:
-            self.plan.params.append(ParamOp("set", names.join(private, key), value, where))
+            self.arg_params.append(ParamOp("set", names.join(private, key), value, where))
         self.plan.nodes.append(node)
 
     def _test(self, el, attrs, scope) -> None:

@@ -321,7 +321,7 @@ def test_an_amcl_in_a_namespace_is_told_to_remap_static_map(caplog):
 def test_an_amcl_reading_a_topic_nobody_publishes_says_so(caplog):
     """amcl on ``scan`` while the laser publishes ``base_scan``: after SILENT_AFTER s without a
     scan it warns, naming where scans are published; an amcl that gets scans does not."""
-    from fleetsim.localization.amcl.node import SILENT_AFTER
+    from fleetsim.runtime.node import SILENT_AFTER
 
     rt = Runtime(seed=0)
     rt.params.set("/lizi1/tf_prefix", "lizi1")

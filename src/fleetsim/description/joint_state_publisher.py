@@ -73,10 +73,9 @@ class JointStatePublisher(Node):
                 # its own output as a source (the manual's [/joint_states], beside a drive
                 # that publishes its wheels there): its own messages are not read back, or a
                 # stale value of its own could overwrite a newer one from the simulator
-                sub = self.runtime.graph.subscribe(
-                    name, sensor_msgs.JointState, self._on_shared_topic, 10, self, True
+                self.create_subscription(
+                    sensor_msgs.JointState, name, self._on_shared_topic, with_publisher=True
                 )
-                self._subscriptions.append(sub)
             else:
                 self.create_subscription(sensor_msgs.JointState, name, self.on_source)
         if p.rate > 0:

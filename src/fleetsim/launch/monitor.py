@@ -391,12 +391,5 @@ class RunMonitor:
     def success(self) -> bool:
         """Every goal reached (confirmed by ground truth), every goal sender done and
         succeeded, no collision; a run with neither goals nor senders did not succeed
-        (`failures` says which failed)."""
-        rs = [r for r in self.results() if r.goals_sent > 0]
-        handled = self._handled_goals()
-        return (
-            (bool(rs) or bool(self.senders))
-            and all(r.ok_but_for(handled) for r in rs)
-            and not self.senders_failed()
-            and all(r.collisions == 0 for r in self.results())
-        )
+        (`failures` names each reason it did not)."""
+        return not self.failures()

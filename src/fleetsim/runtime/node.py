@@ -194,6 +194,29 @@ class Node:
         seen = f"; {topic.type.__name__} is published on {', '.join(others[:6])}"
         return f" (no publisher{seen if others else ''})"
 
+    def warn_while_silent(
+        self, sub: Subscription, heard: Callable[[], bool], what: str, then: str
+    ) -> Timer:
+        """Every `SILENT_AFTER` s until ``heard()``: warn (every `SILENT_REPEAT` s)
+        "``what`` on TOPIC in N s (no publisher; ...): ``then``" with `unpublished_hint` (amcl
+        and slam_gmapping without scans, explore without a costmap). Returns the timer, which
+        cancels itself once heard."""
+        started = self.now()
+
+        def check() -> None:
+            if heard():
+                timer.cancel()
+                return
+            self._warn(
+                f"silent:{sub.topic.name}",
+                f"{what} on {sub.topic.name} in {self.now() - started:.0f} s"
+                f"{self.unpublished_hint(sub)}: {then}",
+                SILENT_REPEAT,
+            )
+
+        timer = self.create_timer(SILENT_AFTER, check)
+        return timer
+
     @property
     def tf_buffer(self):
         return self.runtime.tf_buffer
@@ -207,10 +230,17 @@ class Node:
         return pub
 
     def create_subscription(
-        self, msg_type: Any, topic: str, callback: Callable[[Any], None], queue_size: int = 10
+        self,
+        msg_type: Any,
+        topic: str,
+        callback: Callable[[Any], None],
+        queue_size: int = 10,
+        with_publisher: bool = False,
     ) -> Subscription:
+        """Subscribe; ``with_publisher``: ``callback`` gets ``(msg, publisher)`` (see
+        `fleetsim.runtime.graph`)."""
         sub = self.runtime.graph.subscribe(
-            self.resolve_name(topic), msg_type, callback, queue_size, self
+            self.resolve_name(topic), msg_type, callback, queue_size, self, with_publisher
         )
         self._subscriptions.append(sub)
         return sub

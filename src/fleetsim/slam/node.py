@@ -34,7 +34,6 @@ from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.nav.map_io import OccupancyMap
 from fleetsim.nav.map_server import grid_msg_from_map
 from fleetsim.runtime import Node
-from fleetsim.runtime.node import SILENT_AFTER, SILENT_REPEAT
 from fleetsim.tf import (
     MessageFilter,
     TransformBroadcaster,
@@ -100,8 +99,13 @@ class SlamGmapping(Node):
         self._scan_sub = self.create_subscription(
             sensor_msgs.LaserScan, "scan", self.on_scan, queue_size=5
         )
-        self._started = self.now()
-        self._silence_timer = self.create_timer(SILENT_AFTER, self._warn_if_no_scan)
+        # a laser on base_scan for gmapping's scan had left the map unmade without a word
+        self.warn_while_silent(
+            self._scan_sub,
+            lambda: self._scans_seen > 0,
+            "no scan received",
+            "no map until one comes (remap 'scan' to the laser's topic)",
+        )
         self.tf_period = self._tf_period(p.transform_publish_period)
         if self.tf_period > 0:
             self.create_timer(self.tf_period, self._publish_transform)
@@ -130,21 +134,6 @@ class SlamGmapping(Node):
         return period
 
     # ----- scans -----
-    def _warn_if_no_scan(self) -> None:
-        """`SILENT_AFTER` s without a scan: said (every `SILENT_REPEAT` s) until one comes,
-        naming where scans are published (a laser on ``base_scan`` for gmapping's ``scan``
-        had left the map unmade without a word)."""
-        if self._scans_seen:
-            self._silence_timer.cancel()
-            return
-        self._warn(
-            "no_scan",
-            f"no scan received on {self._scan_sub.topic.name} in {self.now() - self._started:.0f} s"
-            f"{self.unpublished_hint(self._scan_sub)}: no map until one comes (remap 'scan' to "
-            "the laser's topic)",
-            SILENT_REPEAT,
-        )
-
     def on_scan(self, scan: sensor_msgs.LaserScan) -> None:
         self._scans_seen += 1
         if (self._scans_seen - 1) % self.params.throttle_scans:

@@ -29,7 +29,6 @@ from fleetsim.errors import ExtrapolationError, FleetsimError, TransformError
 from fleetsim.msgs import geometry_msgs, nav_msgs, sensor_msgs, std_msgs, std_srvs
 from fleetsim.msgs.builtin_interfaces import Time
 from fleetsim.runtime import Node
-from fleetsim.runtime.node import SILENT_AFTER, SILENT_REPEAT
 from fleetsim.tf import (
     MessageFilter,
     TransformBroadcaster,
@@ -96,8 +95,16 @@ class Amcl(Node):
         self._scan_sub = self.create_subscription(
             sensor_msgs.LaserScan, "scan", self.on_scan, queue_size=1
         )
-        self._scans_heard, self._started = False, self.now()
-        self._silence_timer = self.create_timer(SILENT_AFTER, self._warn_if_no_scan)
+        self._scans_heard = False
+        # amcl on the wrong topic publishes no map -> odom, and the costmaps then report a
+        # missing 'map' frame, which blamed tf, not amcl
+        self.warn_while_silent(
+            self._scan_sub,
+            lambda: self._scans_heard,
+            "no scan received",
+            "no pose estimate and no map -> odom transform until one comes (remap 'scan' to "
+            "the laser's topic)",
+        )
         self.create_subscription(
             geometry_msgs.PoseWithCovarianceStamped, "initialpose", self.on_initial_pose, 2
         )
@@ -263,21 +270,6 @@ class Amcl(Node):
             ("initial_cov_aa", cov[5, 5]),
         ):
             self.set_param(f"~{key}", float(value))
-
-    def _warn_if_no_scan(self) -> None:
-        """`SILENT_AFTER` s without a scan: said (every `SILENT_REPEAT` s) until one comes,
-        naming where scans are published (amcl on the wrong topic publishes no map -> odom,
-        and the costmaps then report a missing 'map' frame, which blamed tf, not amcl)."""
-        if self._scans_heard:
-            self._silence_timer.cancel()
-            return
-        self._warn(
-            "no_scan",
-            f"no scan received on {self._scan_sub.topic.name} in {self.now() - self._started:.0f} s"
-            f"{self.unpublished_hint(self._scan_sub)}: no pose estimate and no map -> odom "
-            "transform until one comes (remap 'scan' to the laser's topic)",
-            SILENT_REPEAT,
-        )
 
     # ----- the scan callback -----
     def on_scan(self, scan: sensor_msgs.LaserScan) -> None:

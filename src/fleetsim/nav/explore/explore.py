@@ -59,7 +59,6 @@ from fleetsim.errors import FleetsimError
 from fleetsim.msgs import move_base_msgs, nav_msgs, std_msgs, visualization_msgs
 from fleetsim.nav.move_base_support import pose_stamped
 from fleetsim.runtime import Node
-from fleetsim.runtime.node import SILENT_AFTER, SILENT_REPEAT
 from fleetsim.tf.names import resolve_frame_once
 
 from .frontier_search import Frontier, frontiers_from_grid, known_window
@@ -118,7 +117,15 @@ class Explore(Node):
         self._costmap_sub = self.create_subscription(
             nav_msgs.OccupancyGrid, p.costmap_topic, self.on_costmap, 1
         )
-        self._started = self.now()
+        # explore_lite says "Waiting for costmap to become available"; a costmap_topic nobody
+        # publishes (the default 'costmap' beside move_base's) had waited unsaid
+        self.warn_while_silent(
+            self._costmap_sub,
+            lambda: self.grid is not None,
+            "no costmap",
+            "not exploring until one comes (set costmap_topic, e.g. "
+            "move_base/global_costmap/costmap)",
+        )
         self._seen_unknown = False  # a costmap it read had unknown space (see make_plan)
         self.move_base = self.create_action_client(move_base_msgs.MoveBase, "move_base")
         self.marker_pub = (
@@ -198,21 +205,7 @@ class Explore(Node):
 
     def make_plan(self) -> None:
         """explore_lite's makePlan: pick the best frontier, watch progress, send the goal."""
-        if self.finished:
-            return
-        if self.grid is None:
-            waited = self.now() - self._started
-            if waited >= SILENT_AFTER:
-                # explore_lite says "Waiting for costmap to become available"; a costmap_topic
-                # nobody publishes (the default 'costmap' beside move_base's) had waited unsaid
-                sub = self._costmap_sub
-                self._warn(
-                    "no costmap",
-                    f"no costmap on {sub.topic.name} in {waited:.0f} s"
-                    f"{self.unpublished_hint(sub)}: not exploring until one comes (set "
-                    "costmap_topic, e.g. move_base/global_costmap/costmap)",
-                    SILENT_REPEAT,
-                )
+        if self.finished or self.grid is None:
             return
         grid = self.grid
         frame = grid.header.frame_id

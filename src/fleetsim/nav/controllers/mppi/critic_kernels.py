@@ -107,6 +107,21 @@ def strict_pose_cost(
     return float(min(v, 252))
 
 
+@njit(cache=True, inline="always")
+def _sample_cost(
+    centre_only, costs, clear2, ox, oy, res, outline, use_footprint, inside2, outside2, escape2,
+    poses, headings, b, t,
+):  # fmt: skip
+    """The cost of sample ``b``'s pose ``t`` for the critics' loops: `centre_cost` when
+    ``centre_only`` (no footprint, no escape), else `pose_cost`."""
+    if centre_only:
+        return centre_cost(costs, ox, oy, res, poses[b, t, 0], poses[b, t, 1])
+    return pose_cost(
+        costs, clear2, ox, oy, res, outline, use_footprint, inside2, outside2, escape2,
+        poses[b, t, 0], poses[b, t, 1], headings[b, t, 0], headings[b, t, 1],
+    )  # fmt: skip
+
+
 @njit(cache=True)
 def cost_terms(
     poses,
@@ -137,13 +152,10 @@ def cost_terms(
     for b in range(nb):
         acc = 0.0
         for t in range(0, nt, step):
-            if centre_only:
-                c = centre_cost(costs, ox, oy, res, poses[b, t, 0], poses[b, t, 1])
-            else:
-                c = pose_cost(
-                    costs, clear2, ox, oy, res, outline, use_footprint, inside2, outside2,
-                    escape2, poses[b, t, 0], poses[b, t, 1], headings[b, t, 0], headings[b, t, 1],
-                )  # fmt: skip
+            c = _sample_cost(
+                centre_only, costs, clear2, ox, oy, res, outline, use_footprint, inside2,
+                outside2, escape2, poses, headings, b, t,
+            )  # fmt: skip
             if c == COLLISION:
                 hit[b] = True
                 break
@@ -187,13 +199,10 @@ def obstacle_terms(
     centre_only = not use_footprint and escape2 < 0.0
     for b in range(nb):
         for t in range(nt):
-            if centre_only:
-                c = centre_cost(costs, ox, oy, res, poses[b, t, 0], poses[b, t, 1])
-            else:
-                c = pose_cost(
-                    costs, clear2, ox, oy, res, outline, use_footprint, inside2, outside2,
-                    escape2, poses[b, t, 0], poses[b, t, 1], headings[b, t, 0], headings[b, t, 1],
-                )  # fmt: skip
+            c = _sample_cost(
+                centre_only, costs, clear2, ox, oy, res, outline, use_footprint, inside2,
+                outside2, escape2, poses, headings, b, t,
+            )  # fmt: skip
             if c == COLLISION:
                 hit[b] = True
                 break

@@ -22,11 +22,11 @@ def sim():
     return rt, sim, probe
 
 
-def spawn(probe, name, pose, ns=""):
+def spawn(probe, name, pose, ns="", xml=None):
     client = probe.create_client(gazebo_msgs.SpawnModel, "/gazebo/spawn_urdf_model")
     req = gazebo_msgs.SpawnModel.Request()
     req.model_name = name
-    req.model_xml = (FIXTURES / "diffbot.urdf").read_text()
+    req.model_xml = xml or (FIXTURES / "diffbot.urdf").read_text()
     req.robot_namespace = ns
     req.initial_pose.position.x, req.initial_pose.position.y = pose
     req.initial_pose.orientation.w = 1.0
@@ -119,6 +119,62 @@ def test_odometry_tf_arrives_before_the_scan_of_the_same_time(sim):
     for i in scans:
         seen = set().union(*(v for kind, v in log[:i] if kind == "tf"))
         assert log[i][1] in seen
+
+
+@pytest.mark.parametrize("publish", [True, False])
+def test_publish_wheel_tf_broadcasts_each_wheel_from_its_parent_link(sim, publish):
+    """gazebo_ros_diff_drive's publishWheelTF: each wheel's transform from its joint's parent
+    link on /tf at the drive's updateRate, turning with the wheel (the angle the drive's own
+    wheel joint states give at the same stamp), with the robot's tf_prefix; none without it."""
+    import mujoco
+
+    from fleetsim.msgs import sensor_msgs, tf2_msgs
+
+    rt, s, probe = sim
+    xml = (FIXTURES / "diffbot.urdf").read_text()
+    flags = f"<publishWheelTF>{str(publish).lower()}</publishWheelTF>"
+    flags += "<publishWheelJointState>true</publishWheelJointState>"
+    xml = xml.replace("<updateRate>50</updateRate>", f"<updateRate>50</updateRate>{flags}", 1)
+    assert spawn(probe, "bot", (22.0, 15.0), ns="/bot", xml=xml).success
+    tf, states = [], []
+    collect(probe, tf2_msgs.TFMessage, "/tf", tf)
+    collect(probe, sensor_msgs.JointState, "/bot/joint_states", states)
+    cmd = probe.create_publisher(geometry_msgs.Twist, "/bot/cmd_vel", queue_size=1)
+    twist = geometry_msgs.Twist(linear=geometry_msgs.Vector3(x=0.3))
+    twist.angular.z = 0.5
+    probe.create_timer(0.1, lambda: cmd.publish(twist))
+    rt.run(duration=1.0)
+    wheels = [
+        t
+        for m in tf
+        for t in m.transforms
+        if t.child_frame_id in ("bot/left_wheel", "bot/right_wheel")
+    ]
+    if not publish:
+        assert wheels == []
+        return
+    assert {t.header.frame_id for t in wheels} == {"bot/base_link"}
+    assert len(wheels) == pytest.approx(2 * 50, abs=4)  # two wheels, 1 s at 50 Hz
+    drive = [m for m in states if "left_wheel_joint" in m.name and len(m.name) == 2]
+    angle = {(m.header.stamp.to_nsec(), n): p for m in drive for n, p in zip(m.name, m.position)}
+    checked = 0
+    for t in wheels:
+        side = t.child_frame_id.split("/")[1].split("_")[0]
+        a = angle.get((t.header.stamp.to_nsec(), f"{side}_wheel_joint"))
+        if a is None:
+            continue
+        tr, r = t.transform.translation, t.transform.rotation
+        y = 0.15 if side == "left" else -0.15
+        np.testing.assert_allclose([tr.x, tr.y, tr.z], [0.0, y, 0.0], atol=1e-9)
+        origin = np.array([np.cos(-np.pi / 4), np.sin(-np.pi / 4), 0.0, 0.0])  # rpy -90 0 0
+        spin = np.array([np.cos(a / 2), 0.0, 0.0, np.sin(a / 2)])  # about the axle, z
+        want = np.zeros(4)
+        mujoco.mju_mulQuat(want, origin, spin)
+        got = np.array([r.w, r.x, r.y, r.z])
+        assert min(np.abs(got - want).max(), np.abs(got + want).max()) < 1e-6, (got, want)
+        checked += 1
+    assert checked >= 90
+    assert max(abs(p) for p in angle.values()) > 3.0  # the wheels turned
 
 
 def test_world_services(sim):

@@ -17,6 +17,7 @@ from fleetsim.sim.plugins.base import (
     JointStateReading,
     OdometryReading,
     ScanReading,
+    TransformsReading,
 )
 from fleetsim.sim.queries import Contact
 
@@ -72,6 +73,21 @@ def odometry_tf(r: OdometryReading) -> geometry_msgs.TransformStamped:
         r.child_frame_id,
         _Transform(_Vector3(x, y, z), _Quaternion(qx, qy, qz, qw)),
     )
+
+
+def reading_tfs(r: TransformsReading) -> list[geometry_msgs.TransformStamped]:
+    out = []
+    for parent, child, pos, quat in r.transforms:
+        x, y, z = pos.tolist()
+        qx, qy, qz, qw = quat.tolist()
+        out.append(
+            _TransformStamped(
+                _Header(stamp(r.stamp), parent),
+                child,
+                _Transform(_Vector3(x, y, z), _Quaternion(qx, qy, qz, qw)),
+            )
+        )
+    return out
 
 
 _RANGES = sensor_msgs.LaserScan.__dict__["ranges"]  # the slot the dataclass keeps them in

@@ -25,6 +25,7 @@ from fleetsim.sim.plugins.base import (
     JointStateReading,
     OdometryReading,
     ScanReading,
+    TransformsReading,
 )
 from fleetsim.sim.plugins.camera import CameraPlugin
 from fleetsim.sim.plugins.laser import LaserPlugin
@@ -234,9 +235,13 @@ class Simulator(Node):
         off = self.offset
         for r in readings:
             r.stamp += off
-        tfs = [
-            conv.odometry_tf(r) for r in readings if isinstance(r, OdometryReading) and r.publish_tf
-        ]
+        tfs = []
+        for r in readings:
+            kind = type(r)
+            if kind is OdometryReading and r.publish_tf:
+                tfs.append(conv.odometry_tf(r))
+            elif kind is TransformsReading:
+                tfs.extend(conv.reading_tfs(r))
         if tfs:
             self.tf.send_transform(tfs)
         pubs = self._reading_pubs

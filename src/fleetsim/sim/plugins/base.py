@@ -267,6 +267,16 @@ class ImageReading:
 
 
 @dataclass
+class TransformsReading:
+    """Transforms for ``/tf`` (a diff drive's ``publishWheelTF``): (parent frame, child frame,
+    position (3,) m, quaternion (x, y, z, w)) each, frames with the tf_prefix applied."""
+
+    stamp: float
+    transforms: list[tuple[str, str, np.ndarray, np.ndarray]]
+    namespace: str = "/"
+
+
+@dataclass
 class JointStateReading:
     stamp: float
     topic: str

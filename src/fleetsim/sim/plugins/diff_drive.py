@@ -27,6 +27,8 @@ from fleetsim.sim.plugins.base import (
     DrivePlugin,
     OdometryReading,
     Plugin,
+    SensorPlugin,
+    TransformsReading,
     joint_addresses,
     register,
     require_joint,
@@ -58,7 +60,9 @@ class DiffDriveParams:
     )
     publishOdomTF: bool = param(True, help="broadcast odom -> base on /tf")
     publishTf: bool = param(True, help="legacy switch for publishOdomTF")
-    publishWheelTF: bool = param(False, help="unused")
+    publishWheelTF: bool = param(
+        False, help="broadcast each wheel's transform from its parent link on /tf at updateRate"
+    )
     publishWheelJointState: bool = param(
         False, help="publish the two wheels' joint states on joint_states at updateRate"
     )
@@ -260,17 +264,21 @@ class DiffDrivePlugin(WheeledDrive):
         """With ``publishWheelJointState``, a joint state publisher of the two wheels on
         ``joint_states`` at ``updateRate``, as gazebo_ros_diff_drive's (which publishes their
         positions; velocities and efforts come along here), so robot_state_publisher places
-        the wheels without a joint_state_publisher node (turtlebot3_gazebo's launch files)."""
+        the wheels without a joint_state_publisher node (turtlebot3_gazebo's launch files).
+        With ``publishWheelTF``, the wheels' transforms on ``/tf`` at the same rate."""
         p = self.params
-        if not p.publishWheelJointState:
-            return []
-        joints = {"jointName": f"{p.leftJoint}, {p.rightJoint}", "topicName": "joint_states"}
-        spec = replace(
-            self.spec,
-            name=f"{self.spec.name}/wheel_joint_states",
-            params={**joints, "updateRate": str(p.updateRate)},
-        )
-        return [JointStatePlugin(self.ctx, spec)]
+        out: list[Plugin] = []
+        if p.publishWheelJointState:
+            joints = {"jointName": f"{p.leftJoint}, {p.rightJoint}", "topicName": "joint_states"}
+            spec = replace(
+                self.spec,
+                name=f"{self.spec.name}/wheel_joint_states",
+                params={**joints, "updateRate": str(p.updateRate)},
+            )
+            out.append(JointStatePlugin(self.ctx, spec))
+        if p.publishWheelTF:
+            out.append(WheelTfPlugin(self, p.updateRate))
+        return out
 
     def bind(self, engine) -> None:
         super().bind(engine)
@@ -367,3 +375,51 @@ def _true_odometries(xpos, xquat, xmat, cvel, subtree_com, rootid, roots):
         out[i, 11] = r[1] * w0 + r[4] * w1 + r[7] * w2
         out[i, 12] = r[2] * w0 + r[5] * w1 + r[8] * w2
     return out
+
+
+@dataclass(frozen=True)
+class _NoParams:
+    pass
+
+
+class WheelTfPlugin(SensorPlugin):
+    """A diff drive's ``publishWheelTF``: each wheel link's transform from its joint's parent
+    link on ``/tf`` at the drive's ``updateRate``, as gazebo_ros_diff_drive broadcasts them
+    (its transform is the wheel's pose relative to the model, which is the parent link's
+    frame when the parent is the root; here it is the parent link's, as tf's tree needs)."""
+
+    Params = _NoParams  # the drive's parameters are used
+
+    def __init__(self, drive: DiffDrivePlugin, rate: float) -> None:
+        spec = replace(drive.spec, name=f"{drive.spec.name}/wheel_tf", params={})
+        super().__init__(drive.ctx, spec)
+        self.rate = rate
+        self.joints = [drive.params.leftJoint, drive.params.rightJoint]
+        joints = [drive.ctx.robot.joints[j] for j in self.joints]
+        self.frames = [(drive.ctx.frame(j.parent), drive.ctx.frame(j.child)) for j in joints]
+
+    @property
+    def update_rate(self) -> float:
+        return self.rate
+
+    def bind(self, engine) -> None:
+        m = engine.model
+        ids = [engine.joint_id(self.ctx.model, j) for j in self.joints]
+        self.qadr = [int(m.jnt_qposadr[j]) for j in ids]
+        self.axes = [m.jnt_axis[j].copy() for j in ids]
+        bodies = [int(m.jnt_bodyid[j]) for j in ids]
+        self.origins = [(m.body_pos[b].copy(), m.body_quat[b].copy()) for b in bodies]
+
+    def measure(self, engine, t: float) -> TransformsReading:
+        # from the joint angle, not the bodies' world poses: those are the kinematics of the
+        # step's start, one step behind the angle that the wheels' joint states report
+        q = engine.data.qpos
+        out = []
+        for (pf, cf), adr, axis, (pos, origin) in zip(
+            self.frames, self.qadr, self.axes, self.origins
+        ):
+            spin, quat = np.empty(4), np.empty(4)
+            mujoco.mju_axisAngle2Quat(spin, axis, q[adr])
+            mujoco.mju_mulQuat(quat, origin, spin)
+            out.append((pf, cf, pos.copy(), quat[[1, 2, 3, 0]]))
+        return TransformsReading(t, out, self.ctx.namespace)

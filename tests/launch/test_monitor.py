@@ -146,6 +146,51 @@ def test_a_goal_in_an_unknown_frame_is_not_confirmed(robot_session):
     assert not s.monitor.success()
 
 
+def test_a_goal_in_the_robots_own_slam_map_is_placed_by_its_estimate_and_checked(robot_session):
+    """A goal in ``lizi1/map`` (the robot's own gmapping map, started wherever it stood: here
+    a map -> odom turned 90 degrees and shifted) has no transform to the world. It is placed
+    where the robot's estimate put it when given, and arriving is checked by ground truth:
+    0.2 m from the estimate confirms, 3 m does not."""
+    import math
+
+    from fleetsim.tf import StaticTransformBroadcaster, make_transform_stamped
+
+    s, (goal_pub, result_pub) = robot_session
+    mb = move_base_msgs.MoveBase
+    # given before gmapping's first map -> odom: placed once the transform comes
+    goal_pub.publish(action_goal("early", 0.0, 0.0, frame="lizi1/map"))
+    s.runtime.run(duration=0.2)
+    assert {r.namespace: r for r in s.monitor.results()}["/lizi1"].goal is None
+    slam = Node(s.runtime, "slam_gmapping", "/lizi1")
+    half = math.sqrt(0.5)
+    StaticTransformBroadcaster(slam).send_transform(
+        make_transform_stamped("lizi1/map", "lizi1/odom", 0.0, (3.0, -1.0, 0.0), (0, 0, half, half))
+    )
+    s.runtime.run(duration=0.2)
+    assert {r.namespace: r for r in s.monitor.results()}["/lizi1"].goal is not None
+    est = s.runtime.tf_buffer.lookup_transform("lizi1/map", "lizi1/base_link", 0.0)
+    ex, ey = est.transform.translation.x, est.transform.translation.y
+    q = est.transform.rotation
+    yaw_est = 2 * math.atan2(q.z, q.w)
+    pos, (w, _, _, z) = s.monitor.sim.engine.model_pose("lizi1")
+    yaw_true = 2 * math.atan2(z, w)
+    for goal_id, (dx, dy) in (("near", (0.2, 0.0)), ("far", (0.0, 3.0))):
+        goal_pub.publish(action_goal(goal_id, ex + dx, ey + dy, frame="lizi1/map"))
+        s.runtime.run(duration=0.1)
+        r = {r.namespace: r for r in s.monitor.results()}["/lizi1"]
+        turn = yaw_true - yaw_est  # the frame's heading in the world
+        want = (
+            pos[0] + math.cos(turn) * dx - math.sin(turn) * dy,
+            pos[1] + math.sin(turn) * dx + math.cos(turn) * dy,
+        )
+        assert r.goal == pytest.approx(want, abs=0.01)
+        result_pub.publish(mb.ActionResult(status=status(goal_id, 3, "Goal reached.")))
+        s.runtime.run(duration=0.1)
+    r = {r.namespace: r for r in s.monitor.results()}["/lizi1"]
+    assert (r.goals_sent, r.goals_reached, r.goals_unconfirmed) == (3, 1, 1)
+    assert r.last_text == "reported reached, 3.0 m away by ground truth"
+
+
 def test_the_localization_error_compares_map_to_base_with_ground_truth(robot_session):
     """A localizer that is 0.5 m off (here a static map -> odom) shows as a 0.5 m error."""
     from fleetsim.tf import StaticTransformBroadcaster, make_transform_stamped

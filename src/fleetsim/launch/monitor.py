@@ -37,7 +37,7 @@ from fleetsim.errors import FleetsimError
 from fleetsim.launch.model import LaunchPlan
 from fleetsim.msgs import actionlib_msgs, gazebo_msgs, move_base_msgs
 from fleetsim.runtime import names
-from fleetsim.tf.transforms import transform_points
+from fleetsim.tf.transforms import compose_transforms, inverse_transform, transform_points
 
 SAMPLE_PERIOD = 0.1  # s of sim time between ground-truth samples
 #: a contact with the same partner within this long of the last one is the same collision
@@ -104,6 +104,11 @@ class RobotResult:
     #: m, map -> base tf against ground truth, where a localizer publishes map (else None)
     localization_error: float | None = None
     goals_by_id: dict[str, tuple[float, float] | None] = field(default_factory=dict, repr=False)
+    #: goals whose frame did not resolve when given (id -> target pose), tried again each
+    #: sample: a SLAM map's transform comes with the first processed scan
+    unresolved: dict[str, Any] = field(default_factory=dict, repr=False)
+    #: the id of the latest goal
+    goal_id: str = ""
     #: the ids of the failed goals, in order
     failed_ids: list[str] = field(default_factory=list, repr=False)
 
@@ -177,11 +182,14 @@ class RunMonitor:
 
     def _on_goal(self, r: RobotResult, msg) -> None:
         r.goals_sent += 1
-        r.goal = self._goal_in_map(msg.goal.target_pose)
+        r.goal_id = msg.goal_id.id
+        r.goal = self._goal_in_map(msg.goal.target_pose, r.namespace)
         r.goals_by_id[msg.goal_id.id] = r.goal
+        if r.goal is None:
+            r.unresolved[msg.goal_id.id] = msg.goal.target_pose
         r.goal_tolerance = self._goal_tolerance(r.namespace) + GOAL_MARGIN
 
-    def _goal_in_map(self, target) -> tuple[float, float] | None:
+    def _goal_in_map(self, target, ns: str) -> tuple[float, float] | None:
         """The goal's x, y in the map (= world) frame, or None if its frame does not resolve."""
         p = target.pose.position
         frame = target.header.frame_id.lstrip("/")
@@ -190,10 +198,49 @@ class RunMonitor:
         try:
             tf = self.tf.lookup_transform("map", frame, 0.0).transform
         except FleetsimError:
-            return None
+            return self._goal_by_estimate(ns, frame, (float(p.x), float(p.y)))
         t, q = tf.translation, tf.rotation
         x, y = transform_points((t.x, t.y, t.z), (q.x, q.y, q.z, q.w), [[p.x, p.y]])[0]
         return (float(x), float(y))
+
+    def _goal_by_estimate(
+        self, ns: str, frame: str, xy: tuple[float, float]
+    ) -> tuple[float, float] | None:
+        """A goal in a frame with no transform to the world, a robot's own SLAM map
+        (``lizi1/map``, which gmapping starts wherever the robot is): placed in the world where
+        the robot's estimate put it when the goal was given (the transform that makes the
+        robot's pose in ``frame`` its true pose, now). Arriving there is then checked by ground
+        truth as any goal is, so drift of the robot's estimate on the way still shows. None
+        when the frame is not in the robot's tf tree or no simulator runs here."""
+        if self.sim is None:
+            return None
+        entry = self.sim.engine.models.get(self._robot_models().get(ns, ""))
+        if entry is None or entry.robot is None:
+            return None
+        root = entry.robot.root_link()
+        base = f"{entry.tf_prefix}/{root}" if entry.tf_prefix else root
+        try:
+            tf = self.tf.lookup_transform(frame, base, 0.0).transform
+        except FleetsimError:
+            return None
+        t, q = tf.translation, tf.rotation
+        base_in_frame = ((t.x, t.y, t.z), (q.x, q.y, q.z, q.w))
+        pos, (w, x, y, z) = self.sim.engine.model_pose(entry.name)
+        frame_in_world = compose_transforms(pos, (x, y, z, w), *inverse_transform(*base_in_frame))
+        gx, gy = transform_points(*frame_in_world, [list(xy)])[0]
+        return (float(gx), float(gy))
+
+    def _resolve(self, r: RobotResult) -> None:
+        """Place the goals whose frames had no transform when they were given, now that
+        they may have (tf's patience, as move_base's own)."""
+        for goal_id, target in list(r.unresolved.items()):
+            xy = self._goal_in_map(target, r.namespace)
+            if xy is None:
+                continue
+            del r.unresolved[goal_id]
+            r.goals_by_id[goal_id] = xy
+            if goal_id == r.goal_id:
+                r.goal = xy
 
     def _goal_tolerance(self, ns: str) -> float:
         """``xy_goal_tolerance`` of the robot's move_base local planner, from the parameters."""
@@ -211,6 +258,8 @@ class RunMonitor:
 
     def _on_result(self, r: RobotResult, msg) -> None:
         S = actionlib_msgs.GoalStatus
+        self._resolve(r)
+        r.unresolved.pop(msg.status.goal_id.id, None)
         goal = r.goals_by_id.pop(msg.status.goal_id.id, r.goal)
         r.last_text = msg.status.text
         if msg.status.status == S.SUCCEEDED:
@@ -326,6 +375,8 @@ class RunMonitor:
         for ns, model in models.items():
             self._watch(ns)  # a spawned robot's move_base may live in another process
             r = self.robots[ns]
+            if r.unresolved:
+                self._resolve(r)
             r.model = model
             pos, _ = engine.model_pose(model)
             x, y = float(pos[0]), float(pos[1])

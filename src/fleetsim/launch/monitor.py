@@ -212,20 +212,13 @@ class RunMonitor:
         robot's pose in ``frame`` its true pose, now). Arriving there is then checked by ground
         truth as any goal is, so drift of the robot's estimate on the way still shows. None
         when the frame is not in the robot's tf tree or no simulator runs here."""
-        if self.sim is None:
+        found = self._base_in(frame, ns)
+        if found is None:
             return None
-        entry = self.sim.engine.models.get(self._robot_models().get(ns, ""))
-        if entry is None or entry.robot is None:
-            return None
-        root = entry.robot.root_link()
-        base = f"{entry.tf_prefix}/{root}" if entry.tf_prefix else root
-        try:
-            tf = self.tf.lookup_transform(frame, base, 0.0).transform
-        except FleetsimError:
-            return None
+        model, tf = found
         t, q = tf.translation, tf.rotation
         base_in_frame = ((t.x, t.y, t.z), (q.x, q.y, q.z, q.w))
-        pos, (w, x, y, z) = self.sim.engine.model_pose(entry.name)
+        pos, (w, x, y, z) = self.sim.engine.model_pose(model)
         frame_in_world = compose_transforms(pos, (x, y, z, w), *inverse_transform(*base_in_frame))
         gx, gy = transform_points(*frame_in_world, [list(xy)])[0]
         return (float(gx), float(gy))
@@ -343,18 +336,27 @@ class RunMonitor:
 
     def _localization_error(self, ns: str, truth: tuple[float, float]) -> float | None:
         """Distance between the map -> base tf and ground truth (None without a map frame)."""
+        found = self._base_in("map", ns)
+        if found is None:
+            return None
+        t = found[1].translation
+        return math.hypot(t.x - truth[0], t.y - truth[1])
+
+    def _base_in(self, frame: str, ns: str) -> tuple[str, Any] | None:
+        """The model of robot namespace ``ns`` and the latest transform of its root link in
+        ``frame`` (the robot's estimate there); None without a simulator here, the robot or
+        the transform."""
         if self.sim is None:
             return None
         entry = self.sim.engine.models.get(self._robot_models().get(ns, ""))
         if entry is None or entry.robot is None:
             return None
         root = entry.robot.root_link()
-        frame = f"{entry.tf_prefix}/{root}" if entry.tf_prefix else root
+        base = f"{entry.tf_prefix}/{root}" if entry.tf_prefix else root
         try:
-            t = self.tf.lookup_transform("map", frame, 0.0).transform.translation
+            return entry.name, self.tf.lookup_transform(frame, base, 0.0).transform
         except FleetsimError:
             return None
-        return math.hypot(t.x - truth[0], t.y - truth[1])
 
     def _robot_models(self) -> dict[str, str]:
         engine = self.sim.engine

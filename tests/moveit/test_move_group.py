@@ -287,3 +287,92 @@ def test_stop_start_deviation_and_the_plan_service(one):
     np.testing.assert_allclose(
         pts[-1].positions, list(arm.get_named_target_values("cam_left").values()), atol=1e-9
     )
+
+
+def test_a_new_goal_preempts_the_running_one_and_runs_itself(one):
+    """The manual's manipulation unit sends a pose every 5 s whether the last is done or not:
+    the running goal ends PREEMPTED (MoveIt's code -7), the new one runs to SUCCESS with its
+    own result, and move_group goes on serving (it had answered the new goal PREEMPTED, run it
+    anyway, then died ending a goal no longer active)."""
+    arm = MoveGroupCommander("arm_group", ns="/hunter1", runtime=one.rt)
+    assert arm.go("home")
+    arm.go("cam_left", wait=False)
+    first = arm._last
+    one.rt.run(1.0)
+    assert first.result is None  # still moving
+    assert arm.go("cam_right")
+    assert first.result is not None and first.result.error_code.val == E.PREEMPTED
+    assert "another goal" in first.text or "new goal" in first.text
+    assert arm.last_result()[0].error_code.val == E.SUCCESS
+    np.testing.assert_allclose(
+        arm.get_current_joint_values(),
+        list(arm.get_named_target_values("cam_right").values()),
+        atol=0.02,
+    )
+    one.rt.run(3.0)  # nothing left running to end a goal that is gone
+    assert arm.go("home")
+
+
+def test_a_goal_already_met_succeeds_without_moving(one):
+    """Going where the arm already is (a named pose twice, the current joint values, a pose
+    target at the current pose): SUCCESS with MoveIt's "already met", nothing executed; a move
+    a hair from where it stands is timed (toppra found no profile below ~5e-5 rad)."""
+    arm = MoveGroupCommander("arm_group", ns="/hunter1", runtime=one.rt)
+    assert arm.go("cam_left")
+    for target in ("cam_left", arm.get_current_joint_values()):
+        assert arm.go(target), arm.last_result()
+        result, text = arm.last_result()
+        assert text == "Requested path and goal constraints are already met."
+        assert not result.planned_trajectory.joint_trajectory.points
+    ok, traj, _, _ = arm.plan(arm.get_current_joint_values())
+    assert ok and not traj.joint_trajectory.points and arm.execute(traj)
+    arm.set_goal_position_tolerance(0.01)
+    arm.set_position_target(
+        [getattr(arm.get_current_pose().pose.position, k) for k in ("x", "y", "z")]
+    )
+    assert arm.go() and "already met" in arm.last_result()[1]
+    arm.set_goal_joint_tolerance(0.0)
+    for delta in (1e-6, 5e-5, 5e-4):
+        q = np.array(arm.get_current_joint_values())
+        q[0] += delta
+        assert arm.go(list(q)), (delta, arm.last_result())
+        assert arm.last_result()[0].planned_trajectory.joint_trajectory.points
+
+
+def test_joint_limits_yaml_values_are_checked_when_move_group_starts(hunter_robot, caplog):
+    """``max_velocity: '0.2 rad/s'`` crashed the first plan with a bare ValueError; now
+    move_group refuses to start, naming the joint, the key and the value."""
+    from fleetsim.errors import PlanningError
+
+    rt = Runtime()
+    load_hunter_params(rt, "/hunter1", hunter_robot)
+    rt.params.set("/hunter1/robot_description_planning/joint_limits/arm_joint_02/max_velocity",
+                  "0.2 rad/s")  # fmt: skip
+    with pytest.raises(PlanningError, match="arm_joint_02/max_velocity: '0.2 rad/s' is not a"):
+        MoveGroup(rt, "move_group", "/hunter1")
+    rt = Runtime()
+    load_hunter_params(rt, "/hunter1", hunter_robot)
+    rt.params.set("/hunter1/robot_description_planning/joint_limits/arm_joint_02/max_velocty", 0.3)
+    rt.params.set("/hunter1/robot_description_planning/default_velocity_scaling_factor", 0.0)
+    with caplog.at_level(logging.WARNING):
+        MoveGroup(rt, "move_group", "/hunter1")
+    assert "max_velocty is not a joint limit; ignored (did you mean 'max_velocity'?)" in caplog.text
+    assert "default_velocity_scaling_factor is 0, outside (0, 1]" in caplog.text
+
+
+def test_execute_of_plans_tuple_and_a_commander_for_a_links_only_group(one):
+    """``arm.execute(arm.plan())`` (the Melodic idiom; plan() returns a tuple since Noetic)
+    says what to pass, before sending anything; the SRDF's ``ee`` group (a link, no joints)
+    gets a commander with no joints and its link as end effector, and refuses to plan."""
+    arm = MoveGroupCommander("arm_group", ns="/hunter1", runtime=one.rt)
+    arm.set_named_target("home")
+    plan = arm.plan()
+    with pytest.raises(MoveItCommanderException, match=r"execute\(plan\[1\]\)"):
+        arm.execute(plan)
+    with pytest.raises(MoveItCommanderException, match="got str"):
+        arm.execute("home")
+    assert arm.execute(plan[1])
+    ee = MoveGroupCommander("ee", ns="/hunter1", runtime=one.rt)
+    assert ee.get_active_joints() == [] and ee.get_end_effector_link() == "cluedo_link"
+    assert not ee.go([])
+    assert ee.last_result()[0].error_code.val == E.INVALID_GROUP_NAME

@@ -17,7 +17,7 @@ import numpy as np
 
 from fleetsim.errors import PlanningError
 from fleetsim.moveit.goal_constraints import joint_goal, pose_goal
-from fleetsim.msgs import geometry_msgs, moveit_msgs, std_msgs
+from fleetsim.msgs import geometry_msgs, moveit_msgs, std_msgs, trajectory_msgs
 from fleetsim.runtime import Node
 from fleetsim.runtime import names as rnames
 from fleetsim.tf.quaternions import quaternion_from_euler
@@ -356,8 +356,17 @@ class MoveGroupCommander:
 
     def execute(self, plan_msg, wait: bool = True) -> bool:
         traj = plan_msg
-        if not isinstance(plan_msg, moveit_msgs.RobotTrajectory):
+        if isinstance(plan_msg, tuple):
+            raise MoveItCommanderException(
+                "execute() takes a RobotTrajectory; plan() returns (success, trajectory, "
+                "planning_time, error_code) since MoveIt 1.1 (Noetic): execute(plan[1])"
+            )
+        if isinstance(plan_msg, trajectory_msgs.JointTrajectory):
             traj = moveit_msgs.RobotTrajectory(joint_trajectory=plan_msg)
+        elif not isinstance(plan_msg, moveit_msgs.RobotTrajectory):
+            raise MoveItCommanderException(
+                f"Expected value of type RobotTrajectory, got {type(plan_msg).__name__}"
+            )
         h = self._send(self._exec, moveit_msgs.ExecuteTrajectoryGoal(trajectory=traj), wait)
         self._last = h
         return not wait or (h.result is not None and h.result.error_code.val == E.SUCCESS)

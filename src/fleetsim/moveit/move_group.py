@@ -29,7 +29,7 @@ from fleetsim.moveit.execution import ExecutionManager
 from fleetsim.moveit.kinematics_services import compute_cartesian_path, compute_fk, compute_ik
 from fleetsim.moveit.pipeline import PlanFailure, PlanningPipeline
 from fleetsim.moveit.robot_model import RobotModel
-from fleetsim.msgs import moveit_msgs, sensor_msgs, shape_msgs, std_msgs
+from fleetsim.msgs import moveit_msgs, sensor_msgs, shape_msgs, std_msgs, trajectory_msgs
 from fleetsim.runtime import Node, param
 
 E = moveit_msgs.MoveItErrorCodes
@@ -207,7 +207,12 @@ class MoveGroup(Node):
         res.trajectory_start.joint_state.position = start
         res.trajectory, res.planning_time = plan.trajectory, plan.planning_time
         res.error_code.val = E.SUCCESS
-        if plan.planner:
+        if not plan.trajectory.joint_trajectory.points:
+            self.get_logger().info(
+                "%s: goal constraints are already satisfied; no need to plan or execute any "
+                "motions", req.group_name,
+            )  # fmt: skip
+        elif plan.planner:
             self.get_logger().info(
                 "%s: geometric::%s found a path in %.1f ms (%.1f ms with goal and timing)",
                 req.group_name, plan.planner, 1e3 * plan.path_time, 1e3 * plan.planning_time,
@@ -230,8 +235,41 @@ class MoveGroup(Node):
         return moveit_msgs.GetMotionPlanResponse(motion_plan_response=res)
 
     # ------------------------------------------------------------------ actions
+    def _accept(self, server):
+        """Accept ``server``'s pending goal, as the simple action server does, ending the one
+        it replaces PREEMPTED with MoveIt's code (its trajectory stopped first); returns the
+        goal message and its server-side handle, to which the goal's `_finisher` is bound."""
+        if server.is_active():
+            self.execution.stop("preempted by a new goal", E.PREEMPTED)
+        if server.is_active():  # planned only, or its execution already over
+            r = server.type.Result()
+            r.error_code.val = E.PREEMPTED
+            server.set_preempted(
+                r,
+                "This goal was canceled because another goal was received by the simple "
+                "action server",
+            )
+        return server.accept_new_goal(), server.current
+
+    def _finisher(self, server, handle, result):
+        """``done(code, why)`` for the trajectory of goal ``handle``: ends that goal with
+        ``result`` (its error code set), and nothing once another goal has replaced it."""
+
+        def done(code, why):
+            if server.current is not handle or not server.is_active():
+                return
+            result.error_code.val = code
+            if code == E.SUCCESS:
+                server.set_succeeded(result, "Solution was found and executed.")
+            elif code == E.PREEMPTED:
+                server.set_preempted(result, why)
+            else:
+                server.set_aborted(result, why)
+
+        return done
+
     def _on_move_goal(self) -> None:
-        goal = self.move_action.accept_new_goal()
+        goal, handle = self._accept(self.move_action)
         if goal.planning_options.planning_scene_diff.is_diff:
             self._apply(goal.planning_options.planning_scene_diff)
         res, text = self.plan(goal.request)
@@ -244,34 +282,32 @@ class MoveGroup(Node):
                 result, text or "No motion plan found. No execution attempted."
             )
             return
+        if not res.trajectory.joint_trajectory.points:  # MoveIt's words for nothing to do
+            self.move_action.set_succeeded(
+                result, "Requested path and goal constraints are already met."
+            )
+            return
         if goal.planning_options.plan_only or not self.params.allow_trajectory_execution:
             self.move_action.set_succeeded(result, "Motion plan was computed successfully.")
             return
+        finish = self._finisher(self.move_action, handle, result)
 
         def done(code, why):
-            result.error_code.val = code
             if code == E.SUCCESS:
                 result.executed_trajectory = res.trajectory
-                self.move_action.set_succeeded(result, "Solution was found and executed.")
-            elif self.move_action.is_active():
-                self.move_action.set_aborted(result, why)
+            finish(code, why)
 
         self.execution.execute(res.trajectory, self.joint_positions, done)
 
     def _on_exec_goal(self) -> None:
-        goal = self.exec_action.accept_new_goal()
-
-        def done(code, why):
-            if not self.exec_action.is_active():
-                return
-            r = moveit_msgs.ExecuteTrajectoryResult()
-            r.error_code.val = code
-            if code == E.SUCCESS:
-                self.exec_action.set_succeeded(r, "Solution was found and executed.")
-            else:
-                self.exec_action.set_aborted(r, why)
-
-        self.execution.execute(goal.trajectory, self.joint_positions, done)
+        goal, handle = self._accept(self.exec_action)
+        result = moveit_msgs.ExecuteTrajectoryResult()
+        done = self._finisher(self.exec_action, handle, result)
+        traj = getattr(goal, "trajectory", None)
+        if not isinstance(getattr(traj, "joint_trajectory", None), trajectory_msgs.JointTrajectory):
+            done(E.INVALID_MOTION_PLAN, f"the goal's trajectory is not a RobotTrajectory: {traj!r}")
+            return
+        self.execution.execute(traj, self.joint_positions, done)
 
     def _preempt(self, server) -> None:
         if server.next is None and server.is_active():

@@ -122,6 +122,19 @@ class PlanningPipeline:
             E.INVALID_GOAL_CONSTRAINTS, "the goal has no joint, position or orientation constraint"
         )
 
+    @staticmethod
+    def _already_met(ctx: GroupContext, c, start: np.ndarray, goal: np.ndarray) -> bool:
+        """Whether ``start`` satisfies the goal constraints ``c``: every joint within its
+        constraint's tolerances, or for a pose goal the IK's first seed, the start itself,
+        already within the goal's tolerance (the IK returns it unchanged)."""
+        if not c.joint_constraints:
+            return bool(np.array_equal(goal, start))
+        for jc in c.joint_constraints:
+            d = start[ctx.joints.index(jc.joint_name)] - jc.position
+            if not -abs(jc.tolerance_below) - 1e-12 <= d <= abs(jc.tolerance_above) + 1e-12:
+                return False
+        return True
+
     def _pose_goal(self, ctx: GroupContext, c, start: np.ndarray) -> np.ndarray:
         """Joint values for a position constraint, with an orientation constraint on the same
         link if one is given (MoveIt's pose goal), through IK."""
@@ -218,6 +231,12 @@ class PlanningPipeline:
         if not req.goal_constraints:
             raise PlanFailure(E.INVALID_GOAL_CONSTRAINTS, "the request has no goal constraints")
         goal = self.goal_from_constraints(ctx, req.goal_constraints[0], start)
+        if self._already_met(ctx, req.goal_constraints[0], start, goal):
+            # move_group: "Goal constraints are already satisfied. No need to plan or execute
+            # any motions" (an empty trajectory; timing a zero-length path fails in toppra)
+            empty = moveit_msgs.RobotTrajectory()
+            empty.joint_trajectory.joint_names = list(ctx.joints)
+            return PlanResult(empty, time.perf_counter() - t0, "", 0.0, "")
         vs = _scaling(req.max_velocity_scaling_factor)
         acs = _scaling(req.max_acceleration_scaling_factor)
         planner = req.planner_id or self.default_planner.get(ctx.group) or "RRTConnect"

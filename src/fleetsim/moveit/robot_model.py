@@ -8,6 +8,7 @@ acceleration limit gets MoveIt's default of 1 rad/s^2.
 
 from __future__ import annotations
 
+import logging
 import math
 from dataclasses import dataclass
 
@@ -19,6 +20,64 @@ from fleetsim.errors import PlanningError, did_you_mean
 DEFAULT_ACCELERATION = 1.0  # rad/s^2: MoveIt's DEFAULT_ACCEL_MAX for joints without a limit
 DEFAULT_VELOCITY = 1.0  # rad/s: DEFAULT_VEL_MAX
 MOVABLE = ("revolute", "continuous", "prismatic")
+SCALING_KEYS = ("default_velocity_scaling_factor", "default_acceleration_scaling_factor")
+#: joint_limits.yaml's keys (joint_limits_interface's getJointLimits) and their kinds
+LIMIT_KEYS = {
+    "has_position_limits": bool,
+    "min_position": float,
+    "max_position": float,
+    "has_velocity_limits": bool,
+    "max_velocity": float,
+    "has_acceleration_limits": bool,
+    "max_acceleration": float,
+    "has_jerk_limits": bool,
+    "max_jerk": float,
+    "has_effort_limits": bool,
+    "max_effort": float,
+    "angle_wraparound": bool,
+    "has_soft_limits": bool,
+    "k_position": float,
+    "k_velocity": float,
+    "soft_lower_limit": float,
+    "soft_upper_limit": float,
+}
+_log = logging.getLogger("fleetsim.moveit")
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)
+
+
+def _set_at(values, key: str) -> str:
+    origin = (getattr(values, "origins", None) or {}).get(key)
+    return f" (set at {origin})" if origin else ""
+
+
+def _checked_limits(joint: str, joint_limits) -> dict:
+    """A joint's joint_limits.yaml entry, each value of the kind getJointLimits reads: a bad
+    one (``max_velocity: '0.2 rad/s'``) is an error naming it and where it was set, when
+    move_group starts, not at the first plan; a key it does not read is warned about (it would
+    be ignored), with the nearest it does."""
+    entry = joint_limits.get(joint) or {}
+    base = f"robot_description_planning/joint_limits/{joint}"
+    if not isinstance(entry, dict):
+        raise PlanningError(f"{base}{_set_at(joint_limits, joint)}: {entry!r} is not a mapping")
+    for key, v in entry.items():
+        kind = LIMIT_KEYS.get(key)
+        where = f"{base}/{key}{_set_at(entry, key)}"
+        if kind is None:
+            _log.warning("%s is not a joint limit; ignored%s", where, did_you_mean(key, LIMIT_KEYS))
+        elif kind is bool and not isinstance(v, bool):
+            raise PlanningError(f"{where}: {v!r} is not true or false")
+        elif kind is float and not _is_number(v):
+            raise PlanningError(f"{where}: {v!r} is not a number")
+    for flag, key in (
+        ("has_velocity_limits", "max_velocity"),
+        ("has_acceleration_limits", "max_acceleration"),
+    ):
+        if entry.get(flag) and key not in entry:
+            raise PlanningError(f"{base}: {flag} is true but {key} is not given")
+    return entry
 
 
 @dataclass(frozen=True)
@@ -46,7 +105,16 @@ class RobotModel:
                     f"robot_description_planning/joint_limits: joint '{j}' is not in the URDF"
                     f"{did_you_mean(j, robot.joints)}"
                 )
-        self.joint_limits = joint_limits
+        self.joint_limits = {j: _checked_limits(j, joint_limits) for j in joint_limits}
+        for key in SCALING_KEYS:
+            v = self.planning.get(key)
+            if v is None:
+                continue
+            where = f"robot_description_planning/{key}{_set_at(self.planning, key)}"
+            if not _is_number(v):
+                raise PlanningError(f"{where}: {v!r} is not a number")
+            if not 0 < float(v) <= 1:
+                _log.warning("%s is %g, outside (0, 1]: planning at full speed (1.0)", where, v)
 
     @property
     def group_names(self) -> list[str]:
@@ -83,7 +151,10 @@ class RobotModel:
         g = self.srdf.groups[self.check_group(group)]
         if g.chains:
             return g.chains[-1][1]
-        return self.robot.joints[self.active_joints(group)[-1]].child
+        joints = self.active_joints(group)
+        if joints:
+            return self.robot.joints[joints[-1]].child
+        return g.links[-1] if g.links else ""  # a group of links only (an end effector's)
 
     def end_effector_link(self, group: str) -> str:
         """MoveIt's rule: an end effector whose parent group is ``group`` gives its group's

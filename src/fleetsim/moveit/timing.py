@@ -15,6 +15,9 @@ import numpy as np
 from fleetsim.errors import PlanningError
 
 SAMPLE_PERIOD = 0.1  # s between output points
+#: rad of joint-space length below which a straight move is timed in closed form: toppra's
+#: solver finds no profile for a path of ~5e-5 rad (a goal a hair from where the arm stands)
+TINY_MOTION = 1e-3
 logging.getLogger("toppra").setLevel(logging.WARNING)  # it logs every parameterisation at INFO
 
 
@@ -43,12 +46,14 @@ def time_parameterize(
         return np.zeros(1), path[:1].copy(), z, z.copy()
     # the path parameter is the cumulative joint-space length, so segments keep their shape
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
+    vmax = np.asarray(max_velocity, float) * velocity_scaling
+    amax = np.asarray(max_acceleration, float) * acceleration_scaling
+    if len(path) == 2 and s[-1] < TINY_MOTION:
+        return _tiny_motion(path, vmax, amax)
     spline = ta.SplineInterpolator(s / s[-1], path) if len(path) > 2 else None
     if spline is None:  # two points: a straight line (toppra's spline needs three)
         mid = 0.5 * (path[0] + path[1])
         spline = ta.SplineInterpolator([0.0, 0.5, 1.0], np.array([path[0], mid, path[1]]))
-    vmax = np.asarray(max_velocity, float) * velocity_scaling
-    amax = np.asarray(max_acceleration, float) * acceleration_scaling
     cons = [
         constraint.JointVelocityConstraint(np.stack([-vmax, vmax], axis=1)),
         constraint.JointAccelerationConstraint(np.stack([-amax, amax], axis=1)),
@@ -65,3 +70,21 @@ def time_parameterize(
     pos[0], pos[-1] = path[0], path[-1]
     vel[0] = vel[-1] = 0.0
     return t, pos, vel, acc
+
+
+def _tiny_motion(path: np.ndarray, vmax: np.ndarray, amax: np.ndarray):
+    """A straight move of less than `TINY_MOTION`, timed in closed form: accelerate for half
+    the time and brake for the other half, the duration the longest any joint needs within
+    its acceleration and (peak) velocity limits."""
+    delta = np.abs(path[1] - path[0])
+    T = float(np.max(np.maximum(2 * np.sqrt(delta / amax), 2 * delta / vmax)))
+    n = max(3, int(np.ceil(T / SAMPLE_PERIOD)) + 1)
+    t = np.linspace(0.0, T, n)
+    x = t / T
+    u = np.where(x <= 0.5, 2 * x**2, 1 - 2 * (1 - x) ** 2)
+    du = np.where(x <= 0.5, 4 * x, 4 * (1 - x)) / T
+    ddu = np.where(x < 0.5, 4.0, -4.0) / T**2
+    step = path[1] - path[0]
+    pos = path[0] + u[:, None] * step
+    pos[-1] = path[1]
+    return t, pos, du[:, None] * step, ddu[:, None] * step

@@ -78,3 +78,41 @@ def test_two_hunters_in_two_namespaces():
             s.runtime.graph.nodes["/hunter1/controller_manager"]
             is not s.runtime.graph.nodes["/hunter2/controller_manager"]
         )
+
+
+def test_run2_refuses_a_misspelt_sim_type_and_amcl_replaces_the_nav_stack():
+    """``sim_type:=gazbo`` had started nothing and run on in silence; ``launch_amcl:=true``
+    alone had been ignored (gmapping ran, no amcl) unless the nav stack was also turned off;
+    an SDF world given to map_server says it needs a map YAML."""
+    from fleetsim.errors import FleetsimError
+    from fleetsim.nav.map_io import MapError, load_map
+
+    with pytest.raises(FleetsimError, match="allowed values: gazebo, rviz, gazeborviz"):
+        load_plan(PKG / "launch" / "run2.launch", {"sim_type": "gazbo"})
+    plan = load_plan(PKG / "launch" / "run2.launch", {"launch_amcl": "true"})
+    types = {(n.pkg, n.type) for n in plan.nodes}
+    assert ("amcl", "amcl") in types and ("map_server", "map_server") in types
+    assert ("gmapping", "slam_gmapping") not in types
+    assert [t for t in types if t == ("move_base", "move_base")] == [("move_base", "move_base")]
+    plan = load_plan(PKG / "launch" / "run2.launch", {})
+    assert ("gmapping", "slam_gmapping") in {(n.pkg, n.type) for n in plan.nodes}
+    from fleetsim.description.packages import ASSET_ROBOTS
+
+    world = ASSET_ROBOTS.parent / "worlds" / "example.world"
+    assert world.is_file()
+    with pytest.raises(MapError, match="needs a map YAML .* not a .world file"):
+        load_map(world)
+
+
+def test_a_launch_file_that_starts_no_node_is_warned_about(tmp_path, caplog):
+    """The manual's own run2.launch with a misspelt sim_type (no <choice> there): every group
+    is skipped, and roslaunch runs on without a word."""
+    f = tmp_path / "nothing.launch"
+    f.write_text(
+        '<launch><arg name="sim_type" default="gazbo"/>'
+        "<group if=\"$(eval sim_type == 'gazebo')\">"
+        '<node pkg="gazebo_ros" type="gzserver" name="gazebo"/></group></launch>'
+    )
+    with caplog.at_level(logging.WARNING), LaunchSession(load_plan(f), seed=1):
+        pass
+    assert "the launch file starts no node" in caplog.text

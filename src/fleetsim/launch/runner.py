@@ -86,6 +86,13 @@ class LaunchSession:
             _log.info(note)
         for spec in self.plan.nodes:
             self._start_node(spec)
+        if not self.plan.nodes and self.connect is None:
+            # roslaunch runs such a file without a word; mostly it is an if/unless whose
+            # argument was misspelt (a sim_type no group matches)
+            _log.warning(
+                "the launch file starts no node: check its if/unless conditions and the "
+                "arguments they read"
+            )
         self.monitor = RunMonitor(rt, self.plan, self.nodes)
         if self.listen is not None and self.connect is None:
             from fleetsim.transport import ZenohBridge

@@ -158,6 +158,12 @@ def _check_resolution(resolution: object, where: str) -> None:
 def load_map(yaml_path: str | Path) -> OccupancyMap:
     """Load a map YAML and its image as map_server does (image path relative to the YAML)."""
     path = Path(yaml_path)
+    if path.suffix.lower() in (".world", ".sdf", ".xml", ".launch", ".urdf", ".xacro"):
+        raise MapError(
+            f"{path}: map_server needs a map YAML (image, resolution, origin, ...), not a "
+            f"{path.suffix} file; a Gazebo world has no map: make one with gmapping and "
+            "map_saver, or give the map the world was made from"
+        )
     try:
         doc = yaml.safe_load(path.read_text())
     except FileNotFoundError:

@@ -155,6 +155,28 @@ def test_a_sender_that_is_not_done_fails_the_run():
     assert monitor.senders_failed() == ["/s"] and not monitor.success()
 
 
+def test_a_follower_keeps_a_goal_run_going_and_is_no_failure():
+    """follow_marker streams move_base_simple goals for as long as the run lasts: its first
+    goal reached had ended --until-goals runs (and batch runs) as a success at ~10 s of 60.
+    A follower is a sender never done (the run lasts its duration) and that is no failure."""
+    from fleetsim.apps.follow_marker import FollowMarker
+    from fleetsim.apps.predictive_follower import PredictiveFollower
+
+    for cls in (FollowMarker, PredictiveFollower):
+        assert cls.sends_goals and cls.follows and not cls.done
+    rt = Runtime(seed=0)
+    MoveBase(rt, lambda n, server: rt.call_later(0.5, lambda: server.set_succeeded(text="ok")))
+    follower = SimpleNamespace(sends_goals=True, follows=True, done=False, full_name="/f")
+    monitor = RunMonitor(rt, PLAN, {"/f": follower})
+    goals = Node(rt, "user").create_action_client(move_base_msgs.MoveBase, "/move_base")
+    rt.run(duration=0.2)
+    goals.send_goal(move_base_msgs.MoveBase.Goal())
+    rt.run(duration=2.0)
+    assert monitor.robots["/"].all_done  # its goal has its result (no ground truth here)
+    assert not monitor.all_goals_done()  # the run goes on
+    assert monitor.senders_failed() == [] and "/f" not in " ".join(monitor.failures())
+
+
 @pytest.mark.parametrize(
     ("goals", "succeeded"),
     [([[1.0, 0.0], [1.0, 1.0]], True), ([[1.0, 0.0], [-2.0, 0.0]], False), ([], False)],

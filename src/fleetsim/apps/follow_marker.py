@@ -122,6 +122,14 @@ class MarkerToTargetPose:
 class FollowMarker(Node):
     """Turns marker observations into move_base goals; explores when the marker is lost."""
 
+    # a follower for the run monitor (`fleetsim.launch.monitor.GoalSender`): it follows for as
+    # long as the run lasts, so a run waiting for the goals (--until-goals, batch) is not ended
+    # by its first goal reached, and it is never done, which is no failure
+    sends_goals = True
+    follows = True
+    done = False
+    succeeded = True
+
     Params = FollowMarkerParams
 
     def __init__(self, runtime, name: str = "follow_marker", namespace: str = "/", **kw: Any):

@@ -58,6 +58,14 @@ class PredictiveFollower(Node):
     """Keeps a marker in view: tracker + sampling MPC + search. State: the tracker, the mode,
     the last command."""
 
+    # a follower for the run monitor (`fleetsim.launch.monitor.GoalSender`): it follows for as
+    # long as the run lasts, so a run waiting for the goals (--until-goals, batch) is not ended
+    # by its first goal reached, and it is never done, which is no failure
+    sends_goals = True
+    follows = True
+    done = False
+    succeeded = True
+
     Params = PredictiveFollowerParams
 
     def __init__(self, runtime, name: str = "predictive_follower", namespace: str = "/", **kw):

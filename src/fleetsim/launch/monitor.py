@@ -65,6 +65,10 @@ class GoalSender(Protocol):
     """
 
     sends_goals: bool
+    #: optional, True for a follower (follow_marker): it sends goals for as long as the run
+    #: lasts, so it is never ``done`` (a run waiting for the goals lasts its whole duration)
+    #: and that is no failure
+    # follows: bool
 
     @property
     def done(self) -> bool: ...
@@ -294,9 +298,13 @@ class RunMonitor:
         return (bool(active) or bool(self.senders)) and all(r.all_done for r in active)
 
     def senders_failed(self) -> list[str]:
-        """Names of the goal senders that are not done, or done and gave up."""
+        """Names of the goal senders that are not done, or done and gave up (followers,
+        never done, are not)."""
         return [
-            _sender_name(s) for s in self.senders if not s.done or not getattr(s, "succeeded", True)
+            _sender_name(s)
+            for s in self.senders
+            if not getattr(s, "follows", False)
+            and (not s.done or not getattr(s, "succeeded", True))
         ]
 
     def _confirm(self, r: RobotResult, goal, text: str) -> None:
@@ -432,6 +440,8 @@ class RunMonitor:
                     + ", ".join(why)
                 )
         for s in self.senders:
+            if getattr(s, "follows", False):
+                continue
             if not s.done:
                 out.append(f"goal sender {_sender_name(s)} had not finished when the run ended")
             elif not getattr(s, "succeeded", True):

@@ -19,7 +19,7 @@ FRAME = "camera_rgb_optical_frame"
 class Harness:
     """aruco_detect in a runtime, fed by a test node, its outputs collected."""
 
-    def __init__(self, params=None, remaps=None, info=True):
+    def __init__(self, params=None, remaps=None, info=True, watch_images=True):
         self.rt = Runtime()
         self.src = Node(self.rt, "camera_driver")
         self.node = ArucoDetect(self.rt, params={"dictionary": 0, **(params or {})}, remaps=remaps)
@@ -36,7 +36,10 @@ class Harness:
             fiducial_msgs.FiducialTransformArray, "/fiducial_transforms", self.transforms.append, 0
         )
         self.src.create_subscription(tf2_msgs.TFMessage, "/tf", self.tf.append, 0)
-        self.src.create_subscription(sensor_msgs.Image, "/fiducial_images", self.images.append, 0)
+        if watch_images:
+            self.src.create_subscription(
+                sensor_msgs.Image, "/fiducial_images", self.images.append, 0
+            )
         if info:
             self.send_info(camera_info_msg(K, W, H, FRAME))
 
@@ -137,6 +140,40 @@ def test_compressed_transport_through_the_tutorials_remap():
     assert pose_errors(ft, facing(25), t)[0] < 0.05
     (img,) = hn.images
     assert (img.width, img.height, img.encoding) == (W, H, "bgr8")
+
+
+def test_watching_the_drawn_images_does_not_change_detections():
+    """A recorder or viewer on /fiducial_images must not change what is detected: with one,
+    the grey image had been made from the colour decode (up to 14 levels from the grey
+    decode), and a recorded run drove differently (8.2 s against 10.5 s to its goal)."""
+    params = {"fiducial_len": 0.15, "image_transport": "compressed", "publish_images": True}
+    remaps = {"/camera/compressed": "/camera/rgb/image_raw/compressed"}
+    watched = Harness(params, remaps=remaps)
+    unwatched = Harness(params, remaps=remaps, watch_images=False)
+    seen = {id(watched): [], id(unwatched): []}  # the grey images the detector was given
+    for hn in (watched, unwatched):
+        process = hn.node.process
+
+        def keep(gray, stamp, colour, process=process, into=seen[id(hn)]):
+            into.append(gray.copy())
+            process(gray, stamp, colour)
+
+        hn.node.process = keep
+    rng = np.random.default_rng(7)
+    for k in range(6):
+        rot = facing(rng.uniform(-40, 40), rng.uniform(-10, 10))
+        t = np.array([rng.uniform(-0.4, 0.4), rng.uniform(-0.1, 0.1), rng.uniform(1.5, 3.5)])
+        img = marker_image(rot.as_rotvec(), t, K, W, H, noise=3.0, rng=rng).astype(np.int16)
+        img[..., 0] += 40  # a tinted scene: grey from the colour decode differs
+        img = np.clip(img, 0, 255).astype(np.uint8)
+        for hn in (watched, unwatched):
+            hn.send(img, t=1.0 + k, compressed=True)
+    assert len(watched.images) == 6 and not unwatched.images
+    for a, b in zip(seen[id(watched)], seen[id(unwatched)], strict=True):
+        assert np.array_equal(a, b)
+    for a, b in zip(watched.vertices, unwatched.vertices, strict=True):
+        assert a.fiducials == b.fiducials
+    assert sum(len(m.fiducials) for m in watched.vertices) >= 4
 
 
 def test_outputs_on_every_core_equal_one_threads():

@@ -188,14 +188,14 @@ class ArucoDetect(Node):
     def on_compressed(self, msg: sensor_msgs.CompressedImage) -> None:
         self._got_image = True
         if self.enabled:
-            if self.images_pub is not None and self.images_pub.get_num_connections():
-                # one decode to colour serves both (only when someone looks at the images)
-                bgr = decompressed_array(msg, self.image_topic)
-                gray = cv2.cvtColor(bgr, cv2.COLOR_BGR2GRAY)
-                self.process(gray, msg.header.stamp, lambda: bgr)
-            else:
-                gray = decompressed_array(msg, self.image_topic, gray=True)
-                self.process(gray, msg.header.stamp, None)
+            # detection always reads the JPEG decoded straight to grey: decoding to colour and
+            # converting gives grey levels up to 14 apart, so deriving it from the colour image
+            # when someone watches /fiducial_images (a recorder, a viewer) changed detections
+            # and the whole run; the colour decode is for drawing only
+            gray = decompressed_array(msg, self.image_topic, gray=True)
+            self.process(
+                gray, msg.header.stamp, lambda: decompressed_array(msg, self.image_topic)
+            )
 
     # -- processing ----------------------------------------------------------------------------
     def detect(self, gray: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -193,9 +193,7 @@ class ArucoDetect(Node):
             # when someone watches /fiducial_images (a recorder, a viewer) changed detections
             # and the whole run; the colour decode is for drawing only
             gray = decompressed_array(msg, self.image_topic, gray=True)
-            self.process(
-                gray, msg.header.stamp, lambda: decompressed_array(msg, self.image_topic)
-            )
+            self.process(gray, msg.header.stamp, lambda: decompressed_array(msg, self.image_topic))
 
     # -- processing ----------------------------------------------------------------------------
     def detect(self, gray: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

@@ -146,6 +146,34 @@ def test_move_to_target_goes_to_the_vantage_pose_once():
     assert not f.exploration.is_exploring()
 
 
+@pytest.mark.parametrize("frame", ["map", "/map"])
+def test_move_to_target_keeps_the_target_frame_as_given_in_a_namespaced_follower(frame):
+    """The tutorial's target_pose ``frame_id: map`` in a follower with tf_prefix hank is the
+    shared map, as grobot copies it; it had become hank/map, which no one publishes."""
+    rt = Runtime(seed=0)
+    rt.params.set("/hank/tf_prefix", "hank")
+    exploration = {**MOVE_TO_TARGET, "target_pose": {**MOVE_TO_TARGET["target_pose"]}}
+    exploration["target_pose"]["frame_id"] = frame
+    f = FollowMarker(rt, namespace="/hank", params={"marker_id": 0, "exploration": exploration})
+    assert f.base_frame == "hank/base_footprint"  # the prefix is there
+    assert f.exploration.target_frame == "map"
+
+
+def test_a_missing_robot_pose_is_said_after_tfs_patience_then_every_5_s(caplog):
+    """Exploring with no map -> robot transform (a follower without its tf_prefix): the
+    warning had come at every image, 51 times in 11 s."""
+    import logging
+
+    rt = Runtime(seed=0)
+    FollowWorld(rt, (0.0, 0.0, 0.0))
+    exploration = {**MOVE_TO_TARGET, "robot_frame": "nowhere"}
+    FollowMarker(rt, params={"marker_id": 0, "exploration": exploration})
+    with caplog.at_level(logging.WARNING):
+        rt.run(duration=16.0)
+    said = [r for r in caplog.records if "no robot pose in map" in r.getMessage()]
+    assert 1 <= len(said) <= 3, [r.getMessage() for r in said]
+
+
 def test_clear_costmaps_every_5_s():
     rt, w, f = world()
     rt.run(duration=16.0)

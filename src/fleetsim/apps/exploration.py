@@ -24,6 +24,7 @@ import numpy as np
 from fleetsim.errors import ParameterError, TransformError
 from fleetsim.msgs import geometry_msgs, move_base_msgs, std_msgs
 from fleetsim.runtime.params import load_params, param
+from fleetsim.tf.patience import TransformPatience
 from fleetsim.tf.quaternions import quaternion_from_yaw, yaw_from_quaternion
 from fleetsim.tf.transforms import compose_transforms, inverse_transform
 
@@ -90,6 +91,7 @@ class Exploration(ABC):
         self.handle = None
         self.goals_sent = 0
         self.sent_at = -math.inf
+        self._patience = TransformPatience()
 
     @classmethod
     def create(cls, node, raw: Any, where: str) -> Exploration:
@@ -159,10 +161,17 @@ class Exploration(ABC):
 
     def robot_in_map(self) -> tuple[np.ndarray, np.ndarray] | None:
         try:
-            return self.node.tf_buffer.lookup_arrays(self.map_frame, self.robot_frame, 0.0)
+            found = self.node.tf_buffer.lookup_arrays(self.map_frame, self.robot_frame, 0.0)
         except TransformError as err:
-            self.node.get_logger().warning(f"exploration: no robot pose in {self.map_frame}: {err}")
+            # said once tf's patience is over, then every 5 s (it is asked for at every image)
+            if self._patience.missing_too_long("robot", self.node.now()):
+                self.node._warn(
+                    "exploration: no robot pose",
+                    f"exploration: no robot pose in {self.map_frame}: {err}",
+                )
             return None
+        self._patience.found("robot")
+        return found
 
 
 class RotateExploration(Exploration):
@@ -185,7 +194,9 @@ class MoveToTargetExploration(Exploration):
             TargetPose, params.target_pose, where=f"{where}/target_pose", logger=node.get_logger()
         )
         self.target = tp
-        self.target_frame = node.frame(tp.frame_id)
+        # as grobot's move_to_target_exploration.h: the frame_id as given, no tf_prefix (the
+        # tutorial's "map" in a namespaced follower is the shared map, not hank/map)
+        self.target_frame = tp.frame_id.lstrip("/") or "map"
         self.t_target = np.array([tp.x, tp.y, 0.0])
         self.q_target = quaternion_from_yaw(tp.yaw)
 

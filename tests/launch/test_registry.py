@@ -34,3 +34,23 @@ def test_unknown_node_lists_known_ones():
 def test_register_checks_the_target():
     with pytest.raises(LaunchError, match="must be 'module:Class'"):
         register("a", "b", "just_a_module")
+
+
+def test_a_user_node_module_beside_the_launch_file_or_in_the_working_directory(
+    tmp_path, monkeypatch
+):
+    """``type="my_teleop:Teleop"`` with my_teleop.py next to the launch file: fleetsim launch
+    had failed to import it (fleetsim batch found it in the working directory)."""
+    beside, cwd = tmp_path / "launch_dir", tmp_path / "work"
+    beside.mkdir()
+    cwd.mkdir()
+    code = "from fleetsim.runtime import Node\n\nclass Teleop(Node):\n    pass\n"
+    (beside / "fs_probe_teleop_a.py").write_text(code)
+    (cwd / "fs_probe_teleop_b.py").write_text(code)
+    monkeypatch.chdir(cwd)
+    monkeypatch.setattr("sys.path", list(__import__("sys").path))
+    where = f"{beside / 'my.launch'}:7 <node>"
+    assert resolve_node("p", "fs_probe_teleop_a:Teleop", where).__name__ == "Teleop"
+    assert resolve_node("p", "fs_probe_teleop_b:Teleop", where).__name__ == "Teleop"
+    with pytest.raises(LaunchError, match="beside the launch file and in the working directory"):
+        resolve_node("p", "fs_probe_teleop_c:Teleop", where)

@@ -8,6 +8,8 @@ that lists what exists.
 from __future__ import annotations
 
 import importlib
+import sys
+from pathlib import Path
 from typing import Any
 
 from fleetsim.errors import LaunchError, did_you_mean
@@ -52,10 +54,18 @@ def register(pkg: str, type_: str, target: str) -> None:
     NODES[(pkg, type_)] = target
 
 
-def _import(target: str, what: str) -> Any:
+def _import(target: str, what: str, where: str = "") -> Any:
     module, _, attr = target.partition(":")
     try:
         mod = importlib.import_module(module)
+    except ModuleNotFoundError as e:
+        mod = _import_beside(module, e, where)
+        if mod is None:
+            raise LaunchError(
+                f"{what}: cannot import module '{module}': {e} (looked on the Python path, "
+                "beside the launch file and in the working directory; set PYTHONPATH for "
+                "elsewhere)"
+            ) from None
     except ImportError as e:
         raise LaunchError(f"{what}: cannot import module '{module}': {e}") from None
     try:
@@ -66,6 +76,23 @@ def _import(target: str, what: str) -> Any:
         ) from None
 
 
+def _import_beside(module: str, error: ModuleNotFoundError, where: str) -> Any:
+    """A user's node module (``type="my_teleop:Teleop"``) beside the launch file (``where``
+    is its file:line) or in the working directory, as ``fleetsim batch`` finds it there:
+    that folder is put on the Python path. None when the module is not there either."""
+    top = module.split(".")[0]
+    if error.name != top:
+        return None  # the module was found; something it imports was not
+    dirs = [Path(where.rsplit(":", 1)[0]).resolve().parent] if where else []
+    dirs.append(Path.cwd())
+    for d in dirs:
+        if (d / f"{top}.py").is_file() or (d / top / "__init__.py").is_file():
+            if str(d) not in sys.path:
+                sys.path.insert(0, str(d))
+            return importlib.import_module(module)
+    return None
+
+
 def resolve_node(pkg: str, type_: str, where: str = "") -> Any:
     """The class for ``pkg/type``; ``where`` (file:line) prefixes errors."""
     what = f"{where + ': ' if where else ''}node {pkg}/{type_}"
@@ -73,7 +100,7 @@ def resolve_node(pkg: str, type_: str, where: str = "") -> Any:
     if target is not None:
         return _import(target, what)
     if ":" in type_:
-        return _import(type_, what)
+        return _import(type_, what, where)
     if "." in pkg or pkg.startswith("fleetsim"):
         try:
             importlib.import_module(pkg)

@@ -67,3 +67,16 @@ def test_the_closing_line_tells_runs_that_missed_goals_from_errors_and_successes
         "4 runs (1 ended in an error; of the 2 with goals, 1 reached every goal without a "
         "collision): out/results.csv, out/results.parquet"
     )
+
+
+@pytest.mark.parametrize(("error", "status"), [("", 0), ("RuntimeError: no world", 1)])
+def test_a_batch_with_a_run_that_ended_in_an_error_exits_1(error, status, tmp_path, monkeypatch):
+    """Every run erroring (a world file that does not exist) had exited 0."""
+    from types import SimpleNamespace
+
+    import fleetsim.batch
+
+    rows = [{"run_id": "r0", "success": None, "error": ""}]
+    rows.append({"run_id": "r1", "success": None, "error": error})
+    monkeypatch.setattr(fleetsim.batch, "run_batch", lambda *a, **k: SimpleNamespace(rows=rows))
+    assert main(["batch", TINY, "-o", str(tmp_path / "out"), "--no-progress"]) == status

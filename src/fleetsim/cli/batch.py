@@ -71,7 +71,8 @@ def run(
     no_progress: bool = typer.Option(False, "--no-progress", help="No progress bar."),
 ) -> None:
     """Run a sweep: every scenario x argument value x seed, each run headless in its own
-    process, as Ray tasks; results in OUTDIR/results.csv and results.parquet."""
+    process, as Ray tasks; results in OUTDIR/results.csv and results.parquet. Exit status 1
+    when a run ended in an error (its row says which)."""
     from fleetsim.batch import load_spec, parse_cli_args, parse_seeds, run_batch
     from fleetsim.batch.spec import BatchSpec
 
@@ -95,6 +96,10 @@ def run(
         progress=not no_progress, console=console,
     )  # fmt: skip
     console.print(closing_line(table.rows, out))
+    errored = sorted({r["run_id"] for r in table.rows if r["error"]})
+    if errored:  # results are what they are; a run that could not run is a failure
+        console.print(f"{len(errored)} run(s) ended in an error (see their 'error' column)")
+        raise typer.Exit(1)
 
 
 def closing_line(rows: list[dict], out) -> str:

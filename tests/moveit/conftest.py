@@ -64,13 +64,15 @@ def load_hunter_params(rt: Runtime, ns: str, robot, fake: bool = False) -> None:
 class Hunters:
     """Hunters in namespaces, each with controllers and a move_group, in the simulator."""
 
-    def __init__(self, robot, names=("hunter1",)) -> None:
+    def __init__(self, robot, names=("hunter1",), tf_prefix: bool = False) -> None:
         self.rt = Runtime()
         self.sim = Simulator(self.rt)
         self.probe = Node(self.rt, "probe")
         for i, name in enumerate(names):
             ns = f"/{name}"
             load_hunter_params(self.rt, ns, robot)
+            if tf_prefix:  # the robot's nodes use its prefixed frames, as the simulator does
+                self.rt.params.set(f"{ns}/tf_prefix", name)
             self.sim.spawn_robot(name, robot, (0, 3.0 * i, 0.05, 0, 0, 0), ns)
             Spawner(self.rt, "spawner", ns, args=["joint_state_controller", "arm_group_controller"])
             MoveGroup(self.rt, "move_group", ns)

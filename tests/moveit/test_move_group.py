@@ -15,6 +15,7 @@ from fleetsim.moveit import (
 from fleetsim.msgs import geometry_msgs, moveit_msgs, sensor_msgs, trajectory_msgs
 from fleetsim.msgs.builtin_interfaces import Duration
 from fleetsim.runtime import Node, Runtime
+from fleetsim.tf.transforms import transform_points
 
 from .conftest import ARM, Hunters, assert_no_mujoco_warnings, load_hunter_params
 
@@ -376,3 +377,62 @@ def test_execute_of_plans_tuple_and_a_commander_for_a_links_only_group(one):
     assert ee.get_active_joints() == [] and ee.get_end_effector_link() == "cluedo_link"
     assert not ee.go([])
     assert ee.last_result()[0].error_code.val == E.INVALID_GROUP_NAME
+
+
+def test_targets_and_objects_in_other_frames_go_through_tf(hunter_robot, caplog):
+    """A PoseStamped target, Cartesian waypoints and collision objects in ``odom`` (or any
+    frame tf knows) are transformed into the planning frame, as move_group does; they had been
+    taken as if in base_link. An unknown frame is MoveIt's FRAME_TRANSFORM_FAILURE, and an
+    object in one is not added."""
+    h = Hunters(hunter_robot, tf_prefix=True)
+    h.sim.engine.set_model_state("hunter1", position=[2.0, -1.0, 0.05],
+                                 orientation=[np.cos(0.3), 0.0, 0.0, np.sin(0.3)])  # fmt: skip
+    h.rt.run(0.5)
+    arm = MoveGroupCommander("arm_group", ns="/hunter1", runtime=h.rt)
+    assert arm.get_planning_frame() == "hunter1/base_link"
+    assert arm.go("home")
+    here = arm.get_current_pose()
+    assert here.header.frame_id == "hunter1/base_link"
+    tf = h.rt.tf_buffer.lookup_arrays("hunter1/odom", "hunter1/base_link", 0.0)
+    p = here.pose.position
+    in_odom = transform_points(*tf, [[p.x, p.y, p.z]])[0]
+    assert np.linalg.norm(in_odom[:2] - [p.x, p.y]) > 1.0  # the frames are far apart
+    arm.set_goal_position_tolerance(0.005)
+    arm.set_pose_reference_frame("hunter1/odom")
+    arm.set_position_target(in_odom - [0.0, 0.0, 0.04])
+    assert arm.go(), arm.last_result()
+    now = arm.get_current_pose().pose.position
+    assert np.linalg.norm([now.x - p.x, now.y - p.y, now.z - (p.z - 0.04)]) < 0.01
+    # Cartesian waypoints in the pose reference frame (odom): 3 cm up again, in a line
+    up = geometry_msgs.Pose(position=geometry_msgs.Point(*in_odom))
+    up.orientation.w = 1.0
+    traj, fraction = arm.compute_cartesian_path([up], 0.005, False)
+    assert fraction == pytest.approx(1.0), fraction
+    assert arm.execute(traj)
+    now = arm.get_current_pose().pose.position
+    assert np.linalg.norm([now.x - p.x, now.y - p.y, now.z - p.z]) < 0.01
+    # a stamped target in an unknown frame
+    target = geometry_msgs.PoseStamped()
+    target.header.frame_id = "nowhere"
+    target.pose.position = geometry_msgs.Point(*in_odom)
+    target.pose.orientation.w = 1.0
+    arm.set_pose_target(target)
+    assert not arm.go()
+    result, text = arm.last_result()
+    assert result.error_code.val == E.FRAME_TRANSFORM_FAILURE
+    assert "Unable to transform from frame 'nowhere'" in text
+    # objects: one in odom lands where the tip is, one in an unknown frame is not added
+    scene = PlanningSceneInterface("/hunter1", runtime=h.rt)
+    box = geometry_msgs.PoseStamped()
+    box.header.frame_id = "hunter1/odom"
+    box.pose.position = geometry_msgs.Point(*in_odom)
+    box.pose.orientation.w = 1.0
+    scene.add_box("at_tip", box, (0.05, 0.05, 0.05))
+    box.header.frame_id = "nowhere"
+    with caplog.at_level(logging.ERROR):
+        scene.add_box("lost", box, (0.05, 0.05, 0.05))
+    mg = h.move_group("hunter1")
+    (geom,) = mg.pipeline.objects["at_tip"]
+    np.testing.assert_allclose(geom[2], [p.x, p.y, p.z], atol=1e-4)  # the base creeps µm
+    assert "lost" not in mg.pipeline.objects and "Unable to transform" in caplog.text
+    assert_no_mujoco_warnings(h.sim.engine)

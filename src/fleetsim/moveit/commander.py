@@ -20,7 +20,8 @@ from fleetsim.moveit.goal_constraints import joint_goal, pose_goal
 from fleetsim.msgs import geometry_msgs, moveit_msgs, std_msgs, trajectory_msgs
 from fleetsim.runtime import Node
 from fleetsim.runtime import names as rnames
-from fleetsim.tf.quaternions import quaternion_from_euler
+from fleetsim.tf.quaternions import quaternion_from_euler, quaternion_multiply
+from fleetsim.tf.transforms import transform_points
 
 E = moveit_msgs.MoveItErrorCodes
 _ids = itertools.count(1)
@@ -91,6 +92,8 @@ class MoveGroupCommander:
         self._attempts = 1
         self._planner_id = ""
         self._joint_tol, self._pos_tol, self._orient_tol = 1e-4, 1e-4, 1e-3
+        self._ref_frame = ""  # pose targets' frame; empty: the planning frame
+        self._target_frame = ""
         self._ee = self._model.end_effector_link(name)
         node = self._c.node
         self._move = node.create_action_client(moveit_msgs.MoveGroup, "move_group")
@@ -112,7 +115,17 @@ class MoveGroupCommander:
         return len(self._joints)
 
     def get_planning_frame(self) -> str:
-        return self._mg.frame(self._model.robot.root_link())
+        """A virtual joint's parent frame, else the robot's root link (MoveIt's model frame)."""
+        vj = self._model.srdf.virtual_joints
+        return self._mg.frame(vj[0].parent_frame if vj else self._model.robot.root_link())
+
+    def set_pose_reference_frame(self, reference_frame: str) -> None:
+        """The frame of pose targets and Cartesian waypoints given without one (default: the
+        planning frame); move_group transforms them through tf."""
+        self._ref_frame = str(reference_frame).lstrip("/")
+
+    def get_pose_reference_frame(self) -> str:
+        return self._ref_frame or self.get_planning_frame()
 
     def get_end_effector_link(self) -> str:
         return self._ee
@@ -138,8 +151,21 @@ class MoveGroupCommander:
         link = end_effector_link or self._ee
         ctx = self._mg.pipeline.context(self._name)
         pos, quat = ctx.kin.link_pose(np.array(self.get_current_joint_values()), link)
+        frame = self._mg.frame(self._model.robot.root_link())  # where the kinematics are
+        planning = self.get_planning_frame()
+        if planning != frame and hasattr(self._mg, "frame_transform"):  # in process: tf
+            from fleetsim.moveit.planner import PlanFailure
+
+            try:
+                tf = self._mg.frame_transform(planning, frame)
+            except PlanFailure as e:
+                raise MoveItCommanderException(str(e)) from None
+            if tf is not None:
+                pos = transform_points(*tf, [pos])[0]
+                quat = quaternion_multiply(tf[1], quat)
+            frame = planning
         ps = geometry_msgs.PoseStamped()
-        ps.header.frame_id = self.get_planning_frame()
+        ps.header.frame_id = frame
         ps.pose.position = geometry_msgs.Point(*map(float, pos))
         ps.pose.orientation = geometry_msgs.Quaternion(*map(float, quat))
         return ps
@@ -218,13 +244,16 @@ class MoveGroupCommander:
             self._ee = end_effector_link
         self._pose_target = np.asarray(xyz, float)[:3]
         self._orientation_target = None
+        self._target_frame = self._ref_frame
 
     def set_pose_target(self, pose, end_effector_link: str = "") -> None:
         """Position and orientation (a Pose, PoseStamped, [x, y, z, roll, pitch, yaw] or
         [x, y, z, qx, qy, qz, qw]). The orientation is kept: a group with fewer than six joints
         reaches only the orientations its joints can make, and planning to any other fails
         with NO_IK_SOLUTION saying so (use ``set_position_target`` for the position alone)."""
+        frame = self._ref_frame
         if isinstance(pose, geometry_msgs.PoseStamped):
+            frame = pose.header.frame_id.lstrip("/") or frame
             pose = pose.pose
         if isinstance(pose, geometry_msgs.Pose):
             xyz = [pose.position.x, pose.position.y, pose.position.z]
@@ -242,6 +271,7 @@ class MoveGroupCommander:
             raise MoveItCommanderException(f"the pose's orientation {list(quat)} is not a rotation")
         self.set_position_target(xyz, end_effector_link)
         self._orientation_target = quat / np.linalg.norm(quat)
+        self._target_frame = frame
 
     def clear_pose_targets(self) -> None:
         self._pose_target = self._orientation_target = None
@@ -307,7 +337,7 @@ class MoveGroupCommander:
         if self._pose_target is not None:
             c = pose_goal(
                 self._ee, self._pose_target, self._orientation_target, self._pos_tol,
-                self._orient_tol,
+                self._orient_tol, frame_id=self._target_frame,
             )  # fmt: skip
         else:
             c = joint_goal(self._joints, self._target, self._joint_tol)
@@ -390,10 +420,20 @@ class MoveGroupCommander:
         poses = [w.pose if isinstance(w, geometry_msgs.PoseStamped) else w for w in waypoints]
         if not all(isinstance(w, geometry_msgs.Pose) for w in poses):
             raise MoveItCommanderException("waypoints must be geometry_msgs Poses")
+        frames = {
+            w.header.frame_id.lstrip("/")
+            for w in waypoints
+            if isinstance(w, geometry_msgs.PoseStamped) and w.header.frame_id
+        }
+        if len(frames) > 1:
+            raise MoveItCommanderException(
+                f"waypoints in several frames ({', '.join(sorted(frames))}): give them in one"
+            )
         req = moveit_msgs.GetCartesianPathRequest(
             group_name=self._name, link_name=self._ee, waypoints=poses, max_step=float(eef_step),
             jump_threshold=float(jump_threshold), avoid_collisions=bool(avoid_collisions),
         )  # fmt: skip
+        req.header.frame_id = frames.pop() if frames else self.get_pose_reference_frame()
         res = self._c.call("compute_cartesian_path", moveit_msgs.GetCartesianPath, req)
         if res.error_code.val != E.SUCCESS:
             return res.solution, -1.0

@@ -25,7 +25,8 @@ def compute_ik(mg, req):
             moveit_msgs.MotionPlanRequest(group_name=r.group_name, start_state=r.robot_state)
         )
         p = r.pose_stamped.pose.position
-        q = mg.pipeline.ik(ctx, r.ik_link_name or ctx.tip, np.array([p.x, p.y, p.z]), start)
+        target, _ = mg.pose_in_root(r.pose_stamped.header.frame_id, [p.x, p.y, p.z])
+        q = mg.pipeline.ik(ctx, r.ik_link_name or ctx.tip, target, start)
     except PlanFailure as e:
         res.error_code.val = e.code
         return res
@@ -57,9 +58,11 @@ def compute_cartesian_path(mg, req):
         if not req.waypoints:
             raise PlanFailure(E.INVALID_GOAL_CONSTRAINTS, "no waypoints")
         mg.sync_world()
+        # the waypoints are in the request's frame (the commander's pose reference frame)
         waypoints = [
-            (
-                np.array([w.position.x, w.position.y, w.position.z]),
+            mg.pose_in_root(
+                req.header.frame_id,
+                [w.position.x, w.position.y, w.position.z],
                 np.array([w.orientation.x, w.orientation.y, w.orientation.z, w.orientation.w]),
             )
             for w in req.waypoints

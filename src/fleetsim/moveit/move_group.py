@@ -16,6 +16,7 @@ and other robots come from the simulator when one runs; planning-scene objects a
 
 from __future__ import annotations
 
+import copy
 from dataclasses import dataclass
 from functools import partial
 
@@ -29,11 +30,21 @@ from fleetsim.moveit.execution import ExecutionManager
 from fleetsim.moveit.kinematics_services import compute_cartesian_path, compute_fk, compute_ik
 from fleetsim.moveit.pipeline import PlanFailure, PlanningPipeline
 from fleetsim.moveit.robot_model import RobotModel
-from fleetsim.msgs import moveit_msgs, sensor_msgs, shape_msgs, std_msgs, trajectory_msgs
+from fleetsim.msgs import (
+    geometry_msgs,
+    moveit_msgs,
+    sensor_msgs,
+    shape_msgs,
+    std_msgs,
+    trajectory_msgs,
+)
 from fleetsim.runtime import Node, param
+from fleetsim.tf.quaternions import quaternion_multiply
+from fleetsim.tf.transforms import transform_points
 
 E = moveit_msgs.MoveItErrorCodes
 FAKE = "moveit_fake_controller_manager/MoveItFakeControllerManager"
+_NO_TURN = np.array([0.0, 0.0, 0.0, 1.0])  # x y z w
 SHAPES = {
     shape_msgs.SolidPrimitive.BOX: mujoco.mjtGeom.mjGEOM_BOX,
     shape_msgs.SolidPrimitive.SPHERE: mujoco.mjtGeom.mjGEOM_SPHERE,
@@ -87,6 +98,7 @@ class MoveGroup(Node):
         self.execution = ExecutionManager(self, p.controller_list, fake, p.trajectory_execution)
         self.joint_positions: dict[str, float] = {}
         self.objects: dict[str, moveit_msgs.CollisionObject] = {}
+        _ = self.tf_buffer  # listen to /tf from now on: targets in other frames go through it
         self.create_subscription(sensor_msgs.JointState, "joint_states", self._on_joints, 50)
         self.create_subscription(moveit_msgs.PlanningScene, "planning_scene", self._on_scene, 10)
         self.create_subscription(std_msgs.String, "trajectory_execution_event", self._on_event, 10)
@@ -186,6 +198,68 @@ class MoveGroup(Node):
         for ctx in self.pipeline.contexts():
             ctx.scene.set_world_from(sim.engine, entry.name)
 
+    # ------------------------------------------------------------------ frames
+    @property
+    def root_frame(self) -> str:
+        """The robot's root link, tf-prefixed: the frame the kinematics work in."""
+        return self.frame(self.model.robot.root_link())
+
+    @property
+    def planning_frame(self) -> str:
+        """MoveIt's planning frame: a virtual joint's parent frame (``odom`` for a planar
+        one), else the robot's root link; a target or object without a frame is in it."""
+        vj = self.model.srdf.virtual_joints
+        return self.frame(vj[0].parent_frame) if vj else self.root_frame
+
+    def frame_transform(self, target: str, source: str):
+        """``(t (3,), q (4,) x y z w)`` of frame ``source`` in ``target`` through tf (either
+        empty: the planning frame); None when they are the same frame. A frame tf does not
+        know fails with MoveIt's FRAME_TRANSFORM_FAILURE."""
+        target = target.lstrip("/") or self.planning_frame
+        source = source.lstrip("/") or self.planning_frame
+        if target == source:
+            return None
+        try:
+            tf = self.tf_buffer.lookup_transform(target, source, 0.0).transform
+        except FleetsimError as e:
+            raise PlanFailure(
+                E.FRAME_TRANSFORM_FAILURE,
+                f"Unable to transform from frame '{source}' to frame '{target}': {e}",
+            ) from None
+        t, q = tf.translation, tf.rotation
+        return np.array([t.x, t.y, t.z]), np.array([q.x, q.y, q.z, q.w])
+
+    def pose_in_root(self, frame: str, position, orientation=None):
+        """A pose given in ``frame`` (x y z, and x y z w or None) in the root link's frame."""
+        tf = self.frame_transform(self.root_frame, frame)
+        if tf is None:
+            return np.asarray(position, float), orientation
+        pos = transform_points(*tf, [position])[0]
+        if orientation is not None:
+            orientation = quaternion_multiply(tf[1], orientation)
+        return pos, orientation
+
+    def _goal_in_root(self, c):
+        """A copy of goal constraints ``c`` with its position and orientation constraints in
+        the root link's frame (the pose goal's frame: its header's, else the planning frame)."""
+        if not (c.position_constraints or c.orientation_constraints):
+            return c
+        c = copy.deepcopy(c)
+        for pc in c.position_constraints:
+            for pose in pc.constraint_region.primitive_poses:
+                p = pose.position
+                pos, _ = self.pose_in_root(pc.header.frame_id, [p.x, p.y, p.z])
+                pose.position = geometry_msgs.Point(*map(float, pos))
+            pc.header.frame_id = self.root_frame
+        for oc in c.orientation_constraints:
+            o = oc.orientation
+            tf = self.frame_transform(self.root_frame, oc.header.frame_id)
+            if tf is not None:
+                q = quaternion_multiply(tf[1], [o.x, o.y, o.z, o.w])
+                oc.orientation = geometry_msgs.Quaternion(*map(float, q))
+            oc.header.frame_id = self.root_frame
+        return c
+
     # ------------------------------------------------------------------ planning
     def plan(self, req):
         """MotionPlanResponse for a MotionPlanRequest (never raises for a bad request)."""
@@ -194,6 +268,9 @@ class MoveGroup(Node):
             ctx = self.pipeline.context(req.group_name)
             start = self.start_state(req)
             self.sync_world()
+            if req.goal_constraints:
+                req = copy.copy(req)
+                req.goal_constraints = [self._goal_in_root(c) for c in req.goal_constraints]
             plan = self.pipeline.plan(req, start)
         except PlanFailure as e:
             self.get_logger().error("%s", e)
@@ -334,6 +411,11 @@ class MoveGroup(Node):
                     self.pipeline.remove_object(oid)
                 continue
             geoms = []
+            try:
+                placed = self.frame_transform(self.root_frame, obj.header.frame_id)
+            except PlanFailure as e:  # MoveIt: "Unknown frame", and the object is not added
+                self.get_logger().error("collision object '%s': %s", obj.id, e)
+                return False
             for prim, pose in zip(obj.primitives, obj.primitive_poses, strict=False):
                 if prim.type not in SHAPES:
                     self.get_logger().error(
@@ -353,12 +435,11 @@ class MoveGroup(Node):
                     return False
                 pos = np.array([pose.position.x, pose.position.y, pose.position.z])
                 o = pose.orientation
-                q = (
-                    np.array([o.w, o.x, o.y, o.z])
-                    if (o.w or o.x or o.y or o.z)
-                    else np.array([1.0, 0, 0, 0])
-                )
-                geoms.append((int(SHAPES[prim.type]), size, pos, q))
+                q = np.array([o.x, o.y, o.z, o.w]) if (o.w or o.x or o.y or o.z) else _NO_TURN
+                if placed is not None:  # from the object's frame into the root link's
+                    pos = transform_points(*placed, [pos])[0]
+                    q = quaternion_multiply(placed[1], q)
+                geoms.append((int(SHAPES[prim.type]), size, pos, np.array([q[3], *q[:3]])))
             self.objects[obj.id] = obj
             self.pipeline.set_object(obj.id, geoms)
         return True

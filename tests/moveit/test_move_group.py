@@ -15,6 +15,7 @@ from fleetsim.moveit import (
 from fleetsim.msgs import geometry_msgs, moveit_msgs, sensor_msgs, trajectory_msgs
 from fleetsim.msgs.builtin_interfaces import Duration
 from fleetsim.runtime import Node, Runtime
+from fleetsim.tf.quaternions import quaternion_multiply
 from fleetsim.tf.transforms import transform_points
 
 from .conftest import ARM, Hunters, assert_no_mujoco_warnings, load_hunter_params
@@ -436,3 +437,56 @@ def test_targets_and_objects_in_other_frames_go_through_tf(hunter_robot, caplog)
     np.testing.assert_allclose(geom[2], [p.x, p.y, p.z], atol=1e-4)  # the base creeps µm
     assert "lost" not in mg.pipeline.objects and "Unable to transform" in caplog.text
     assert_no_mujoco_warnings(h.sim.engine)
+
+
+def test_out_of_reach_approximate_ik_and_more_of_moveit_commanders_calls(one, caplog):
+    """A pose 2 m away is out of reach whatever its orientation, and says so (it had blamed
+    the orientation, sending the user to set_position_target, which failed too); approx=True
+    takes the position with the orientation the arm makes there; moveit_commander calls the
+    manual's client makes exist."""
+    arm = MoveGroupCommander("arm_group", ns="/hunter1", runtime=one.rt)
+    assert arm.go("home")
+    far = geometry_msgs.Pose(position=geometry_msgs.Point(2.0, 0.0, 0.5))
+    far.orientation.w = 1.0
+    arm.set_pose_target(far)
+    assert not arm.go()
+    text = arm.last_result()[1]
+    assert "whatever its orientation: the position is out of the arm's reach" in text
+    here = arm.get_current_pose().pose
+    p = here.position
+    target = geometry_msgs.Pose(position=geometry_msgs.Point(p.x, p.y, p.z - 0.05))
+    o = here.orientation  # a quarter turn about the tip's own z: not one the joints make
+    turned = quaternion_multiply([o.x, o.y, o.z, o.w], [0.0, 0.0, np.sqrt(0.5), np.sqrt(0.5)])
+    target.orientation = geometry_msgs.Quaternion(*turned)
+    arm.set_goal_position_tolerance(0.005)
+    arm.set_joint_value_target(target, False)
+    assert not arm.go()  # that orientation is not one the arm can make there
+    assert "an orientation the arm can make" in arm.last_result()[1]
+    arm.set_joint_value_target(target, "cluedo_link", True)
+    assert arm.go(), arm.last_result()
+    z = arm.get_current_pose().pose.position.z
+    assert z == pytest.approx(p.z - 0.05, abs=0.006)
+    arm.set_pose_reference_frame(arm.get_planning_frame())
+    arm.allow_replanning(True)
+    arm.set_start_state_to_current_state()
+    assert len(arm.get_current_rpy()) == 3 and len(arm.get_random_joint_values()) == 4
+    arm.set_random_target()
+    assert arm.get_joint_value_target() != arm.get_current_joint_values()
+
+
+def test_a_group_state_missing_a_joint_is_warned_about(hunter_robot, caplog):
+    from fleetsim.description.srdf import parse_srdf
+    from fleetsim.moveit.robot_model import RobotModel
+
+    from .conftest import HUNTER
+
+    text = (HUNTER / "config" / "robocluedo_robot.srdf").read_text()
+    start = text.index('<group_state name="cam_left"')
+    line = text.index('<joint name="arm_joint_01"', start)
+    text = text[:line] + text[text.index("\n", line) + 1 :]
+    with caplog.at_level(logging.WARNING):
+        RobotModel(hunter_robot, parse_srdf(text, "hunter.srdf", hunter_robot), {})
+    assert (
+        "group state 'cam_left' doesn't specify all joints of group 'arm_group' "
+        "(arm_joint_01 missing: taken as 0)" in caplog.text
+    )

@@ -20,7 +20,11 @@ from fleetsim.moveit.goal_constraints import joint_goal, pose_goal
 from fleetsim.msgs import geometry_msgs, moveit_msgs, std_msgs, trajectory_msgs
 from fleetsim.runtime import Node
 from fleetsim.runtime import names as rnames
-from fleetsim.tf.quaternions import quaternion_from_euler, quaternion_multiply
+from fleetsim.tf.quaternions import (
+    euler_from_quaternion,
+    quaternion_from_euler,
+    quaternion_multiply,
+)
 from fleetsim.tf.transforms import transform_points
 
 E = moveit_msgs.MoveItErrorCodes
@@ -93,6 +97,8 @@ class MoveGroupCommander:
         self._planner_id = ""
         self._joint_tol, self._pos_tol, self._orient_tol = 1e-4, 1e-4, 1e-3
         self._ref_frame = ""  # pose targets' frame; empty: the planning frame
+        # set_random_target: the commander's node's stream (a run's seed makes it repeat)
+        self._rng = getattr(self._c.node, "rng", None) or np.random.default_rng(0)
         self._target_frame = ""
         self._ee = self._model.end_effector_link(name)
         node = self._c.node
@@ -211,7 +217,18 @@ class MoveGroupCommander:
                     )
                 q[self._joints.index(j)] = v
         elif isinstance(arg1, geometry_msgs.Pose | geometry_msgs.PoseStamped):
-            self.set_pose_target(arg1)  # MoveIt solves IK for the pose, then plans in joints
+            # moveit_commander's (pose, end_effector_link="", approx=False): MoveIt solves IK
+            # for the pose, then plans in joints; with approx, an approximate solution is
+            # accepted: here the position exactly, the orientation whatever the arm makes
+            # there (what approximate IK gives an arm of fewer than six joints)
+            ee, approx = "", False
+            if isinstance(arg2, str):
+                ee, approx = arg2, bool(arg3)
+            elif arg2 is not None:
+                approx = bool(arg2)
+            self.set_pose_target(arg1, ee)
+            if approx:
+                self._orientation_target = None
             return
         elif hasattr(arg1, "name") and hasattr(arg1, "position"):  # JointState
             self.set_joint_value_target(dict(zip(arg1.name, arg1.position, strict=False)))
@@ -275,6 +292,42 @@ class MoveGroupCommander:
 
     def clear_pose_targets(self) -> None:
         self._pose_target = self._orientation_target = None
+
+    def clear_pose_target(self, end_effector_link: str = "") -> None:
+        self.clear_pose_targets()
+
+    def set_orientation_target(self, q, end_effector_link: str = "") -> None:
+        """The end effector turned to ``q`` (x y z w, or roll pitch yaw) where it is now."""
+        p = self.get_current_pose(end_effector_link).pose.position
+        q = list(q)
+        if len(q) == 3:
+            q = list(quaternion_from_euler(*q))
+        if len(q) != 4:
+            raise MoveItCommanderException("Expected [qx, qy, qz, qw] or [r, p, y]")
+        self.set_pose_target([p.x, p.y, p.z, *q], end_effector_link)
+
+    def set_rpy_target(self, rpy, end_effector_link: str = "") -> None:
+        if len(rpy) != 3:
+            raise MoveItCommanderException("Expected [roll, pitch, yaw]")
+        self.set_orientation_target(rpy, end_effector_link)
+
+    def get_current_rpy(self, end_effector_link: str = "") -> list[float]:
+        o = self.get_current_pose(end_effector_link).pose.orientation
+        return [float(v) for v in euler_from_quaternion([o.x, o.y, o.z, o.w])]
+
+    def get_random_joint_values(self) -> list[float]:
+        lim = self._model.limits(self._name)
+        return [float(v) for v in self._rng.uniform(lim.lower, lim.upper)]
+
+    def set_random_target(self) -> None:
+        self.set_joint_value_target(self.get_random_joint_values())
+
+    def set_start_state_to_current_state(self) -> None:
+        """Plans start from the current state (the only start fleetsim's commander uses)."""
+
+    def allow_replanning(self, value: bool) -> None:
+        """Accepted: fleetsim's move_group does not replan when the scene changes."""
+        self._replanning = bool(value)
 
     # ------------------------------------------------------------------ settings
     def set_max_velocity_scaling_factor(self, value: float) -> None:

@@ -192,6 +192,14 @@ class PlanningPipeline:
                 E.NO_IK_SOLUTION,
                 f"no collision-free IK solution puts '{link}' at {where} in the planning frame",
             )
+        if self.ik(ctx, link, target, start, tolerance=max(float(tol), 1e-4)) is None:
+            # not the orientation: the position itself is out of reach (or only in collision)
+            raise PlanFailure(
+                E.NO_IK_SOLUTION,
+                f"no collision-free IK solution puts '{link}' at {where} in the planning frame, "
+                "whatever its orientation: the position is out of the arm's reach or in "
+                "collision",
+            )
         q_txt = ", ".join(f"{v:.3f}" for v in quat / np.linalg.norm(quat))
         few = (
             f"; group '{ctx.group}' has {len(ctx.joints)} joints, fewer than the 6 an arbitrary "

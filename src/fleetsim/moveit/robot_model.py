@@ -106,6 +106,15 @@ class RobotModel:
                     f"{did_you_mean(j, robot.joints)}"
                 )
         self.joint_limits = {j: _checked_limits(j, joint_limits) for j in joint_limits}
+        for (group, name), values in srdf.group_states.items():
+            if group not in srdf.groups:
+                continue  # the SRDF's reader refuses those
+            missing = [j for j in self.active_joints(group) if j not in values]
+            if missing:  # MoveIt's SRDF loader says so too; the joint is taken as 0
+                _log.warning(
+                    "%s: group state '%s' doesn't specify all joints of group '%s' (%s missing: "
+                    "taken as 0)", self.source, name, group, ", ".join(missing),
+                )  # fmt: skip
         for key in SCALING_KEYS:
             v = self.planning.get(key)
             if v is None:

@@ -88,3 +88,34 @@ def test_commander_from_another_process_over_the_bridge(served):
         assert fraction == pytest.approx(1.0) and len(traj.joint_trajectory.points) >= 2
     finally:
         arm._c.close()
+
+
+def test_a_commander_waiting_on_a_simulation_whose_clock_stopped_gives_up(
+    hunter_robot, monkeypatch
+):
+    """A script's go() against a run that has ended (or stopped) had waited ~10 minutes (the
+    600 s allowed a move plus margins); it now ends once the clock stands still."""
+    import time
+
+    import fleetsim.moveit.remote as remote
+    from fleetsim.moveit import MoveGroupCommander
+
+    monkeypatch.setattr(remote, "CLOCK_STALL", 2.0)
+    ep = free_endpoint()
+    h = Hunters(hunter_robot)
+    bridge = ZenohBridge(h.rt, listen=[ep])
+    stop = threading.Event()
+    th = threading.Thread(target=lambda: h.rt.run(until=stop.is_set, rate=20.0), daemon=True)
+    th.start()
+    arm = MoveGroupCommander("arm_group", ns="/hunter1", connect=ep)
+    try:
+        stop.set()  # the run stops: nothing answers the goal, the clock stands
+        th.join(10)
+        t0 = time.monotonic()
+        with pytest.raises(FleetsimError, match="the simulation's clock has stood at"):
+            arm.go("cam_left")
+        assert time.monotonic() - t0 < 15.0
+    finally:
+        arm._c.close()
+        bridge.close()
+        h.rt.shutdown()

@@ -47,6 +47,12 @@ def robot_model(client, ns: str):
     return RobotModel(robot, srdf, planning if isinstance(planning, dict) else {})
 
 
+#: wall seconds between checks that the simulation a commander waits on is still there
+LIVENESS_PERIOD = 1.0
+#: wall seconds the simulation's clock may stand still before a wait gives up
+CLOCK_STALL = 10.0
+
+
 class _Handle:
     def __init__(self) -> None:
         self.result: Any = None
@@ -156,10 +162,32 @@ class RemoteSession:
         return self.client.call_service(names.join(self.ns, name), request, srv_type)
 
     def wait(self, until, timeout: float) -> None:
-        deadline = _wall.monotonic() + timeout
+        """Until ``until()`` or ``timeout`` wall seconds; a simulation that goes away or whose
+        clock stops meanwhile ends the wait at once (a run that ended had kept a script
+        waiting ~10 minutes for a move's answer)."""
+        now = _wall.monotonic()
+        deadline, next_check = now + timeout, now + LIVENESS_PERIOD
+        last_time, advanced_at = None, now
         while not until():
-            if _wall.monotonic() > deadline:
+            now = _wall.monotonic()
+            if now > deadline:
                 raise TransportError(f"no answer from {self.ns}/move_group within {timeout:g} s")
+            if now >= next_check:
+                next_check = now + LIVENESS_PERIOD
+                try:
+                    t = self.client.sim_time()
+                except TransportError as e:
+                    raise TransportError(
+                        f"waiting for {self.ns}/move_group: the simulation is gone (its run "
+                        f"ended?): {e}"
+                    ) from None
+                if t != last_time:
+                    last_time, advanced_at = t, now
+                elif now - advanced_at > CLOCK_STALL:
+                    raise TransportError(
+                        f"waiting for {self.ns}/move_group: the simulation's clock has stood at "
+                        f"{t:.3f} s for {CLOCK_STALL:g} s of wall time"
+                    )
             _wall.sleep(0.02)
 
     def close(self) -> None:

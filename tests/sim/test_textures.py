@@ -109,6 +109,23 @@ def test_missing_texture_image_names_the_file_the_material_and_the_model(tmp_pat
         load_sdf_model(text)
 
 
+def test_a_material_name_no_script_defines_is_warned_about(tmp_path):
+    """A typo in the material's <name> (a marker's MyMarkr for MyMarker) had drawn the plate
+    blank without a word, and the follower never saw the marker; Gazebo says it cannot find
+    the material. A name the scripts define, or one of Gazebo's colours, is not warned about."""
+    import warnings
+
+    text = quadrant_model(tmp_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        load_sdf_model(text)
+        load_sdf_model(text.replace("Sign/Quadrants", "Gazebo/Red"))
+    with pytest.warns(
+        UserWarning, match=r"model 'sign' \(<string>\): material script 'Sign/Quadrnts' is not "
+    ):
+        load_sdf_model(text.replace("Sign/Quadrants", "Sign/Quadrnts"))
+
+
 def test_urdf_texture_and_missing_image(tmp_path):
     from fleetsim.description import parse_urdf
 

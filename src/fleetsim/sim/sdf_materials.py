@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import warnings
 from pathlib import Path
 
 from fleetsim.errors import SimulationError
@@ -79,6 +80,16 @@ def _texture_from_script(script, vis, where: str, find_model) -> tuple[str | Non
         dirs.append(GAZEBO_MATERIALS)
     material = ogre_scripts.find_ogre_material(name, dirs)
     if material is None:
+        # a user's script name (Gazebo: "Unable to find material"); a Gazebo/* name fleetsim
+        # does not draw is Gazebo's own, not a mistake
+        if name and not name.startswith("Gazebo/"):
+            looked = ", ".join(str(d) for d in dirs) or "no <uri>"
+            warnings.warn(
+                f"{_owner(vis, where)}: material script '{name}' is not defined in its "
+                f"scripts ({looked}): drawn without it (a texture it names, such as a "
+                "marker's image, will not show)",
+                stacklevel=2,
+            )
         return None, None
     image = None
     if material.texture is not None:

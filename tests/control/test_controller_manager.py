@@ -137,6 +137,7 @@ def test_goal_rejections_and_tolerance_violations(hunters):
     hunters.rt.run(2.0, until=lambda: jump.result is not None)
     assert jump.result.error_code == Result.GOAL_TOLERANCE_VIOLATED
     assert "goal velocity" in jump.result.error_string
+    assert "beyond constraints/stopped_velocity_tolerance 0.01" in jump.result.error_string
 
 
 def test_old_header_timestamp(hunters):

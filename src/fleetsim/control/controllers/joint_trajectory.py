@@ -323,7 +323,13 @@ class JointTrajectoryController(Controller):
             self.outcome = (Result.SUCCESSFUL, "")
         elif t > end + tol.goal_time:
             i = int(np.nonzero(pos_bad | vel_bad)[0][0])
-            what = f"goal error {err[i]:.6f}" if pos_bad[i] else f"goal velocity {qd[i]:.6f}"
+            if pos_bad[i]:
+                what = f"goal error {err[i]:.6f} beyond constraints/{self.joints[i]}/goal "
+                what += f"{tol.goal[i]:g}"
+            else:  # the default 0.01 rad/s catches P-only gains still settling
+                what = f"goal velocity {qd[i]:.6f} beyond constraints/stopped_velocity_tolerance "
+                what += f"{tol.stopped_velocity:g}"
+            what += f" at goal_time {tol.goal_time:g} s after the trajectory's end"
             self.outcome = (Result.GOAL_TOLERANCE_VIOLATED, f"{self.joints[i]} {what}")
             self._hold(t)
 

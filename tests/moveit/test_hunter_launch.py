@@ -52,6 +52,12 @@ def test_run2_rviz_moves_the_arm_with_fake_execution():
         s.run(duration=0.5)
         assert "/gazebo" not in s.runtime.graph.nodes
         arm = MoveGroupCommander("arm_group", runtime=s.runtime)
+        # fake_controllers.yaml's initial: the arm starts at home, as the manual's config has it
+        np.testing.assert_allclose(
+            arm.get_current_joint_values(),
+            list(arm.get_named_target_values("home").values()),
+            atol=1e-9,
+        )
         arm.set_named_target("cam_back")
         assert arm.go()
         s.run(duration=0.2)

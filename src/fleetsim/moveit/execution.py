@@ -33,7 +33,13 @@ class ExecutionManager:
         self.settings = settings
         self.controllers = []
         for k, c in enumerate(controllers):
-            if not isinstance(c, dict) or not all(
+            if fake:  # moveit_fake_controller_manager reads a name and joints (fake_controllers)
+                if not isinstance(c, dict) or not all(key in c for key in ("name", "joints")):
+                    raise PlanningError(
+                        f"{node.full_name}: controller_list[{k}]: a fake controller needs a name "
+                        "and joints"
+                    )
+            elif not isinstance(c, dict) or not all(
                 key in c for key in ("name", "joints", "action_ns", "type")
             ):
                 raise PlanningError(
@@ -172,6 +178,14 @@ class ExecutionManager:
                 f"for the trajectory execution was {limit:.4f} seconds). Stopping trajectory.",
                 E.TIMED_OUT,
             )
+
+    def hold(self, joints: list[str], q) -> None:
+        """Fake execution: stand at ``q`` (the fake controllers' initial pose) until a
+        trajectory moves the joints."""
+        q = np.asarray(q, float)
+        self.fake_joints = list(joints)
+        z = np.zeros((1, len(joints)))
+        self.fake_traj = Trajectory(np.array([self.node.now()]), q[None, :], z, z.copy(), 3)
 
     def _fake_tick(self) -> None:
         if self.fake_traj is None:

@@ -60,6 +60,9 @@ class MoveGroupParams:
         help="or moveit_fake_controller_manager/MoveItFakeControllerManager",
     )
     controller_list: list = param([], help="[{name, action_ns, type, joints, default}]")
+    initial: list = param(
+        [], help="fake execution: [{group, pose}], the named poses the fake controllers start at"
+    )
     trajectory_execution: dict = param({}, help="allowed_execution_duration_scaling, ...")
     max_safe_path_cost: float = param(1.0, help="accepted, unused")
     jiggle_fraction: float = param(0.05, help="accepted, unused")
@@ -96,6 +99,8 @@ class MoveGroup(Node):
         p = self.params
         fake = p.moveit_controller_manager == FAKE
         self.execution = ExecutionManager(self, p.controller_list, fake, p.trajectory_execution)
+        if fake:
+            self._fake_initial(p.initial)
         self.joint_positions: dict[str, float] = {}
         self.objects: dict[str, moveit_msgs.CollisionObject] = {}
         _ = self.tf_buffer  # listen to /tf from now on: targets in other frames go through it
@@ -124,6 +129,22 @@ class MoveGroup(Node):
         self.create_service(moveit_msgs.GetPlanningScene, "get_planning_scene", self._srv_get_scene)
         self.create_service(moveit_msgs.ApplyPlanningScene, "apply_planning_scene", self._srv_apply)
         self.get_logger().info("You can start planning now!")
+
+    def _fake_initial(self, initial: list) -> None:
+        """moveit_fake_controller_manager's ``initial`` (fake_controllers.yaml): each group
+        starts at its named pose (else at zeros); a wrong group or pose is an error."""
+        held: dict[str, float] = {}
+        for k, entry in enumerate(initial):
+            where = f"{self.full_name}/initial[{k}]"
+            if not isinstance(entry, dict) or not {"group", "pose"} <= set(entry):
+                raise PlanningError(f"{where}: expected {{group: ..., pose: ...}}, got {entry!r}")
+            try:
+                q = self.model.named_target(str(entry["group"]), str(entry["pose"]))
+            except PlanningError as e:
+                raise PlanningError(f"{where}: {e}") from None
+            held.update(zip(self.model.active_joints(str(entry["group"])), map(float, q)))
+        if held:
+            self.execution.hold(list(held), list(held.values()))
 
     def _load_params(self):
         """Its parameters, without the keys MoveIt's launch files put beside them: each

@@ -176,6 +176,29 @@ def test_watching_the_drawn_images_does_not_change_detections():
     assert sum(len(m.fiducials) for m in watched.vertices) >= 4
 
 
+def test_markers_of_another_dictionary_are_pointed_out(caplog):
+    """A DICT_4X4_50 marker with ``dictionary`` 8 (DICT_6X6_50) is never detected, and ROS's
+    aruco_detect says nothing; after 30 images without a marker the other dictionaries are
+    tried once, and the one that holds the marker is named. Plain images are not warned of."""
+    import logging
+
+    t = np.array([0.1, 0.0, 1.5])
+    img = marker_image(facing(20).as_rotvec(), t, K, W, H)
+    blank = np.full((H, W, 3), 170, np.uint8)
+    with caplog.at_level(logging.WARNING):
+        wrong = Harness({"fiducial_len": 0.15, "dictionary": 8})
+        for k in range(35):
+            wrong.send(img, t=1.0 + 0.1 * k)
+        quiet = Harness({"fiducial_len": 0.15})
+        for k in range(35):
+            quiet.send(blank, t=1.0 + 0.1 * k)
+    said = [r.getMessage() for r in caplog.records if "dictionary" in r.getMessage()]
+    assert len(said) == 1, said
+    assert "no marker of dictionary 8 (DICT_6X6_50) in 30 images" in said[0]
+    assert "markers of dictionary 0 (DICT_4X4_50), ids 0" in said[0]
+    assert all(len(m.fiducials) == 0 for m in wrong.vertices)
+
+
 def test_outputs_on_every_core_equal_one_threads():
     """OpenCV runs the package's 13 threshold windows as a parallel_for (its default thread
     count, one per core); markers, corners, poses and errors are a single thread's, exactly."""

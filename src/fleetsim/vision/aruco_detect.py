@@ -41,6 +41,7 @@ from fleetsim.tf import TransformBroadcaster, make_transform_stamped
 from fleetsim.vision.aruco_params import ArucoDetectParams, detector_parameters
 from fleetsim.vision.errors import VisionError
 from fleetsim.vision.fiducials import (
+    DICTIONARIES,
     aruco_dictionary,
     dictionary_size,
     fiducial_areas,
@@ -61,6 +62,10 @@ NO_IMAGES_TIME, NO_IMAGES_AGAIN = 5.0, 30.0
 _NO_CORNERS = np.zeros((0, 4, 2), np.float32)
 _NO_IDS = np.zeros(0, np.int64)
 _NO_VECS = np.zeros((0, 3))
+
+
+#: images in a row without a marker after which the other dictionaries are tried, once each
+DICTIONARY_CHECKS = (30, 300, 3000)
 
 
 class ArucoDetect(Node):
@@ -88,6 +93,8 @@ class ArucoDetect(Node):
         self.dist_coeffs = np.zeros(5)
         self.frame_id = ""
         self._warned_intrinsics = False
+        self._empty = 0  # images in a row without a marker
+        self._warned_dictionary = False
 
         self.vertices_pub = self.create_publisher(
             fiducial_msgs.FiducialArray, "fiducial_vertices", 1
@@ -208,12 +215,35 @@ class ArucoDetect(Node):
         keep = np.array([i not in self.ignore_ids for i in ids], dtype=bool)
         return corners[keep], ids[keep]
 
+    def _other_dictionaries(self, gray: np.ndarray) -> None:
+        """After `DICTIONARY_CHECKS` images in a row without a marker, look for markers of the
+        other dictionaries in this one: aruco_detect finds nothing of a marker printed from
+        another dictionary, and says nothing (a DICT_6X6 marker with ``dictionary`` 0)."""
+        p: ArucoDetectParams = self.params
+        for i, name in enumerate(DICTIONARIES):
+            if i == p.dictionary:
+                continue
+            other = cv2.aruco.ArucoDetector(aruco_dictionary(i), detector_parameters(p))
+            _, ids, _ = other.detectMarkers(gray)
+            if ids is not None and len(ids):
+                self._warned_dictionary = True
+                found = ", ".join(str(int(k)) for k in sorted(set(ids.reshape(-1).tolist())))
+                self.get_logger().warning(
+                    f"no marker of dictionary {p.dictionary} ({DICTIONARIES[p.dictionary]}) in "
+                    f"{self._empty} images, but this one holds markers of dictionary {i} "
+                    f"({name}), ids {found}: is the 'dictionary' parameter the markers'?"
+                )
+                return
+
     def process(self, gray: np.ndarray, stamp: Any, colour) -> None:
         """Detect, publish vertices, estimate and publish poses, for one image."""
         self.frames += 1
         p: ArucoDetectParams = self.params
         header = std_msgs.Header(stamp=stamp, frame_id=self.frame_id)
         corners, ids = self.detect(gray)
+        self._empty = 0 if len(ids) else self._empty + 1
+        if self._empty in DICTIONARY_CHECKS and not self._warned_dictionary:
+            self._other_dictionaries(gray)
         self.vertices_pub.publish(
             fiducial_msgs.FiducialArray(
                 header=header,

@@ -264,6 +264,21 @@ def test_no_camera_info_no_transforms_and_one_error(caplog):
     assert len(errors) == 1 and "/camera_info" in errors[0].getMessage()
 
 
+def test_no_camera_info_names_where_camera_info_is_published(caplog):
+    """The camera's info on /camera/rgb/camera_info, the detector reading /camera_info: the
+    error names where CameraInfo is published, as the missing image's warning does."""
+    rt = Runtime()
+    cam = Node(rt, "camera_driver")
+    images = cam.create_publisher(sensor_msgs.Image, "/camera", 1)
+    cam.create_publisher(sensor_msgs.CameraInfo, "/camera/rgb/camera_info", 1)
+    ArucoDetect(rt, params={"dictionary": 0})
+    for k in range(7):
+        images.publish(image_msg(np.zeros((H, W, 3), np.uint8), 1.0 + 0.1 * k, FRAME))
+        rt.spin_once()
+    (error,) = [r.getMessage() for r in caplog.records if "No camera intrinsics" in r.getMessage()]
+    assert "(no publisher; CameraInfo is published on /camera/rgb/camera_info)" in error
+
+
 def test_no_images_at_all_are_reported_and_the_report_stops_with_the_first(caplog):
     """A detector on a robot without a camera (the tutorial's burger) or behind a remap that
     misses it never gets an image: it says so at 5 s and every 30 s, not at every tick, and

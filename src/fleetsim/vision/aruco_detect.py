@@ -118,7 +118,9 @@ class ArucoDetect(Node):
             self.image_topic = base
             self._image_sub = self.create_subscription(sensor_msgs.Image, base, self.on_image, 1)
         self.info_topic = self.resolve_name("camera_info")
-        self.create_subscription(sensor_msgs.CameraInfo, self.info_topic, self.on_camera_info, 1)
+        self._info_sub = self.create_subscription(
+            sensor_msgs.CameraInfo, self.info_topic, self.on_camera_info, 1
+        )
         self.create_subscription(std_msgs.String, "ignore_fiducials", self.on_ignore, 1)
         self.create_service(std_srvs.SetBool, "enable_detections", self.on_enable)
         self._got_image = False
@@ -260,7 +262,8 @@ class ArucoDetect(Node):
                     self._warned_intrinsics = True
                     self.get_logger().error(
                         f"No camera intrinsics: nothing on {self.info_topic} after "
-                        f"{self.frames} images on {self.image_topic}; no fiducial_transforms"
+                        f"{self.frames} images on {self.image_topic}"
+                        f"{self.unpublished_hint(self._info_sub)}; no fiducial_transforms"
                     )
                 self._publish_image(colour, corners, ids, None, header)
                 return

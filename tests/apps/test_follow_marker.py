@@ -174,6 +174,19 @@ def test_a_missing_robot_pose_is_said_after_tfs_patience_then_every_5_s(caplog):
     assert 1 <= len(said) <= 3, [r.getMessage() for r in said]
 
 
+def test_a_bad_exploration_parameter_names_the_line_it_was_set_at():
+    """``<rosparam param="exploration">{strategy: spin}</rosparam>``: the error names the
+    launch file's line of the rosparam, as every other parameter error does."""
+    rt = Runtime(seed=0)
+    rt.params.set(
+        "/follow_marker/exploration",
+        {"strategy": "spin", "robot_frame": "base_footprint"},
+        origin="p13.launch:15",
+    )
+    with pytest.raises(ParameterError, match=r"got 'spin' \(set at p13.launch:15\)"):
+        FollowMarker(rt, params={"marker_id": 0})
+
+
 def test_clear_costmaps_every_5_s():
     rt, w, f = world()
     rt.run(duration=16.0)

@@ -137,13 +137,13 @@ class FollowMarker(Node):
         p: FollowMarkerParams = self.params
         offset = load_params(
             MarkerToTargetPose,
-            p.marker_to_target_pose,
+            self._sourced("marker_to_target_pose", p.marker_to_target_pose),
             where=f"{self.full_name}/marker_to_target_pose",
             logger=self.get_logger(),
         )
         self.offset = np.array([offset.x, offset.y, 0.0])
         self.exploration = Exploration.create(
-            self, p.exploration, where=f"{self.full_name}/exploration"
+            self, self._sourced("exploration", p.exploration), where=f"{self.full_name}/exploration"
         )
         self.base_frame = self.frame("base_footprint")
         self.map_frame = "map"
@@ -159,6 +159,12 @@ class FollowMarker(Node):
             fiducial_msgs.FiducialTransformArray, "fiducial_transforms", self.on_fiducials, 1
         )
         self.create_timer(CLEAR_COSTMAPS_PERIOD, self.clear_costmaps)
+
+    def _sourced(self, key: str, value: Any) -> Any:
+        """The private parameter ``key`` as the parameter tree holds it, with where each of its
+        values was set (a launch file's line), for errors about them; else ``value``."""
+        raw = self.get_param(f"~{key}", None)
+        return raw if isinstance(raw, dict) else value
 
     def _lookup(self, key: str, target: str, source: str, stamp: Any):
         """``target <- source`` at ``stamp``, or None (warned about once the failure has lasted

@@ -63,6 +63,11 @@ def test_until_goals_with_no_goal_at_all_says_so(tmp_path: Path, capsys):
         (["launch", "no_such_scenario", "--duration", "1"], "neither a launch file nor"),
         (["launch", "pioneer_multi"], "give --duration S, --until-goals, or both"),
         (["launch", "pioneer_multi", "robot", "--duration", "1"], "not of the form name:=value"),
+        (
+            ["launch", "robocluedo_robot_hunter", "run3.launch", "--duration", "1"],
+            r"package 'robocluedo_robot_hunter' \(.*\) has no launch file 'run3.launch'; it has "
+            r".*run2.launch",
+        ),
         (["launch", "pioneer_multi", "nope:=1", "--duration", "1"], r"unused args \['nope'\]"),
         (
             ["launch", "pioneer_multi", "--connect", "tcp/127.0.0.1:9", "--realtime"],
@@ -117,3 +122,9 @@ def test_launch_help_says_where_until_goals_gets_its_goals(capsys):
     text = " ".join(capsys.readouterr().out.replace("│", " ").split())
     for words in ("move_base action goals", "send_goals nodes", "'fleetsim goal'", "user nodes"):
         assert words in text, words
+
+
+def test_roslaunchs_package_file_form(capsys):
+    """``fleetsim launch robocluedo_robot_hunter run2.launch sim_type:=rviz``, as roslaunch."""
+    argv = ["launch", "robocluedo_robot_hunter", "run2.launch", "sim_type:=rviz"]
+    assert main([*argv, "--duration", "0.2", "--no-bridge"]) == 0, capsys.readouterr().err

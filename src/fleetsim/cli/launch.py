@@ -19,7 +19,12 @@ from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 from rich.table import Table
 
 from fleetsim.errors import LaunchError
-from fleetsim.launch.scenarios import resolve_launch_file, scenarios
+from fleetsim.launch.scenarios import (
+    LAUNCH_SUFFIXES,
+    package_launch_file,
+    resolve_launch_file,
+    scenarios,
+)
 
 console = Console(stderr=True)
 PIPED_WIDTH = 200  # columns of a table written to a pipe or a file
@@ -215,7 +220,9 @@ def register(app: typer.Typer) -> None:
     @app.command("launch")
     def launch(
         file: str = typer.Argument(
-            None, help="A launch file (.launch XML or .yaml) or a scenario."
+            None,
+            help="A launch file (.launch XML or .yaml), a scenario, or a package followed by "
+            "one of its launch files (roslaunch PACKAGE FILE).",
         ),
         args: list[str] = typer.Argument(None, help="Launch arguments name:=value."),
         duration: float = typer.Option(None, "--duration", help="Sim seconds to run."),
@@ -245,12 +252,16 @@ def register(app: typer.Typer) -> None:
             return
         if not file:
             raise LaunchError("name a launch file or a scenario (fleetsim launch --list)")
+        args = list(args or [])
+        if args and ":=" not in args[0] and args[0].endswith(LAUNCH_SUFFIXES):
+            # roslaunch PACKAGE FILE: `fleetsim launch robocluedo_robot_hunter run2.launch`
+            file = str(package_launch_file(file, args.pop(0)))
         from fleetsim.transport.keys import default_endpoint
 
         endpoint = None if no_bridge else (listen or default_endpoint())
         monitor = run_launch(
             file,
-            parse_launch_args(args or []),
+            parse_launch_args(args),
             duration,
             until_goals,
             record,

@@ -33,3 +33,22 @@ def resolve_launch_file(name: str) -> Path:
         f"'{name}' is neither a launch file nor a shipped scenario; scenarios: "
         f"{', '.join(known) or 'none'} (fleetsim launch --list)"
     )
+
+
+LAUNCH_SUFFIXES = (".launch", ".xml", ".yaml", ".yml", ".py")
+
+
+def package_launch_file(pkg: str, name: str) -> Path:
+    """roslaunch's ``PACKAGE FILE`` form: the launch file ``name`` in package ``pkg`` (its
+    ``launch`` folder first, then anywhere in it); a `LaunchError` naming what it holds."""
+    from fleetsim.launch.packages import default_finder
+
+    root = default_finder(Path.cwd())(pkg)
+    found = [root / "launch" / name] if (root / "launch" / name).is_file() else []
+    found += sorted(p for p in root.rglob(name) if p.is_file() and p not in found)
+    if found:
+        return found[0]
+    held = sorted(p.name for p in root.rglob("*.launch"))
+    raise LaunchError(
+        f"package '{pkg}' ({root}) has no launch file '{name}'; it has {', '.join(held) or 'none'}"
+    )

@@ -491,3 +491,15 @@ def test_a_group_state_missing_a_joint_is_warned_about(hunter_robot, caplog):
         "group state 'cam_left' doesn't specify all joints of group 'arm_group' "
         "(arm_joint_01 missing: taken as 0)" in caplog.text
     )
+
+
+def test_a_timed_out_execution_says_when_the_physics_is_paused(hunter_robot):
+    """``gazebo_paused:=true``: the arm never moves and the execution times out; the message
+    says the physics is paused."""
+    h = Hunters(hunter_robot)
+    arm = MoveGroupCommander("arm_group", ns="/hunter1", runtime=h.rt)
+    h.sim.engine.paused = True
+    assert not arm.go("cam_left")
+    result, text = arm.last_result()
+    assert result.error_code.val == E.TIMED_OUT
+    assert "The simulator's physics is paused (/gazebo/unpause_physics)" in text

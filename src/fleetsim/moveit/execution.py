@@ -173,9 +173,15 @@ class ExecutionManager:
                 done(E.SUCCESS, "")
             return
         if self.settings.get("execution_duration_monitoring", True) and self.node.now() > deadline:
+            paused = getattr(self.node, "physics_paused", lambda: False)()
             self.stop(
                 "Controller is taking too long to execute trajectory (the expected upper bound "
-                f"for the trajectory execution was {limit:.4f} seconds). Stopping trajectory.",
+                f"for the trajectory execution was {limit:.4f} seconds). Stopping trajectory."
+                + (
+                    " The simulator's physics is paused (/gazebo/unpause_physics)."
+                    if paused
+                    else ""
+                ),
                 E.TIMED_OUT,
             )
 

@@ -199,6 +199,15 @@ class MoveGroup(Node):
                     q[joints.index(n)] = v
         return q
 
+    def physics_paused(self) -> bool:
+        """Whether a simulator in this process has its physics paused (a trajectory then never
+        moves, and its execution times out)."""
+        from fleetsim.sim.node import Simulator
+
+        return any(
+            isinstance(n, Simulator) and n.engine.paused for n in self.runtime.graph.nodes.values()
+        )
+
     def sync_world(self) -> None:
         """Copy the simulator's world near this robot into each group's collision scene."""
         from fleetsim.sim.node import Simulator

@@ -40,3 +40,23 @@ def test_footprint_sources_in_order():
 
 def test_colours_cycle():
     assert colour_of(0) == colour_of(10) != colour_of(1)
+
+
+def test_a_robot_without_move_base_is_drawn_by_its_collision_shapes():
+    """The tutorial's leader (a burger driven by cmd_vel, no move_base) had been drawn as
+    costmap_2d's default 0.92 m disc; its URDF's collision shapes give 0.14 x 0.18 m. A
+    costmap footprint still comes first; a URDF that does not parse leaves the default."""
+    from fleetsim.description import load_robot
+    from fleetsim.description.packages import ASSET_ROBOTS
+
+    burger = load_robot(
+        ASSET_ROBOTS / "turtlebot3_burger" / "urdf" / "turtlebot3_burger.urdf.xacro"
+    )
+    params = {"karl": {"robot_description": burger.to_urdf()}}
+    fp = footprint_from_params(params, "karl")
+    size = fp.max(axis=0) - fp.min(axis=0)
+    np.testing.assert_allclose(size, [0.140, 0.178], atol=0.005)
+    params["karl"]["move_base"] = {"robot_radius": 0.1}
+    assert np.allclose(np.hypot(*footprint_from_params(params, "karl").T), 0.1)
+    broken = {"x": {"robot_description": "<robot name='x'><link name="}}
+    assert np.allclose(np.hypot(*footprint_from_params(broken, "x").T), DEFAULT_ROBOT_RADIUS)

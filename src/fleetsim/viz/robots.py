@@ -4,8 +4,9 @@ A robot is a tf prefix with a ``<prefix>/base_footprint`` or ``<prefix>/base_lin
 (the seeds' convention: robot ``lizi1`` in namespace ``/lizi1`` with ``tf_prefix`` ``lizi1``).
 Its footprint comes, in this order, from its costmap's ``footprint`` topic (if recorded), the
 ``footprint`` parameter of ``<ns>/move_base/local_costmap`` (or ``global_costmap``, or
-``move_base``), the ``robot_radius`` parameter there, else a circle of costmap_2d's default
-``robot_radius`` (0.46 m).
+``move_base``), the ``robot_radius`` parameter there, the rectangle around the collision
+shapes of its ``robot_description``, else a circle of costmap_2d's default ``robot_radius``
+(0.46 m).
 """
 
 from __future__ import annotations
@@ -95,7 +96,61 @@ def footprint_from_params(params: dict, robot: str) -> np.ndarray:
         radius = node.get("robot_radius")
         if isinstance(radius, int | float) and radius > 0:
             return circle_footprint(float(radius))
+    description = ns.get("robot_description")
+    if isinstance(description, str) and description.strip():
+        found = urdf_footprint(description)
+        if found is not None:
+            return found
     return circle_footprint(DEFAULT_ROBOT_RADIUS)
+
+
+def urdf_footprint(text: str) -> np.ndarray | None:
+    """The rectangle (4, 2) in the root link's frame that holds the robot's collision boxes,
+    cylinders and spheres seen from above, every joint at zero (meshes are left out); None
+    when the URDF does not parse or has none. For a robot without move_base (a leader driven
+    by cmd_vel), which costmap_2d's 0.46 m default drew as a 0.92 m disc."""
+    from fleetsim.description.urdf import parse_urdf
+    from fleetsim.errors import FleetsimError
+    from fleetsim.tf.quaternions import matrix_from_quaternion, quaternion_from_euler
+
+    try:
+        robot = parse_urdf(text)
+    except FleetsimError:
+        return None
+
+    def pose(origin) -> np.ndarray:
+        m = np.eye(4)
+        m[:3, :3] = matrix_from_quaternion(quaternion_from_euler(*origin.rpy))
+        m[:3, 3] = origin.xyz
+        return m
+
+    points = []
+    stack = [(robot.root_link(), np.eye(4))]
+    while stack:
+        name, at = stack.pop()
+        for c in robot.links[name].collisions:
+            g, m = c.geometry, at @ pose(c.origin)
+            if hasattr(g, "size"):  # a box: its eight corners
+                h = np.asarray(g.size, float) / 2
+                local = np.array([[x, y, z] for x in (-h[0], h[0]) for y in (-h[1], h[1])
+                                  for z in (-h[2], h[2])])  # fmt: skip
+            elif hasattr(g, "length"):  # a cylinder along its z: two rims
+                a = np.linspace(0, 2 * np.pi, 16, endpoint=False)
+                rim = np.column_stack([g.radius * np.cos(a), g.radius * np.sin(a)])
+                local = np.vstack([np.column_stack([rim, np.full(16, z)])
+                                   for z in (-g.length / 2, g.length / 2)])  # fmt: skip
+            elif hasattr(g, "radius"):  # a sphere: its axis extremes
+                local = np.vstack([np.eye(3) * g.radius, -np.eye(3) * g.radius])
+            else:
+                continue
+            points.append(local @ m[:3, :3].T + m[:3, 3])
+        for j in robot.children(name):
+            stack.append((j.child, at @ pose(j.origin)))
+    if not points:
+        return None
+    xy = np.vstack(points)[:, :2]
+    (x0, y0), (x1, y1) = xy.min(axis=0), xy.max(axis=0)
+    return np.array([[x1, y1], [x0, y1], [x0, y0], [x1, y0]])
 
 
 def colour_of(index: int) -> tuple[float, float, float]:

@@ -177,6 +177,30 @@ def test_a_follower_keeps_a_goal_run_going_and_is_no_failure():
     assert monitor.senders_failed() == [] and "/f" not in " ".join(monitor.failures())
 
 
+def test_a_followers_goal_still_going_or_withdrawn_at_the_end_is_no_failure():
+    """A follower's newest goal is normally still active when the run ends, and the exploration
+    goals it cancels on seeing the marker again end PREEMPTED: neither fails its robot."""
+    rt = Runtime(seed=0)
+    MoveBase(rt, lambda n, server: None)  # never finishes: the marker keeps moving
+    follower = SimpleNamespace(
+        sends_goals=True, follows=True, done=False, full_name="/f", namespace="/",
+        withdrawn_goals=set(),
+    )  # fmt: skip
+    monitor = RunMonitor(rt, PLAN, {"/f": follower})
+    client = Node(rt, "user").create_action_client(move_base_msgs.MoveBase, "/move_base")
+    rt.run(duration=0.2)
+    first = client.send_goal(move_base_msgs.MoveBase.Goal())
+    rt.run(duration=0.5)
+    follower.withdrawn_goals.add(first.goal_id.id)
+    first.cancel()
+    rt.run(duration=0.5)
+    client.send_goal(move_base_msgs.MoveBase.Goal())  # still going when the run ends
+    rt.run(duration=0.5)
+    (r,) = monitor.results()
+    assert r.followed and not r.all_done and r.goals_failed == 0
+    assert monitor.failures() == [] and r.ok
+
+
 @pytest.mark.parametrize(
     ("goals", "succeeded"),
     [([[1.0, 0.0], [1.0, 1.0]], True), ([[1.0, 0.0], [-2.0, 0.0]], False), ([], False)],

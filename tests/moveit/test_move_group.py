@@ -503,3 +503,35 @@ def test_a_timed_out_execution_says_when_the_physics_is_paused(hunter_robot):
     result, text = arm.last_result()
     assert result.error_code.val == E.TIMED_OUT
     assert "The simulator's physics is paused (/gazebo/unpause_physics)" in text
+
+
+def test_a_fixed_virtual_joint_needs_no_tf(hunter_robot):
+    """The Setup Assistant's ``<virtual_joint type="fixed" parent_frame="world">``: the planning
+    frame is ``world``, which no one publishes on tf; MoveIt's model holds that transform
+    (identity), so targets without a frame and get_current_pose work without it."""
+    from fleetsim.control.spawner import Spawner
+    from fleetsim.sim.node import Simulator
+
+    from .conftest import HUNTER
+
+    rt = Runtime()
+    sim = Simulator(rt)
+    load_hunter_params(rt, "/hunter1", hunter_robot)
+    srdf = (HUNTER / "config" / "robocluedo_robot.srdf").read_text()
+    vj = '<virtual_joint name="vj" type="fixed" parent_frame="world" child_link="base_link"/>'
+    rt.params.set("/hunter1/robot_description_semantic", srdf.replace("</robot>", vj + "</robot>"))
+    sim.spawn_robot("hunter1", hunter_robot, (0, 0, 0.05, 0, 0, 0), "/hunter1")
+    Spawner(rt, "spawner", "/hunter1", args=["joint_state_controller", "arm_group_controller"])
+    MoveGroup(rt, "move_group", "/hunter1")
+    rt.run(0.3)
+    arm = MoveGroupCommander("arm_group", ns="/hunter1", runtime=rt)
+    assert arm.get_planning_frame() == "world"
+    assert arm.go("home")
+    here = arm.get_current_pose()
+    assert here.header.frame_id == "world"
+    p = here.pose.position
+    arm.set_goal_position_tolerance(0.005)
+    arm.set_position_target([p.x, p.y, p.z - 0.03])
+    assert arm.go(), arm.last_result()
+    assert arm.get_current_pose().pose.position.z == pytest.approx(p.z - 0.03, abs=0.006)
+    assert_no_mujoco_warnings(sim.engine)

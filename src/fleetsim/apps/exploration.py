@@ -147,6 +147,10 @@ class Exploration(ABC):
         if self.exploring and not self.cancelled and self.handle is not None:
             self.handle.cancel()
             self.cancelled = True
+            # the follower no longer wants it: for the run monitor, no failure
+            withdrawn = getattr(self.node, "withdrawn_goals", None)
+            if withdrawn is not None:
+                withdrawn.add(self.handle.goal_id.id)
             if not self.handle.heard:  # no server to answer: no done callback will come
                 self.exploring = self.cancelled = False
 

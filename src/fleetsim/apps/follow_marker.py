@@ -134,6 +134,7 @@ class FollowMarker(Node):
 
     def __init__(self, runtime, name: str = "follow_marker", namespace: str = "/", **kw: Any):
         super().__init__(runtime, name, namespace, **kw)
+        self.withdrawn_goals: set[str] = set()  # exploration goals it canceled
         p: FollowMarkerParams = self.params
         offset = load_params(
             MarkerToTargetPose,

@@ -70,6 +70,7 @@ class PredictiveFollower(Node):
 
     def __init__(self, runtime, name: str = "predictive_follower", namespace: str = "/", **kw):
         super().__init__(runtime, name, namespace, **kw)
+        self.withdrawn_goals: set[str] = set()  # exploration goals it canceled
         p: PredictiveFollowerParams = self.params
         where = self.full_name
         self.tracker = TargetTracker(

@@ -115,6 +115,9 @@ class RobotResult:
     goal_id: str = ""
     #: the ids of the failed goals, in order
     failed_ids: list[str] = field(default_factory=list, repr=False)
+    #: a follower (follow_marker) drives it: its newest goal is still going when the run ends,
+    #: and that is no failure
+    followed: bool = False
 
     @property
     def all_done(self) -> bool:
@@ -131,7 +134,7 @@ class RobotResult:
             all(i in handled for i in self.failed_ids)
             and self.goals_unconfirmed == 0
             and self.collisions == 0
-            and self.all_done
+            and (self.all_done or self.followed)
         )
 
 
@@ -405,7 +408,13 @@ class RunMonitor:
     # -- summary ------------------------------------------------------------------------
     def results(self) -> list[RobotResult]:
         """Every robot's result, with ground-truth distance and localization error as of now."""
+        followed = {
+            getattr(s, "namespace", "/").rstrip("/") or "/"
+            for s in self.senders
+            if getattr(s, "follows", False)
+        }
         for ns, r in self.robots.items():
+            r.followed = (ns.rstrip("/") or "/") in followed
             truth = self._true_xy(ns)
             if truth is None:
                 continue
@@ -431,7 +440,7 @@ class RunMonitor:
                 why.append(f"{len(failed)} failed")
             if r.goals_unconfirmed:
                 why.append(f"{r.goals_unconfirmed} reported reached but not confirmed")
-            if not r.all_done:
+            if not r.all_done and not r.followed:
                 finished = r.goals_reached + r.goals_failed + r.goals_unconfirmed
                 why.append(f"{r.goals_sent - finished} not finished when the run ended")
             if why:

@@ -122,6 +122,8 @@ class MoveGroupCommander:
 
     def get_planning_frame(self) -> str:
         """A virtual joint's parent frame, else the robot's root link (MoveIt's model frame)."""
+        if hasattr(self._mg, "planning_frame"):  # in process: move_group's own
+            return self._mg.planning_frame
         vj = self._model.srdf.virtual_joints
         return self._mg.frame(vj[0].parent_frame if vj else self._model.robot.root_link())
 
@@ -297,14 +299,18 @@ class MoveGroupCommander:
         self.clear_pose_targets()
 
     def set_orientation_target(self, q, end_effector_link: str = "") -> None:
-        """The end effector turned to ``q`` (x y z w, or roll pitch yaw) where it is now."""
-        p = self.get_current_pose(end_effector_link).pose.position
+        """The end effector turned to ``q`` (x y z w, or roll pitch yaw, in the planning frame)
+        where it is now."""
+        here = self.get_current_pose(end_effector_link)  # in the planning frame
         q = list(q)
         if len(q) == 3:
             q = list(quaternion_from_euler(*q))
         if len(q) != 4:
             raise MoveItCommanderException("Expected [qx, qy, qz, qw] or [r, p, y]")
-        self.set_pose_target([p.x, p.y, p.z, *q], end_effector_link)
+        # the position stays where it is (fleetsim's pose goals constrain the position too;
+        # MoveIt leaves it free), both in the frame get_current_pose gave them in
+        here.pose.orientation = geometry_msgs.Quaternion(*map(float, q))
+        self.set_pose_target(here, end_effector_link)
 
     def set_rpy_target(self, rpy, end_effector_link: str = "") -> None:
         if len(rpy) != 3:

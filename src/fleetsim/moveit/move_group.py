@@ -241,12 +241,21 @@ class MoveGroup(Node):
         vj = self.model.srdf.virtual_joints
         return self.frame(vj[0].parent_frame) if vj else self.root_frame
 
+    def _same_as_root(self, frame: str) -> str:
+        """The root link's frame for a *fixed* virtual joint's parent frame (``world`` in
+        the Setup Assistant's configs): MoveIt's model holds that transform, identity, and no
+        one publishes it on tf; a planar or floating one's parent is looked up through tf."""
+        vj = self.model.srdf.virtual_joints
+        if vj and vj[0].type == "fixed" and frame == self.frame(vj[0].parent_frame):
+            return self.root_frame
+        return frame
+
     def frame_transform(self, target: str, source: str):
         """``(t (3,), q (4,) x y z w)`` of frame ``source`` in ``target`` through tf (either
         empty: the planning frame); None when they are the same frame. A frame tf does not
         know fails with MoveIt's FRAME_TRANSFORM_FAILURE."""
-        target = target.lstrip("/") or self.planning_frame
-        source = source.lstrip("/") or self.planning_frame
+        target = self._same_as_root(target.lstrip("/") or self.planning_frame)
+        source = self._same_as_root(source.lstrip("/") or self.planning_frame)
         if target == source:
             return None
         try:

@@ -64,6 +64,10 @@ def test_until_goals_with_no_goal_at_all_says_so(tmp_path: Path, capsys):
         (["launch", "pioneer_multi"], "give --duration S, --until-goals, or both"),
         (["launch", "pioneer_multi", "robot", "--duration", "1"], "not of the form name:=value"),
         (
+            ["launch", "visual_servoing", "--until-goals", "--no-bridge"],
+            r"--until-goals without --duration: /follow_marker is a follower",
+        ),
+        (
             ["launch", "robocluedo_robot_hunter", "run3.launch", "--duration", "1"],
             r"package 'robocluedo_robot_hunter' \(.*\) has no launch file 'run3.launch'; it has "
             r".*run2.launch",

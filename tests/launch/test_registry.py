@@ -49,7 +49,8 @@ def test_a_user_node_module_beside_the_launch_file_or_in_the_working_directory(
     (cwd / "fs_probe_teleop_b.py").write_text(code)
     monkeypatch.chdir(cwd)
     monkeypatch.setattr("sys.path", list(__import__("sys").path))
-    where = f"{beside / 'my.launch'}:7 <node>"
+    # a node of an included file: "file:line <node> (included from top:line <include>)"
+    where = f"{beside / 'my.launch'}:7 <node> (included from {cwd / 'top.launch'}:2 <include>)"
     assert resolve_node("p", "fs_probe_teleop_a:Teleop", where).__name__ == "Teleop"
     assert resolve_node("p", "fs_probe_teleop_b:Teleop", where).__name__ == "Teleop"
     with pytest.raises(LaunchError, match="beside the launch file and in the working directory"):

@@ -173,6 +173,12 @@ def run_launch(
     rate = 1.0 if realtime else None
     with LaunchSession(plan, seed=seed, viz=viz, record=record, listen=listen) as session:
         rt = session.runtime
+        followers = [s for s in session.monitor.senders if getattr(s, "follows", False)]
+        if until_goals and duration is None and followers:
+            raise LaunchError(
+                f"--until-goals without --duration: {followers[0].full_name} is a follower, "
+                "which never finishes; give --duration S"
+            )
         total = duration if duration is not None else 3600.0
         until = session.monitor.all_goals_done if until_goals else None
         wall0 = time.monotonic()

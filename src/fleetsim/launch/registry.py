@@ -8,6 +8,7 @@ that lists what exists.
 from __future__ import annotations
 
 import importlib
+import re
 import sys
 from pathlib import Path
 from typing import Any
@@ -83,13 +84,18 @@ def _import_beside(module: str, error: ModuleNotFoundError, where: str) -> Any:
     top = module.split(".")[0]
     if error.name != top:
         return None  # the module was found; something it imports was not
-    dirs = [Path(where.rsplit(":", 1)[0]).resolve().parent] if where else []
+    # ``where`` is "file:line <node>", perhaps "(included from other.launch:3 <include>)"
+    found = re.match(r"(.*?):\d+( <|$)", where)
+    dirs = [Path(found.group(1)).resolve().parent] if found else []
     dirs.append(Path.cwd())
     for d in dirs:
         if (d / f"{top}.py").is_file() or (d / top / "__init__.py").is_file():
             if str(d) not in sys.path:
-                sys.path.insert(0, str(d))
-            return importlib.import_module(module)
+                sys.path.append(str(d))  # after the path's own: a stray yaml.py shadows nothing
+            try:
+                return importlib.import_module(module)
+            except ImportError as e:
+                raise LaunchError(f"{where}: cannot import module '{module}' ({d}): {e}") from None
     return None
 
 

@@ -49,8 +49,9 @@ def robot_model(client, ns: str):
 
 #: wall seconds between checks that the simulation a commander waits on is still there
 LIVENESS_PERIOD = 1.0
-#: wall seconds the simulation's clock may stand still before a wait gives up
-CLOCK_STALL = 10.0
+#: wall seconds the simulation's clock may stand still before a wait gives up (move_group
+#: plans inside one callback, the clock standing meanwhile: this is well above a plan's time)
+CLOCK_STALL = 60.0
 
 
 class _Handle:

@@ -121,4 +121,4 @@ def test_a_launch_file_that_starts_no_node_is_warned_about(tmp_path, caplog):
     )
     with caplog.at_level(logging.WARNING), LaunchSession(load_plan(f), seed=1):
         pass
-    assert "the launch file starts no node" in caplog.text
+    assert "the launch file starts no node and sets no parameter" in caplog.text

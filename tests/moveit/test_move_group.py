@@ -326,9 +326,11 @@ def test_a_goal_already_met_succeeds_without_moving(one):
         assert arm.go(target), arm.last_result()
         result, text = arm.last_result()
         assert text == "Requested path and goal constraints are already met."
-        assert not result.planned_trajectory.joint_trajectory.points
+        (point,) = result.planned_trajectory.joint_trajectory.points  # the start, at rest
+        assert point.time_from_start.to_sec() == 0.0
+    # a plan of it holds that one point (MoveIt's tutorials test for points), and executes
     ok, traj, _, _ = arm.plan(arm.get_current_joint_values())
-    assert ok and not traj.joint_trajectory.points and arm.execute(traj)
+    assert ok and len(traj.joint_trajectory.points) == 1 and arm.execute(traj)
     arm.set_goal_position_tolerance(0.01)
     arm.set_position_target(
         [getattr(arm.get_current_pose().pose.position, k) for k in ("x", "y", "z")]
@@ -359,7 +361,10 @@ def test_joint_limits_yaml_values_are_checked_when_move_group_starts(hunter_robo
     rt.params.set("/hunter1/robot_description_planning/default_velocity_scaling_factor", 0.0)
     with caplog.at_level(logging.WARNING):
         MoveGroup(rt, "move_group", "/hunter1")
-    assert "max_velocty is not a joint limit; ignored (did you mean 'max_velocity'?)" in caplog.text
+    assert (
+        "max_velocty is not a joint limit fleetsim reads; ignored (did you mean 'max_velocity'?)"
+        in caplog.text
+    )
     assert "default_velocity_scaling_factor is 0, outside (0, 1]" in caplog.text
 
 

@@ -121,3 +121,18 @@ def test_timing_stays_within_scaled_limits(scaling):
     assert not vel[0].any() and not vel[-1].any()
     # the limit is reached: joint 1 moves 3.25 rad at 0.2 rad/s * scaling
     assert t[-1] == pytest.approx(3.25 / (0.2 * scaling) + 0.2 * scaling, rel=0.05)
+
+
+@pytest.mark.parametrize("points", [2, 3, 5])
+def test_a_move_a_hair_long_is_timed_within_the_limits(points):
+    """Paths shorter than ~5e-5 rad, two points or more (a short Cartesian path, a plan's path
+    with its goal appended): toppra found no profile for them; they are timed in closed form,
+    from rest to rest, within the scaled limits, through the path's points."""
+    rng = np.random.default_rng(points)
+    path = np.cumsum(rng.uniform(-1e-5, 1e-5, (points, 4)), axis=0)
+    vmax, amax = np.array([0.2, 0.2, 0.2, 0.5]), np.array([1.0, 1.0, 1.0, 2.0])
+    t, pos, vel, acc = time_parameterize(path, vmax, amax, 0.5, 0.5)
+    assert t[0] == 0.0 and t[-1] > 0 and np.all(np.diff(t) > 0)
+    np.testing.assert_allclose(pos[0], path[0]) and np.testing.assert_allclose(pos[-1], path[-1])
+    assert np.all(np.abs(vel) <= 0.5 * vmax + 1e-12) and np.all(np.abs(acc) <= 0.5 * amax + 1e-9)
+    assert not vel[0].any() and not vel[-1].any()

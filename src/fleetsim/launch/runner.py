@@ -86,12 +86,13 @@ class LaunchSession:
             _log.info(note)
         for spec in self.plan.nodes:
             self._start_node(spec)
-        if not self.plan.nodes and self.connect is None:
+        if not self.plan.nodes and not self.plan.params and self.connect is None:
             # roslaunch runs such a file without a word; mostly it is an if/unless whose
-            # argument was misspelt (a sim_type no group matches)
+            # argument was misspelt (a sim_type no group matches); a file that only sets
+            # parameters (an upload.launch) is left alone
             _log.warning(
-                "the launch file starts no node: check its if/unless conditions and the "
-                "arguments they read"
+                "the launch file starts no node and sets no parameter: check its if/unless "
+                "conditions and the arguments they read"
             )
         self.monitor = RunMonitor(rt, self.plan, self.nodes)
         if self.listen is not None and self.connect is None:

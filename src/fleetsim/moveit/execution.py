@@ -74,6 +74,7 @@ class ExecutionManager:
         if not jt.points:
             done(E.SUCCESS, "empty trajectory")
             return
+        standing = len(jt.points) == 1 and jt.points[0].time_from_start.to_sec() == 0.0
         if not self.fake:
             try:
                 controller = self.controller_for(list(jt.joint_names))
@@ -99,6 +100,9 @@ class ExecutionManager:
                     f"robot state more than {tol:g}",
                 )
                 return
+        if standing:  # one point, at rest where the arm is (a plan of a goal already met)
+            done(E.SUCCESS, "nothing to move")
+            return
         duration = jt.points[-1].time_from_start.to_sec()
         limit = duration * float(
             self.settings.get("allowed_execution_duration_scaling", 1.2)

@@ -45,6 +45,15 @@ from fleetsim.tf.transforms import transform_points
 E = moveit_msgs.MoveItErrorCodes
 FAKE = "moveit_fake_controller_manager/MoveItFakeControllerManager"
 _NO_TURN = np.array([0.0, 0.0, 0.0, 1.0])  # x y z w
+
+
+def _standing(traj) -> bool:
+    """A trajectory with nothing to move: no point, or one at its start time (a goal the start
+    already met)."""
+    points = traj.joint_trajectory.points
+    return len(points) <= 1 and all(p.time_from_start.to_sec() == 0.0 for p in points)
+
+
 SHAPES = {
     shape_msgs.SolidPrimitive.BOX: mujoco.mjtGeom.mjGEOM_BOX,
     shape_msgs.SolidPrimitive.SPHERE: mujoco.mjtGeom.mjGEOM_SPHERE,
@@ -323,7 +332,7 @@ class MoveGroup(Node):
         res.trajectory_start.joint_state.position = start
         res.trajectory, res.planning_time = plan.trajectory, plan.planning_time
         res.error_code.val = E.SUCCESS
-        if not plan.trajectory.joint_trajectory.points:
+        if _standing(plan.trajectory):
             self.get_logger().info(
                 "%s: goal constraints are already satisfied; no need to plan or execute any "
                 "motions", req.group_name,
@@ -398,7 +407,7 @@ class MoveGroup(Node):
                 result, text or "No motion plan found. No execution attempted."
             )
             return
-        if not res.trajectory.joint_trajectory.points:  # MoveIt's words for nothing to do
+        if _standing(res.trajectory):  # MoveIt's words for nothing to do
             self.move_action.set_succeeded(
                 result, "Requested path and goal constraints are already met."
             )

@@ -187,16 +187,18 @@ class PlanningPipeline:
         if q is not None:
             return q
         where = f"({target[0]:.3f}, {target[1]:.3f}, {target[2]:.3f})"
+        # move_group gives the goal in the root link's frame, whatever frame it came in
+        frame = f"{self.model.robot.root_link()}'s frame"
         if quat is None:
             raise PlanFailure(
                 E.NO_IK_SOLUTION,
-                f"no collision-free IK solution puts '{link}' at {where} in the planning frame",
+                f"no collision-free IK solution puts '{link}' at {where} in {frame}",
             )
         if self.ik(ctx, link, target, start, tolerance=max(float(tol), 1e-4)) is None:
             # not the orientation: the position itself is out of reach (or only in collision)
             raise PlanFailure(
                 E.NO_IK_SOLUTION,
-                f"no collision-free IK solution puts '{link}' at {where} in the planning frame, "
+                f"no collision-free IK solution puts '{link}' at {where} in {frame}, "
                 "whatever its orientation: the position is out of the arm's reach or in "
                 "collision",
             )
@@ -211,7 +213,7 @@ class PlanningPipeline:
         raise PlanFailure(
             E.NO_IK_SOLUTION,
             f"no collision-free IK solution puts '{link}' at {where} turned to "
-            f"(x y z w) ({q_txt}) in the planning frame{few}",
+            f"(x y z w) ({q_txt}) in {frame}{few}",
         )
 
     def ik(
@@ -241,10 +243,12 @@ class PlanningPipeline:
         goal = self.goal_from_constraints(ctx, req.goal_constraints[0], start)
         if self._already_met(ctx, req.goal_constraints[0], start, goal):
             # move_group: "Goal constraints are already satisfied. No need to plan or execute
-            # any motions" (an empty trajectory; timing a zero-length path fails in toppra)
-            empty = moveit_msgs.RobotTrajectory()
-            empty.joint_trajectory.joint_names = list(ctx.joints)
-            return PlanResult(empty, time.perf_counter() - t0, "", 0.0, "")
+            # any motions": the trajectory is the start alone, at rest (a plan's caller finds
+            # a point in it; timing a zero-length path fails in toppra)
+            return PlanResult(
+                self.timed_trajectory(ctx, start[None, :], 1.0, 1.0),
+                time.perf_counter() - t0, "", 0.0, "",
+            )  # fmt: skip
         vs = _scaling(req.max_velocity_scaling_factor)
         acs = _scaling(req.max_acceleration_scaling_factor)
         planner = req.planner_id or self.default_planner.get(ctx.group) or "RRTConnect"

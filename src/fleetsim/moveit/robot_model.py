@@ -30,6 +30,8 @@ LIMIT_KEYS = {
     "max_velocity": float,
     "has_acceleration_limits": bool,
     "max_acceleration": float,
+    "has_deceleration_limits": bool,  # pilz_industrial_motion_planner's
+    "max_deceleration": float,
     "has_jerk_limits": bool,
     "max_jerk": float,
     "has_effort_limits": bool,
@@ -66,7 +68,10 @@ def _checked_limits(joint: str, joint_limits) -> dict:
         kind = LIMIT_KEYS.get(key)
         where = f"{base}/{key}{_set_at(entry, key)}"
         if kind is None:
-            _log.warning("%s is not a joint limit; ignored%s", where, did_you_mean(key, LIMIT_KEYS))
+            _log.warning(
+                "%s is not a joint limit fleetsim reads; ignored%s",
+                where, did_you_mean(key, LIMIT_KEYS),
+            )  # fmt: skip
         elif kind is bool and not isinstance(v, bool):
             raise PlanningError(f"{where}: {v!r} is not true or false")
         elif kind is float and not _is_number(v):

@@ -48,8 +48,8 @@ def time_parameterize(
     s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(path, axis=0), axis=1))])
     vmax = np.asarray(max_velocity, float) * velocity_scaling
     amax = np.asarray(max_acceleration, float) * acceleration_scaling
-    if len(path) == 2 and s[-1] < TINY_MOTION:
-        return _tiny_motion(path, vmax, amax)
+    if s[-1] < TINY_MOTION:
+        return _tiny_motion(path, s, vmax, amax)
     spline = ta.SplineInterpolator(s / s[-1], path) if len(path) > 2 else None
     if spline is None:  # two points: a straight line (toppra's spline needs three)
         mid = 0.5 * (path[0] + path[1])
@@ -72,19 +72,24 @@ def time_parameterize(
     return t, pos, vel, acc
 
 
-def _tiny_motion(path: np.ndarray, vmax: np.ndarray, amax: np.ndarray):
-    """A straight move of less than `TINY_MOTION`, timed in closed form: accelerate for half
-    the time and brake for the other half, the duration the longest any joint needs within
-    its acceleration and (peak) velocity limits."""
-    delta = np.abs(path[1] - path[0])
-    T = float(np.max(np.maximum(2 * np.sqrt(delta / amax), 2 * delta / vmax)))
+def _tiny_motion(path: np.ndarray, s: np.ndarray, vmax: np.ndarray, amax: np.ndarray):
+    """A move of less than `TINY_MOTION` along ``path`` (its cumulative length ``s``), timed in
+    closed form: accelerate along the path for half the time and brake for the other half, the
+    duration the longest any joint needs within its acceleration and peak velocity limits at
+    the path's steepest segment for it."""
+    S = s[-1]
+    slope = np.abs(np.diff(path, axis=0)) / np.diff(s)[:, None]  # |dq/ds| per segment, joint
+    reach = S * slope.max(axis=0)  # what each joint would move along the whole path's length
+    T = float(np.max(np.maximum(2 * np.sqrt(reach / amax), 2 * reach / vmax)))
     n = max(3, int(np.ceil(T / SAMPLE_PERIOD)) + 1)
     t = np.linspace(0.0, T, n)
     x = t / T
-    u = np.where(x <= 0.5, 2 * x**2, 1 - 2 * (1 - x) ** 2)
+    u = np.where(x <= 0.5, 2 * x**2, 1 - 2 * (1 - x) ** 2)  # share of the path's length
     du = np.where(x <= 0.5, 4 * x, 4 * (1 - x)) / T
     ddu = np.where(x < 0.5, 4.0, -4.0) / T**2
-    step = path[1] - path[0]
-    pos = path[0] + u[:, None] * step
-    pos[-1] = path[1]
-    return t, pos, du[:, None] * step, ddu[:, None] * step
+    at = u * S
+    pos = np.column_stack([np.interp(at, s, path[:, j]) for j in range(path.shape[1])])
+    seg = np.clip(np.searchsorted(s, at, side="right") - 1, 0, len(s) - 2)
+    dq_ds = np.diff(path, axis=0)[seg] / np.diff(s)[seg][:, None]
+    pos[-1] = path[-1]
+    return t, pos, (du * S)[:, None] * dq_ds, (ddu * S)[:, None] * dq_ds

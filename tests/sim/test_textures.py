@@ -124,6 +124,8 @@ def test_a_material_name_no_script_defines_is_warned_about(tmp_path):
         UserWarning, match=r"model 'sign' \(<string>\): material script 'Sign/Quadrnts' is not "
     ):
         load_sdf_model(text.replace("Sign/Quadrants", "Sign/Quadrnts"))
+    with pytest.warns(UserWarning, match=r"no model for model://no_such_model/scripts"):
+        load_sdf_model(text.replace(f"file://{tmp_path}", "model://no_such_model/scripts"))
 
 
 def test_urdf_texture_and_missing_image(tmp_path):

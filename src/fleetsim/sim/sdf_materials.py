@@ -63,6 +63,7 @@ def _texture_from_script(script, vis, where: str, find_model) -> tuple[str | Non
     """
     name = _text(script, "name", "")
     dirs: list[Path] = []
+    missing: list[str] = []  # model:// URIs whose model is not found
     for uri in script.findall("uri"):
         u = (uri.text or "").strip()
         if u.startswith("model://"):
@@ -70,6 +71,7 @@ def _texture_from_script(script, vis, where: str, find_model) -> tuple[str | Non
             try:
                 dirs.append(find_model(model, where) / rest)
             except SimulationError:
+                missing.append(u)
                 continue
         elif u.startswith("file://"):
             path = Path(u[len("file://") :])
@@ -84,9 +86,10 @@ def _texture_from_script(script, vis, where: str, find_model) -> tuple[str | Non
         # does not draw is Gazebo's own, not a mistake
         if name and not name.startswith("Gazebo/"):
             looked = ", ".join(str(d) for d in dirs) or "no <uri>"
+            lost = f"; no model for {', '.join(missing)} (GAZEBO_MODEL_PATH)" if missing else ""
             warnings.warn(
                 f"{_owner(vis, where)}: material script '{name}' is not defined in its "
-                f"scripts ({looked}): drawn without it (a texture it names, such as a "
+                f"scripts ({looked}{lost}): drawn without it (a texture it names, such as a "
                 "marker's image, will not show)",
                 stacklevel=2,
             )

@@ -208,3 +208,32 @@ def test_a_graph_query_before_the_first_snapshot_still_names_the_process(monkeyp
     finally:
         bridge.close()
         rt.shutdown()
+
+
+def test_an_action_server_in_the_simulation_is_seen_by_a_joined_node(endpoint):
+    """The lesson's send_goals (or a user's client) joined to a run with --connect waited for
+    /lizi1/move_base for ever: wait_for_server looked only at its own graph. A server whose
+    status messages come over the bridge is there, as actionlib's wait_for_server has it."""
+    from fleetsim.msgs import move_base_msgs
+
+    from .conftest import SimThread
+
+    rt = Runtime(seed=1)
+    server = Node(rt, "move_base", "/lizi1")
+    server.create_action_server(move_base_msgs.MoveBase, "move_base", goal_callback=lambda: None)
+    with SimThread(rt, endpoint):
+        follower, bridge = _follower(endpoint)
+        try:
+            client = Node(follower, "send_goals").create_action_client(
+                move_base_msgs.MoveBase, "/lizi1/move_base"
+            )
+            assert not client.wait_for_server()  # nothing heard yet
+            bridge.run_following(until=follower.now() + 1.0)
+            assert client.wait_for_server()
+            missing = Node(follower, "other").create_action_client(
+                move_base_msgs.MoveBase, "/lizi9/move_base"
+            )
+            bridge.run_following(until=follower.now() + 0.5)
+            assert not missing.wait_for_server()
+        finally:
+            follower.shutdown()

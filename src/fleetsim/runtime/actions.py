@@ -285,6 +285,7 @@ class ActionClient:
         self.name = node.resolve_name(name)
         self.handles: dict[str, ClientGoalHandle] = {}
         self._count = itertools.count(1)
+        self._server_heard = False
         self._goal_pub = node.create_publisher(action_type.ActionGoal, f"{self.name}/goal")
         self._cancel_pub = node.create_publisher(al.GoalID, f"{self.name}/cancel")
         node.create_subscription(al.GoalStatusArray, f"{self.name}/status", self._on_status, 0)
@@ -296,7 +297,11 @@ class ActionClient:
         )
 
     def wait_for_server(self, timeout: float | None = None) -> bool:
-        """True when a server publishes this action's status (in process: no waiting)."""
+        """True when a server publishes this action's status: one in this process, or one
+        whose status messages have come (a server in another process, over the bridge: a
+        node joined to a run with --connect sees none in its own graph). No waiting."""
+        if self._server_heard:
+            return True
         topic = self.node.runtime.graph.topics.get(f"{self.name}/status")
         return topic is not None and bool(topic.publishers)
 
@@ -328,6 +333,7 @@ class ActionClient:
         self._cancel_pub.publish(al.GoalID())
 
     def _on_status(self, msg) -> None:
+        self._server_heard = True  # actionlib: a server is there once its status comes
         for st in msg.status_list:
             h = self.handles.get(st.goal_id.id)
             if h is not None and h.result is None:

@@ -110,3 +110,16 @@ def test_the_command_stops_cleanly_on_ctrl_c_and_sigterm(sim, sig, status):
             p.wait()
     assert p.returncode == status, out
     assert "Traceback" not in out
+
+
+def test_a_node_module_in_the_working_directory_is_found(tmp_path, monkeypatch):
+    """``fleetsim node run mygoals:Crosser`` beside mygoals.py, as rosrun finds a script: the
+    console script's path does not hold the working directory."""
+    (tmp_path / "fs_probe_noderun_mod.py").write_text(
+        "from fleetsim.runtime import Node\n\nclass Crosser(Node):\n    pass\n"
+    )
+    monkeypatch.chdir(tmp_path)
+    monkeypatch.setattr("sys.path", [p for p in __import__("sys").path if p not in ("", ".")])
+    assert load_node_class("fs_probe_noderun_mod:Crosser").__name__ == "Crosser"
+    with pytest.raises(LaunchError, match="looked on the Python path and in the working"):
+        load_node_class("fs_probe_noderun_none:Crosser")

@@ -60,7 +60,7 @@ def _import(target: str, what: str, where: str = "") -> Any:
     try:
         mod = importlib.import_module(module)
     except ModuleNotFoundError as e:
-        mod = _import_beside(module, e, where)
+        mod = import_beside(module, e, where)
         if mod is None:
             raise LaunchError(
                 f"{what}: cannot import module '{module}': {e} (looked on the Python path, "
@@ -77,7 +77,7 @@ def _import(target: str, what: str, where: str = "") -> Any:
         ) from None
 
 
-def _import_beside(module: str, error: ModuleNotFoundError, where: str) -> Any:
+def import_beside(module: str, error: ModuleNotFoundError, where: str) -> Any:
     """A user's node module (``type="my_teleop:Teleop"``) beside the launch file (``where``
     is its file:line) or in the working directory, as ``fleetsim batch`` finds it there:
     that folder is put on the Python path. None when the module is not there either."""

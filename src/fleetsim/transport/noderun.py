@@ -49,10 +49,17 @@ def load_node_class(spec: str) -> type:
     module, sep, attr = spec.partition(":")
     if not sep or not module or not attr:
         raise LaunchError(f"node {spec!r} must be given as module:Class (my_pkg.nodes:Follower)")
+    from fleetsim.launch.registry import import_beside
+
     try:
         mod = importlib.import_module(module)
     except ModuleNotFoundError as e:
-        raise LaunchError(f"node {spec!r}: cannot import module {e.name!r}") from None
+        mod = import_beside(module, e, "")  # a module in the working directory, as rosrun's
+        if mod is None:
+            raise LaunchError(
+                f"node {spec!r}: cannot import module {e.name!r} (looked on the Python path "
+                "and in the working directory; set PYTHONPATH for elsewhere)"
+            ) from None
     cls = getattr(mod, attr, None)
     if not (isinstance(cls, type) and issubclass(cls, Node)):
         raise LaunchError(f"node {spec!r}: {module} has no Node subclass named {attr!r}")

@@ -411,6 +411,25 @@ def test_bad_parameters_are_refused_by_name(params, words):
         CollvoidLocalPlanner.from_namespace(node, cmr, params, "r/CollvoidLocalPlanner")
 
 
+def test_a_planner_told_to_avoid_no_robot_says_so(caplog):
+    """max_neighbors 0 (or neighbor_dist 0): collvoid takes it, and robots drive into each
+    other at crossings with no word of why (a new user's four lizis: 6 contacts)."""
+    import logging
+
+    rt = Runtime()
+    node = Node(rt, "move_base", "/r")
+    cmr = SimpleNamespace(costmap=empty_map(), footprint=LIZI, global_frame="map")
+    with caplog.at_level(logging.WARNING):
+        CollvoidLocalPlanner.from_namespace(node, cmr, {}, "r/CollvoidLocalPlanner")
+        assert "avoids no other robot" not in caplog.text
+        CollvoidLocalPlanner.from_namespace(
+            node, cmr, {"max_neighbors": 0}, "r/CollvoidLocalPlanner"
+        )
+    assert "r/CollvoidLocalPlanner: max_neighbors 0, neighbor_dist 3: the planner avoids" in (
+        caplog.text
+    )
+
+
 def test_move_base_knows_the_plugin_by_its_ros_name():
     assert LOCAL_PLANNERS["collvoid_local_planner/CollvoidLocalPlanner"] == "CollvoidLocalPlanner"
 

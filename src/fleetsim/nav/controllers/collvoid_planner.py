@@ -135,6 +135,12 @@ class CollvoidLocalPlanner(
             )
         if p.type_vo != 0:
             _log.warning("%s: type_vo %d has no effect with orca: true", where, p.type_vo)
+        if p.max_neighbors == 0 or p.neighbor_dist == 0:  # collvoid takes it; robots collide
+            _log.warning(
+                "%s: max_neighbors %d, neighbor_dist %g: the planner avoids no other robot "
+                "(as the plain local planner, robots meet only as laser obstacles)",
+                where, p.max_neighbors, p.neighbor_dist,
+            )  # fmt: skip
         self.node = node
         self.where = where
         self.costmap_ros = costmap_ros

@@ -442,6 +442,15 @@ def test_targets_and_objects_in_other_frames_go_through_tf(hunter_robot, caplog)
     (geom,) = mg.pipeline.objects["at_tip"]
     np.testing.assert_allclose(geom[2], [p.x, p.y, p.z], atol=1e-4)  # the base creeps µm
     assert "lost" not in mg.pipeline.objects and "Unable to transform" in caplog.text
+    scene = h.rt.graph.call_service(
+        "/hunter1/get_planning_scene",
+        moveit_msgs.GetPlanningScene,
+        moveit_msgs.GetPlanningSceneRequest(),
+    ).scene
+    (obj,) = scene.world.collision_objects  # as placed, in the root link's frame
+    assert obj.header.frame_id == "hunter1/base_link"
+    q = obj.primitive_poses[0].position
+    np.testing.assert_allclose([q.x, q.y, q.z], [p.x, p.y, p.z], atol=1e-4)
     assert_no_mujoco_warnings(h.sim.engine)
 
 

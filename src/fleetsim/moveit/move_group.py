@@ -458,7 +458,7 @@ class MoveGroup(Node):
                     self.objects.pop(oid, None)
                     self.pipeline.remove_object(oid)
                 continue
-            geoms = []
+            geoms, poses = [], []
             try:
                 placed = self.frame_transform(self.root_frame, obj.header.frame_id)
             except PlanFailure as e:  # MoveIt: "Unknown frame", and the object is not added
@@ -488,7 +488,17 @@ class MoveGroup(Node):
                     pos = transform_points(*placed, [pos])[0]
                     q = quaternion_multiply(placed[1], q)
                 geoms.append((int(SHAPES[prim.type]), size, pos, np.array([q[3], *q[:3]])))
-            self.objects[obj.id] = obj
+                poses.append(
+                    geometry_msgs.Pose(
+                        position=geometry_msgs.Point(*map(float, pos)),
+                        orientation=geometry_msgs.Quaternion(*map(float, q)),
+                    )
+                )
+            # kept as placed, in the root link's frame (get_planning_scene answers with it;
+            # an object given in odom would otherwise come back in odom, as of when it came)
+            stored = copy.deepcopy(obj)
+            stored.header.frame_id, stored.primitive_poses = self.root_frame, poses
+            self.objects[obj.id] = stored
             self.pipeline.set_object(obj.id, geoms)
         return True
 

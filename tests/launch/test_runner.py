@@ -1,5 +1,6 @@
 """Running plans: nodes in namespaces with tf_prefix, viewers skipped, clear failures."""
 
+import logging
 from pathlib import Path
 
 import pytest
@@ -94,3 +95,17 @@ def test_the_error_that_ended_a_run_is_not_hidden_by_shutdown_errors(tmp_path: P
         s.runtime.on_shutdown(broken_hook)
         raise LaunchError("the run's own error")
     assert "while shutting down after 'the run's own error': hook broke" in caplog.text
+
+
+def test_a_launch_file_that_starts_no_node_is_warned_about(tmp_path, caplog):
+    """The manual's own run2.launch with a misspelt sim_type (no <choice> there): every group
+    is skipped, and roslaunch runs on without a word."""
+    f = tmp_path / "nothing.launch"
+    f.write_text(
+        '<launch><arg name="sim_type" default="gazbo"/>'
+        "<group if=\"$(eval sim_type == 'gazebo')\">"
+        '<node pkg="gazebo_ros" type="gzserver" name="gazebo"/></group></launch>'
+    )
+    with caplog.at_level(logging.WARNING), LaunchSession(load_plan(f), seed=1) as session:
+        assert session.nodes == {}
+    assert "the launch file starts no node and sets no parameter" in caplog.text

@@ -108,17 +108,3 @@ def test_run2_refuses_a_misspelt_sim_type_and_amcl_replaces_the_nav_stack():
     assert world.is_file()
     with pytest.raises(MapError, match="needs a map YAML .* not a .world file"):
         load_map(world)
-
-
-def test_a_launch_file_that_starts_no_node_is_warned_about(tmp_path, caplog):
-    """The manual's own run2.launch with a misspelt sim_type (no <choice> there): every group
-    is skipped, and roslaunch runs on without a word."""
-    f = tmp_path / "nothing.launch"
-    f.write_text(
-        '<launch><arg name="sim_type" default="gazbo"/>'
-        "<group if=\"$(eval sim_type == 'gazebo')\">"
-        '<node pkg="gazebo_ros" type="gzserver" name="gazebo"/></group></launch>'
-    )
-    with caplog.at_level(logging.WARNING), LaunchSession(load_plan(f), seed=1):
-        pass
-    assert "the launch file starts no node and sets no parameter" in caplog.text

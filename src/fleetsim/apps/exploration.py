@@ -70,6 +70,23 @@ def pose_stamped(frame: str, stamp: Any, t: np.ndarray, q: np.ndarray) -> Any:
     )
 
 
+class Follower:
+    """A follower as the run monitor sees it (`fleetsim.launch.monitor.GoalSender`): it
+    follows for as long as the run lasts, so a run waiting for the goals (--until-goals,
+    batch) is not ended by its first goal reached, and it is never done, which is no failure;
+    the exploration goals it cancels on seeing the marker again are withdrawn, no failure."""
+
+    sends_goals = True
+    follows = True
+    done = False
+    succeeded = True
+    exploration: Exploration
+
+    @property
+    def withdrawn_goals(self) -> set[str]:
+        return self.exploration.withdrawn
+
+
 class Exploration(ABC):
     """Base: one move_base action goal at a time, cancelled at most once."""
 
@@ -92,6 +109,7 @@ class Exploration(ABC):
         self.goals_sent = 0
         self.sent_at = -math.inf
         self._patience = TransformPatience()
+        self.withdrawn: set[str] = set()  # ids of the goals it canceled as no longer wanted
 
     @classmethod
     def create(cls, node, raw: Any, where: str) -> Exploration:
@@ -147,10 +165,7 @@ class Exploration(ABC):
         if self.exploring and not self.cancelled and self.handle is not None:
             self.handle.cancel()
             self.cancelled = True
-            # the follower no longer wants it: for the run monitor, no failure
-            withdrawn = getattr(self.node, "withdrawn_goals", None)
-            if withdrawn is not None:
-                withdrawn.add(self.handle.goal_id.id)
+            self.withdrawn.add(self.handle.goal_id.id)  # no longer wanted: no failure
             if not self.handle.heard:  # no server to answer: no done callback will come
                 self.exploring = self.cancelled = False
 

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from fleetsim.apps.exploration import Exploration, pose_stamped
+from fleetsim.apps.exploration import Exploration, Follower, pose_stamped
 from fleetsim.errors import ServiceError, TransformError
 from fleetsim.msgs import fiducial_msgs, geometry_msgs, std_srvs
 from fleetsim.runtime import Node, param
@@ -119,32 +119,23 @@ class MarkerToTargetPose:
     y: float = param(0.0, unit="m", help="offset to the marker's left")
 
 
-class FollowMarker(Node):
+class FollowMarker(Follower, Node):
     """Turns marker observations into move_base goals; explores when the marker is lost."""
-
-    # a follower for the run monitor (`fleetsim.launch.monitor.GoalSender`): it follows for as
-    # long as the run lasts, so a run waiting for the goals (--until-goals, batch) is not ended
-    # by its first goal reached, and it is never done, which is no failure
-    sends_goals = True
-    follows = True
-    done = False
-    succeeded = True
 
     Params = FollowMarkerParams
 
     def __init__(self, runtime, name: str = "follow_marker", namespace: str = "/", **kw: Any):
         super().__init__(runtime, name, namespace, **kw)
-        self.withdrawn_goals: set[str] = set()  # exploration goals it canceled
         p: FollowMarkerParams = self.params
         offset = load_params(
             MarkerToTargetPose,
-            self._sourced("marker_to_target_pose", p.marker_to_target_pose),
+            p.marker_to_target_pose,
             where=f"{self.full_name}/marker_to_target_pose",
             logger=self.get_logger(),
         )
         self.offset = np.array([offset.x, offset.y, 0.0])
         self.exploration = Exploration.create(
-            self, self._sourced("exploration", p.exploration), where=f"{self.full_name}/exploration"
+            self, p.exploration, where=f"{self.full_name}/exploration"
         )
         self.base_frame = self.frame("base_footprint")
         self.map_frame = "map"
@@ -160,12 +151,6 @@ class FollowMarker(Node):
             fiducial_msgs.FiducialTransformArray, "fiducial_transforms", self.on_fiducials, 1
         )
         self.create_timer(CLEAR_COSTMAPS_PERIOD, self.clear_costmaps)
-
-    def _sourced(self, key: str, value: Any) -> Any:
-        """The private parameter ``key`` as the parameter tree holds it, with where each of its
-        values was set (a launch file's line), for errors about them; else ``value``."""
-        raw = self.get_param(f"~{key}", None)
-        return raw if isinstance(raw, dict) else value
 
     def _lookup(self, key: str, target: str, source: str, stamp: Any):
         """``target <- source`` at ``stamp``, or None (warned about once the failure has lasted

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from fleetsim.apps.exploration import Exploration, pose_stamped
+from fleetsim.apps.exploration import Exploration, Follower, pose_stamped
 from fleetsim.apps.follow_marker import MARKER_TO_MARKER, OtherMarkersWatch
 from fleetsim.apps.follower_mpc import costs_without_target, rollout_costs, velocity_samples
 from fleetsim.apps.predictive_follower_params import PredictiveFollowerParams
@@ -54,23 +54,14 @@ TRACK, SEARCH_PREDICTED, SEARCH_LAST_SEEN, EXPLORE = (
 )
 
 
-class PredictiveFollower(Node):
+class PredictiveFollower(Follower, Node):
     """Keeps a marker in view: tracker + sampling MPC + search. State: the tracker, the mode,
     the last command."""
-
-    # a follower for the run monitor (`fleetsim.launch.monitor.GoalSender`): it follows for as
-    # long as the run lasts, so a run waiting for the goals (--until-goals, batch) is not ended
-    # by its first goal reached, and it is never done, which is no failure
-    sends_goals = True
-    follows = True
-    done = False
-    succeeded = True
 
     Params = PredictiveFollowerParams
 
     def __init__(self, runtime, name: str = "predictive_follower", namespace: str = "/", **kw):
         super().__init__(runtime, name, namespace, **kw)
-        self.withdrawn_goals: set[str] = set()  # exploration goals it canceled
         p: PredictiveFollowerParams = self.params
         where = self.full_name
         self.tracker = TargetTracker(

@@ -20,31 +20,27 @@ import copy
 from dataclasses import dataclass
 from functools import partial
 
-import mujoco
 import numpy as np
 
 from fleetsim.description.srdf import parse_srdf
 from fleetsim.description.urdf import parse_urdf
 from fleetsim.errors import FleetsimError, PlanningError
 from fleetsim.moveit.execution import ExecutionManager
+from fleetsim.moveit.frames import PlanningFrames
 from fleetsim.moveit.kinematics_services import compute_cartesian_path, compute_fk, compute_ik
 from fleetsim.moveit.pipeline import PlanFailure, PlanningPipeline
+from fleetsim.moveit.planning_scene import PlanningSceneKeeper
 from fleetsim.moveit.robot_model import RobotModel
 from fleetsim.msgs import (
-    geometry_msgs,
     moveit_msgs,
     sensor_msgs,
-    shape_msgs,
     std_msgs,
     trajectory_msgs,
 )
 from fleetsim.runtime import Node, param
-from fleetsim.tf.quaternions import quaternion_multiply
-from fleetsim.tf.transforms import transform_points
 
 E = moveit_msgs.MoveItErrorCodes
 FAKE = "moveit_fake_controller_manager/MoveItFakeControllerManager"
-_NO_TURN = np.array([0.0, 0.0, 0.0, 1.0])  # x y z w
 
 
 def _standing(traj) -> bool:
@@ -52,13 +48,6 @@ def _standing(traj) -> bool:
     already met)."""
     points = traj.joint_trajectory.points
     return len(points) <= 1 and all(p.time_from_start.to_sec() == 0.0 for p in points)
-
-
-SHAPES = {
-    shape_msgs.SolidPrimitive.BOX: mujoco.mjtGeom.mjGEOM_BOX,
-    shape_msgs.SolidPrimitive.SPHERE: mujoco.mjtGeom.mjGEOM_SPHERE,
-    shape_msgs.SolidPrimitive.CYLINDER: mujoco.mjtGeom.mjGEOM_CYLINDER,
-}
 
 
 @dataclass(frozen=True)
@@ -82,7 +71,7 @@ class MoveGroupParams:
     capabilities: str = param("", help="accepted")
 
 
-class MoveGroup(Node):
+class MoveGroup(PlanningFrames, PlanningSceneKeeper, Node):
     Params = MoveGroupParams
     PARAM_NAMESPACES = ("planner_configs", "ompl", "sensors", "planning_pipelines")
 
@@ -237,77 +226,6 @@ class MoveGroup(Node):
         for ctx in self.pipeline.contexts():
             ctx.scene.set_world_from(sim.engine, entry.name)
 
-    # ------------------------------------------------------------------ frames
-    @property
-    def root_frame(self) -> str:
-        """The robot's root link, tf-prefixed: the frame the kinematics work in."""
-        return self.frame(self.model.robot.root_link())
-
-    @property
-    def planning_frame(self) -> str:
-        """MoveIt's planning frame: a virtual joint's parent frame (``odom`` for a planar
-        one), else the robot's root link; a target or object without a frame is in it."""
-        vj = self.model.srdf.virtual_joints
-        return self.frame(vj[0].parent_frame) if vj else self.root_frame
-
-    def _same_as_root(self, frame: str) -> str:
-        """The root link's frame for a *fixed* virtual joint's parent frame (``world`` in
-        the Setup Assistant's configs): MoveIt's model holds that transform, identity, and no
-        one publishes it on tf; a planar or floating one's parent is looked up through tf."""
-        vj = self.model.srdf.virtual_joints
-        if vj and vj[0].type == "fixed" and frame == self.frame(vj[0].parent_frame):
-            return self.root_frame
-        return frame
-
-    def frame_transform(self, target: str, source: str):
-        """``(t (3,), q (4,) x y z w)`` of frame ``source`` in ``target`` through tf (either
-        empty: the planning frame); None when they are the same frame. A frame tf does not
-        know fails with MoveIt's FRAME_TRANSFORM_FAILURE."""
-        target = self._same_as_root(target.lstrip("/") or self.planning_frame)
-        source = self._same_as_root(source.lstrip("/") or self.planning_frame)
-        if target == source:
-            return None
-        try:
-            tf = self.tf_buffer.lookup_transform(target, source, 0.0).transform
-        except FleetsimError as e:
-            raise PlanFailure(
-                E.FRAME_TRANSFORM_FAILURE,
-                f"Unable to transform from frame '{source}' to frame '{target}': {e}",
-            ) from None
-        t, q = tf.translation, tf.rotation
-        return np.array([t.x, t.y, t.z]), np.array([q.x, q.y, q.z, q.w])
-
-    def pose_in_root(self, frame: str, position, orientation=None):
-        """A pose given in ``frame`` (x y z, and x y z w or None) in the root link's frame."""
-        tf = self.frame_transform(self.root_frame, frame)
-        if tf is None:
-            return np.asarray(position, float), orientation
-        pos = transform_points(*tf, [position])[0]
-        if orientation is not None:
-            orientation = quaternion_multiply(tf[1], orientation)
-        return pos, orientation
-
-    def _goal_in_root(self, c):
-        """A copy of goal constraints ``c`` with its position and orientation constraints in
-        the root link's frame (the pose goal's frame: its header's, else the planning frame)."""
-        if not (c.position_constraints or c.orientation_constraints):
-            return c
-        c = copy.deepcopy(c)
-        for pc in c.position_constraints:
-            for pose in pc.constraint_region.primitive_poses:
-                p = pose.position
-                pos, _ = self.pose_in_root(pc.header.frame_id, [p.x, p.y, p.z])
-                pose.position = geometry_msgs.Point(*map(float, pos))
-            pc.header.frame_id = self.root_frame
-        for oc in c.orientation_constraints:
-            o = oc.orientation
-            tf = self.frame_transform(self.root_frame, oc.header.frame_id)
-            if tf is not None:
-                q = quaternion_multiply(tf[1], [o.x, o.y, o.z, o.w])
-                oc.orientation = geometry_msgs.Quaternion(*map(float, q))
-            oc.header.frame_id = self.root_frame
-        return c
-
     # ------------------------------------------------------------------ planning
     def plan(self, req):
         """MotionPlanResponse for a MotionPlanRequest (never raises for a bad request)."""
@@ -366,15 +284,9 @@ class MoveGroup(Node):
         goal message and its server-side handle, to which the goal's `_finisher` is bound."""
         if server.is_active():
             self.execution.stop("preempted by a new goal", E.PREEMPTED)
-        if server.is_active():  # planned only, or its execution already over
-            r = server.type.Result()
-            r.error_code.val = E.PREEMPTED
-            server.set_preempted(
-                r,
-                "This goal was canceled because another goal was received by the simple "
-                "action server",
-            )
-        return server.accept_new_goal(), server.current
+        preempted = server.type.Result()  # for a goal still active: its execution was over
+        preempted.error_code.val = E.PREEMPTED
+        return server.accept_new_goal(preempted), server.current
 
     def _finisher(self, server, handle, result):
         """``done(code, why)`` for the trajectory of goal ``handle``: ends that goal with
@@ -445,69 +357,3 @@ class MoveGroup(Node):
     def _on_event(self, msg) -> None:
         if msg.data == "stop":
             self.execution.stop("stopped by trajectory_execution_event", E.PREEMPTED)
-
-    # ------------------------------------------------------------------ planning scene
-    def _on_scene(self, msg) -> None:
-        self._apply(msg)
-
-    def _apply(self, scene) -> bool:
-        for obj in scene.world.collision_objects:
-            if obj.operation == moveit_msgs.CollisionObject.REMOVE:
-                ids = [obj.id] if obj.id else list(self.objects)
-                for oid in ids:
-                    self.objects.pop(oid, None)
-                    self.pipeline.remove_object(oid)
-                continue
-            geoms, poses = [], []
-            try:
-                placed = self.frame_transform(self.root_frame, obj.header.frame_id)
-            except PlanFailure as e:  # MoveIt: "Unknown frame", and the object is not added
-                self.get_logger().error("collision object '%s': %s", obj.id, e)
-                return False
-            for prim, pose in zip(obj.primitives, obj.primitive_poses, strict=False):
-                if prim.type not in SHAPES:
-                    self.get_logger().error(
-                        "collision object '%s': unsupported shape %d", obj.id, prim.type
-                    )
-                    return False
-                d = np.asarray(prim.dimensions, float)
-                size = {
-                    mujoco.mjtGeom.mjGEOM_BOX: d[:3] / 2 if len(d) >= 3 else None,
-                    mujoco.mjtGeom.mjGEOM_SPHERE: np.array([d[0], 0, 0]) if len(d) >= 1 else None,
-                    mujoco.mjtGeom.mjGEOM_CYLINDER: np.array([d[1], d[0] / 2, 0])
-                    if len(d) >= 2
-                    else None,
-                }[SHAPES[prim.type]]
-                if size is None:
-                    self.get_logger().error("collision object '%s': too few dimensions", obj.id)
-                    return False
-                pos = np.array([pose.position.x, pose.position.y, pose.position.z])
-                o = pose.orientation
-                q = np.array([o.x, o.y, o.z, o.w]) if (o.w or o.x or o.y or o.z) else _NO_TURN
-                if placed is not None:  # from the object's frame into the root link's
-                    pos = transform_points(*placed, [pos])[0]
-                    q = quaternion_multiply(placed[1], q)
-                geoms.append((int(SHAPES[prim.type]), size, pos, np.array([q[3], *q[:3]])))
-                poses.append(
-                    geometry_msgs.Pose(
-                        position=geometry_msgs.Point(*map(float, pos)),
-                        orientation=geometry_msgs.Quaternion(*map(float, q)),
-                    )
-                )
-            # kept as placed, in the root link's frame (get_planning_scene answers with it;
-            # an object given in odom would otherwise come back in odom, as of when it came)
-            stored = copy.deepcopy(obj)
-            stored.header.frame_id, stored.primitive_poses = self.root_frame, poses
-            self.objects[obj.id] = stored
-            self.pipeline.set_object(obj.id, geoms)
-        return True
-
-    def _srv_get_scene(self, req):
-        scene = moveit_msgs.PlanningScene(name="(noname)", robot_model_name=self.model.srdf.name)
-        scene.robot_state.joint_state.name = list(self.joint_positions)
-        scene.robot_state.joint_state.position = np.array(list(self.joint_positions.values()))
-        scene.world.collision_objects = list(self.objects.values())
-        return moveit_msgs.GetPlanningSceneResponse(scene=scene)
-
-    def _srv_apply(self, req):
-        return moveit_msgs.ApplyPlanningSceneResponse(success=self._apply(req.scene))

@@ -147,8 +147,9 @@ class ActionServer:
     def is_new_goal_available(self) -> bool:
         return self.next is not None
 
-    def accept_new_goal(self) -> Any:
-        """Make the pending goal active (preempting the active one); returns its goal message."""
+    def accept_new_goal(self, preempted_result: Any = None) -> Any:
+        """Make the pending goal active (preempting the active one, whose result is
+        ``preempted_result``, else an empty one); returns its goal message."""
         al = self._al
         if self.next is None:
             raise ActionError(f"action {self.name}: accept_new_goal() with no new goal pending")
@@ -158,6 +159,7 @@ class ActionServer:
                 al.GoalStatus.PREEMPTED,
                 "This goal was canceled because another goal was received by the simple action "
                 "server",
+                preempted_result,
             )
         self.current, self.next = self.next, None
         self.current.status = al.GoalStatus.ACTIVE

@@ -161,7 +161,9 @@ def _convert(value: Any, tp: Any) -> Any:
     if origin is dict or tp is dict:
         if not isinstance(value, Mapping):
             raise TypeError("dict")
-        return dict(value)
+        # a copy that keeps where each key was set, so that a node loading the dict's own
+        # parameters (load_params) names the file and line of a bad one
+        return ParamDict.copy_of(value)
     if isinstance(tp, type) and isinstance(value, tp):
         return value
     raise TypeError(_type_label(tp))

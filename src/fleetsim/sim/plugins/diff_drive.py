@@ -379,7 +379,7 @@ def _true_odometries(xpos, xquat, xmat, cvel, subtree_com, rootid, roots):
 
 @dataclass(frozen=True)
 class _NoParams:
-    pass
+    """The wheels' transforms have no parameters of their own: the drive's are used."""
 
 
 class WheelTfPlugin(SensorPlugin):
@@ -388,7 +388,7 @@ class WheelTfPlugin(SensorPlugin):
     (its transform is the wheel's pose relative to the model, which is the parent link's
     frame when the parent is the root; here it is the parent link's, as tf's tree needs)."""
 
-    Params = _NoParams  # the drive's parameters are used
+    Params = _NoParams
 
     def __init__(self, drive: DiffDrivePlugin, rate: float) -> None:
         spec = replace(drive.spec, name=f"{drive.spec.name}/wheel_tf", params={})
